@@ -1,0 +1,97 @@
+// The grid of tool-width cells ("IOP", thesis §3.6.1) every planner works on.
+//
+// Square cells of side `cell_size` aligned with the map frame. A cell is free
+// when more than `min_free_fraction` (default 50 %) of its area is free map
+// area. Row 0 is the smallest y, column 0 the smallest x; cell (r, c) is the
+// square origin + (c*s, r*s) .. origin + ((c+1)*s, (r+1)*s). The grid origin
+// equals the map origin.
+//
+//   GridOptions opt; opt.cell_size = 0.8;
+//   absl::StatusOr<Grid> grid = BuildGrid(map, opt);
+//
+// Thread-safety: immutable after construction; const methods are thread-safe.
+#ifndef COVPLAN_PLANNER_GRID_GRID_H_
+#define COVPLAN_PLANNER_GRID_GRID_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "planner/grid/occupancy_map.h"
+
+namespace covplan {
+
+struct CellIndex {
+  int row = 0;
+  int col = 0;
+  friend bool operator==(CellIndex a, CellIndex b) { return a.row == b.row && a.col == b.col; }
+  friend bool operator!=(CellIndex a, CellIndex b) { return !(a == b); }
+};
+
+struct GridOptions {
+  double cell_size = 0.8;          // metres: the tool width
+  double min_free_fraction = 0.5;  // a cell is free when free share > this
+  int64_t max_cells = 20'000'000;  // reject grids larger than this
+
+  absl::Status Validate() const;
+};
+
+class Grid {
+ public:
+  Grid() = default;
+  // Builds a grid directly from free flags (row-major, row 0 = smallest y).
+  Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free);
+
+  // Parses ASCII art for tests: one string per row, *first string is the top
+  // row* (largest y) so the picture reads naturally; '.' free, '#' blocked.
+  static Grid FromAscii(const std::vector<std::string>& rows_top_down, double cell_size = 1.0);
+
+  int rows() const { return rows_; }
+  int cols() const { return cols_; }
+  int64_t size() const { return static_cast<int64_t>(rows_) * cols_; }
+  double cell_size() const { return cell_size_; }
+  Point2 origin() const { return origin_; }
+
+  bool InBounds(int r, int c) const { return r >= 0 && c >= 0 && r < rows_ && c < cols_; }
+  bool IsFree(int r, int c) const { return InBounds(r, c) && free_[Index(r, c)] != 0; }
+  bool IsFree(CellIndex c) const { return IsFree(c.row, c.col); }
+  int64_t Index(int r, int c) const { return static_cast<int64_t>(r) * cols_ + c; }
+  CellIndex FromIndex(int64_t i) const { return {static_cast<int>(i / cols_), static_cast<int>(i % cols_)}; }
+  int64_t CountFree() const;
+  const std::vector<uint8_t>& free_flags() const { return free_; }
+
+  // Centre of a cell in the map frame.
+  Point2 CellCenter(int r, int c) const {
+    return {origin_.x + (c + 0.5) * cell_size_, origin_.y + (r + 0.5) * cell_size_};
+  }
+  Point2 CellCenter(CellIndex c) const { return CellCenter(c.row, c.col); }
+  // Cell containing a map-frame point (may be out of bounds).
+  CellIndex CellAt(Point2 p) const;
+
+  // One string per row (row 0 first) of '1' free / '0' blocked.
+  std::vector<std::string> ToRowStrings() const;
+
+  size_t MemoryBytes() const { return sizeof(*this) + free_.capacity(); }
+
+ private:
+  int rows_ = 0;
+  int cols_ = 0;
+  double cell_size_ = 1.0;
+  Point2 origin_;
+  std::vector<uint8_t> free_;
+};
+
+// Builds the tool-width grid over `map`. InvalidArgument when the cell is
+// smaller than a map pixel, larger than the map, the grid exceeds max_cells,
+// or no cell is free.
+absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& options);
+
+// Share of the map's free area covered by free grid cells (the area the tool
+// sweeps when every free cell is covered). 0 when the map has no free area.
+double CoveredFreeAreaRatio(const OccupancyMap& map, const Grid& grid);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_PLANNER_GRID_GRID_H_

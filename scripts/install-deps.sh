@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package covplan needs to build, test and run.
+# Idempotent: skips apt entirely when everything is already present.
+set -euo pipefail
+
+PKGS=(
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
+  libabsl-dev libglpk-dev glpk-utils libeigen3-dev libboost-graph-dev
+  libyaml-cpp-dev libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
+  prometheus-cpp-dev curl
+)
+# Optional tools for fuzzing / sanitizer builds (clang + libFuzzer runtime).
+OPTIONAL=(clang libclang-rt-14-dev)
+
+missing=()
+for p in "${PKGS[@]}" "${OPTIONAL[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${PKGS[@]}" >/dev/null
+# Optional packages: do not fail the install if unavailable.
+$SUDO apt-get install -y -qq --no-install-recommends "${OPTIONAL[@]}" >/dev/null || \
+  echo "install-deps: optional packages (${OPTIONAL[*]}) not installed; fuzz target disabled"
+echo "install-deps: done"
