@@ -1,0 +1,186 @@
+#include "planner/grid/grid.h"
+
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+
+namespace covplan {
+
+absl::Status GridOptions::Validate() const {
+  if (!std::isfinite(cell_size) || cell_size <= 0.0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "tool width must be a positive number of metres, got %g", cell_size));
+  }
+  if (!std::isfinite(min_free_fraction) || min_free_fraction < 0.0 || min_free_fraction >= 1.0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "min_free_fraction must be in [0, 1), got %g", min_free_fraction));
+  }
+  if (max_cells <= 0) return absl::InvalidArgumentError("max_cells must be positive");
+  return absl::OkStatus();
+}
+
+Grid::Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free)
+    : rows_(rows), cols_(cols), cell_size_(cell_size), origin_(origin), free_(std::move(free)) {}
+
+Grid Grid::FromAscii(const std::vector<std::string>& rows_top_down, double cell_size) {
+  const int rows = static_cast<int>(rows_top_down.size());
+  const int cols = rows == 0 ? 0 : static_cast<int>(rows_top_down[0].size());
+  std::vector<uint8_t> free(static_cast<size_t>(rows) * cols, 0);
+  for (int i = 0; i < rows; ++i) {
+    const int r = rows - 1 - i;
+    for (int c = 0; c < cols && c < static_cast<int>(rows_top_down[i].size()); ++c) {
+      free[static_cast<size_t>(r) * cols + c] = rows_top_down[i][c] == '.' ? 1 : 0;
+    }
+  }
+  return Grid(rows, cols, cell_size, {0.0, 0.0}, std::move(free));
+}
+
+int64_t Grid::CountFree() const {
+  int64_t n = 0;
+  for (uint8_t f : free_) n += (f != 0);
+  return n;
+}
+
+CellIndex Grid::CellAt(Point2 p) const {
+  return {static_cast<int>(std::floor((p.y - origin_.y) / cell_size_)),
+          static_cast<int>(std::floor((p.x - origin_.x) / cell_size_))};
+}
+
+std::vector<std::string> Grid::ToRowStrings() const {
+  std::vector<std::string> out(rows_, std::string(cols_, '0'));
+  for (int r = 0; r < rows_; ++r) {
+    for (int c = 0; c < cols_; ++c) out[r][c] = IsFree(r, c) ? '1' : '0';
+  }
+  return out;
+}
+
+namespace {
+
+// Snaps x to the nearest integer when it is within floating-point noise, so
+// that e.g. 0.8 / 0.05 is exactly 16 pixels.
+double Snap(double x) {
+  const double r = std::round(x);
+  return std::abs(x - r) < 1e-9 * std::max(1.0, std::abs(x)) ? r : x;
+}
+
+// Free area (in pixel units) of every grid cell, computed exactly with
+// fractional overlap of boundary pixels. Separable: per pixel row, prefix sums
+// over columns give the column-weighted sum in O(1).
+class FreeAreaIntegrator {
+ public:
+  explicit FreeAreaIntegrator(const OccupancyMap& map) : map_(map) {
+    const int w = map.width();
+    prefix_.assign(static_cast<size_t>(map.height()) * (w + 1), 0);
+    for (int r = 0; r < map.height(); ++r) {
+      int32_t* row = &prefix_[static_cast<size_t>(r) * (w + 1)];
+      for (int c = 0; c < w; ++c) row[c + 1] = row[c] + (map.IsFree(r, c) ? 1 : 0);
+    }
+  }
+
+  // Free pixel area of the rectangle [x0, x1) x [y0, y1) in pixel coordinates.
+  double Area(double x0, double x1, double y0, double y1) const {
+    const int w = map_.width();
+    const int h = map_.height();
+    x0 = std::max(0.0, x0);
+    y0 = std::max(0.0, y0);
+    x1 = std::min<double>(w, x1);
+    y1 = std::min<double>(h, y1);
+    if (x0 >= x1 || y0 >= y1) return 0.0;
+    const int r_begin = static_cast<int>(std::floor(y0));
+    const int r_end = static_cast<int>(std::ceil(y1));
+    double total = 0.0;
+    for (int r = r_begin; r < r_end && r < h; ++r) {
+      const double wy = std::min<double>(r + 1, y1) - std::max<double>(r, y0);
+      if (wy <= 0.0) continue;
+      total += wy * RowSum(r, x0, x1);
+    }
+    return total;
+  }
+
+ private:
+  double RowSum(int r, double x0, double x1) const {
+    const int w = map_.width();
+    const int32_t* row = &prefix_[static_cast<size_t>(r) * (w + 1)];
+    const int c0 = static_cast<int>(std::floor(x0));
+    const int c1 = static_cast<int>(std::floor(x1));  // column containing x1
+    if (c0 == c1) return (x1 - x0) * (row[c0 + 1] - row[c0]);
+    double s = (c0 + 1 - x0) * (row[c0 + 1] - row[c0]);   // partial first column
+    s += row[c1] - row[c0 + 1];                            // full columns
+    if (c1 < w) s += (x1 - c1) * (row[c1 + 1] - row[c1]);  // partial last column
+    return s;
+  }
+
+  const OccupancyMap& map_;
+  std::vector<int32_t> prefix_;
+};
+
+}  // namespace
+
+absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& options) {
+  absl::Status valid = options.Validate();
+  if (!valid.ok()) return valid;
+  const double res = map.resolution();
+  if (map.width() <= 0 || map.height() <= 0 || !(res > 0.0) || !std::isfinite(res)) {
+    return absl::InvalidArgumentError("map is empty or has no valid resolution");
+  }
+  const double width_m = map.width() * res;
+  const double height_m = map.height() * res;
+  if (options.cell_size < res * (1.0 - 1e-9)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "tool width %g m is narrower than one map pixel (%g m): use a coarser map or a wider tool",
+        options.cell_size, res));
+  }
+  if (options.cell_size > width_m || options.cell_size > height_m) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "tool width %g m is wider than the map (%g m x %g m)", options.cell_size, width_m,
+        height_m));
+  }
+  const double px_per_cell = Snap(options.cell_size / res);
+  const int cols = static_cast<int>(std::ceil(Snap(map.width() / px_per_cell)));
+  const int rows = static_cast<int>(std::ceil(Snap(map.height() / px_per_cell)));
+  if (static_cast<int64_t>(rows) * cols > options.max_cells) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "grid of %d x %d cells exceeds the limit of %d cells: use a wider tool or a smaller map",
+        rows, cols, options.max_cells));
+  }
+  FreeAreaIntegrator integrator(map);
+  const double cell_area = px_per_cell * px_per_cell;
+  std::vector<uint8_t> free(static_cast<size_t>(rows) * cols, 0);
+  int64_t num_free = 0;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const double a = integrator.Area(c * px_per_cell, (c + 1) * px_per_cell, r * px_per_cell,
+                                       (r + 1) * px_per_cell);
+      if (a > options.min_free_fraction * cell_area * (1.0 + 1e-12)) {
+        free[static_cast<size_t>(r) * cols + c] = 1;
+        ++num_free;
+      }
+    }
+  }
+  if (num_free == 0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "map has no free cell at tool width %g m (%d free pixels of %d): check the thresholds, "
+        "negate flag and resolution",
+        options.cell_size, map.CountFree(), static_cast<int64_t>(map.width()) * map.height()));
+  }
+  return Grid(rows, cols, options.cell_size, map.origin(), std::move(free));
+}
+
+double CoveredFreeAreaRatio(const OccupancyMap& map, const Grid& grid) {
+  const int64_t map_free = map.CountFree();
+  if (map_free == 0) return 0.0;
+  const double px_per_cell = Snap(grid.cell_size() / map.resolution());
+  FreeAreaIntegrator integrator(map);
+  double covered = 0.0;
+  for (int r = 0; r < grid.rows(); ++r) {
+    for (int c = 0; c < grid.cols(); ++c) {
+      if (!grid.IsFree(r, c)) continue;
+      covered += integrator.Area(c * px_per_cell, (c + 1) * px_per_cell, r * px_per_cell,
+                                 (r + 1) * px_per_cell);
+    }
+  }
+  return covered / static_cast<double>(map_free);
+}
+
+}  // namespace covplan

@@ -1,0 +1,16 @@
+#include "planner/partition/partitioner.h"
+
+#include "planner/partition/lp_partitioner.h"
+#include "planner/partition/mincut_partitioner.h"
+
+namespace covplan {
+
+std::unique_ptr<RankPartitioner> MakePartitioner(PartitionSolver solver) {
+  switch (solver) {
+    case PartitionSolver::kLp: return std::make_unique<LpPartitioner>();
+    case PartitionSolver::kMinCut: break;
+  }
+  return std::make_unique<MinCutPartitioner>();
+}
+
+}  // namespace covplan
