@@ -40,6 +40,7 @@ struct PlanStats {
   int64_t grid_rows = 0;
   int64_t grid_cols = 0;
   int64_t free_cells = 0;
+  int64_t unreachable_free_cells = 0;  // free cells not connected to the planned area
   double map_free_area_m2 = 0.0;
   // Timing (wall clock, milliseconds).
   double planning_ms = 0.0;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "planner/common/stop_token.h"
@@ -34,8 +35,9 @@ enum class TourSolver { kGreedy, kGtsp };
 struct DecompositionOptions {
   GridOptions grid;  // grid.cell_size = tool width
   PartitionSolver partition_solver = PartitionSolver::kMinCut;
+  int num_threads = 1;  // for the transition table; not part of the key
   absl::Status Validate() const;
-  std::string CacheKey() const;  // stable text form of all fields
+  std::string CacheKey() const;  // stable text form of the fields that matter
 };
 
 // Per-map, per-tool-width data: built once, immutable, shared.
@@ -45,6 +47,8 @@ struct Decomposition {
   std::shared_ptr<const TransitionTable> transitions;  // may be null until computed
   double map_free_area_m2 = 0.0;
   double covered_free_area_ratio = 0.0;
+  // Free cells outside the largest connected free area (not planned).
+  int64_t unreachable_free_cells = 0;
   double grid_ms = 0.0;
   double partition_ms = 0.0;
   double transitions_ms = 0.0;
@@ -70,6 +74,10 @@ absl::StatusOr<std::shared_ptr<const Decomposition>> BuildDecomposition(
 
 absl::StatusOr<CoveragePlan> PlanOnDecomposition(const Decomposition& decomposition,
                                                  const PlanOptions& options);
+
+// Path length, turns and duration recomputed from waypoints alone (the
+// robot turns in place to each waypoint's heading, then drives straight).
+PlanStats ComputePathStats(const std::vector<Waypoint>& path, const RobotModel& robot);
 
 absl::StatusOr<CoveragePlan> PlanCoverage(const OccupancyMap& map, const PlanOptions& options);
 

@@ -1,0 +1,107 @@
+#include "planner/plan/svg.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+
+namespace covplan {
+namespace {
+
+// Emits one rect per horizontal run of pixels/cells for which pred(r, c).
+template <typename Pred>
+void AppendRuns(std::string* out, int rows, int cols, double x0, double y0, double size,
+                const char* fill, Pred pred) {
+  absl::StrAppend(out, "<g fill=\"", fill, "\" shape-rendering=\"crispEdges\">\n");
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols;) {
+      if (!pred(r, c)) {
+        ++c;
+        continue;
+      }
+      int e = c;
+      while (e + 1 < cols && pred(r, e + 1)) ++e;
+      absl::StrAppendFormat(out, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\"/>\n",
+                            x0 + c * size, y0 + r * size, (e - c + 1) * size, size);
+      c = e + 1;
+    }
+  }
+  absl::StrAppend(out, "</g>\n");
+}
+
+}  // namespace
+
+std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map) {
+  const Grid& grid = *plan.grid;
+  const double s = grid.cell_size();
+  const Point2 o = grid.origin();
+  double w = grid.cols() * s, h = grid.rows() * s;
+  if (map) {
+    w = std::max(w, map->width() * map->resolution());
+    h = std::max(h, map->height() * map->resolution());
+  }
+  const double px_per_m = std::clamp(1600.0 / std::max(w, h), 2.0, 60.0);
+  const double legend_h = 0.06 * std::max(w, h) + 1.0;
+  std::string out;
+  absl::StrAppendFormat(&out,
+                        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+                        "viewBox=\"%.4f %.4f %.4f %.4f\">\n",
+                        w * px_per_m, (h + legend_h) * px_per_m, o.x, -legend_h, w, h + legend_h);
+  absl::StrAppendFormat(&out, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" fill=\"#ffffff\"/>\n",
+                        o.x, -legend_h, w, h + legend_h);
+  // Map frame: y up. Flip about the map's vertical extent.
+  absl::StrAppendFormat(&out, "<g transform=\"matrix(1 0 0 -1 0 %.4f)\">\n", h + 2 * o.y);
+  AppendRuns(&out, grid.rows(), grid.cols(), o.x, o.y, s, "#e3ecf7",
+             [&](int r, int c) { return grid.IsFree(r, c); });
+  if (map) {
+    const Point2 mo = map->origin();
+    const double res = map->resolution();
+    AppendRuns(&out, map->height(), map->width(), mo.x, mo.y, res, "#b8b8b8",
+               [&](int r, int c) { return map->at(r, c) == CellState::kUnknown; });
+    AppendRuns(&out, map->height(), map->width(), mo.x, mo.y, res, "#202020",
+               [&](int r, int c) { return map->at(r, c) == CellState::kOccupied; });
+  }
+  // Ranks, coloured by orientation.
+  const double stroke = 0.55 * s;
+  absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-linecap=\"round\" fill=\"none\">\n", stroke);
+  for (const Rank& r : plan.ranks) {
+    const Point2 a = grid.CellCenter(r.first), b = grid.CellCenter(r.last);
+    const char* color = r.orientation == Orientation::kHorizontal ? "#f08c2e" : "#8e44ad";
+    absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\" stroke-opacity=\"0.8\"/>\n",
+                          a.x, a.y, b.x, b.y, color);
+  }
+  absl::StrAppend(&out, "</g>\n");
+  // Transitions as dashed polylines.
+  absl::StrAppendFormat(&out,
+                        "<g stroke=\"#1f8a5b\" stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" fill=\"none\">\n",
+                        0.12 * s, 0.3 * s, 0.2 * s);
+  for (size_t i = 1; i < plan.path.size(); ++i) {
+    if (plan.path[i].kind != SegmentKind::kTransition) continue;
+    absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\"/>\n",
+                          plan.path[i - 1].x, plan.path[i - 1].y, plan.path[i].x, plan.path[i].y);
+  }
+  absl::StrAppend(&out, "</g>\n");
+  if (!plan.path.empty()) {
+    const Waypoint& st = plan.path.front();
+    const Waypoint& en = plan.path.back();
+    absl::StrAppendFormat(&out, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"#1aa33a\"/>\n", st.x, st.y, 0.45 * s);
+    absl::StrAppendFormat(&out, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"%.4f\"/>\n",
+                          en.x, en.y, 0.6 * s, 0.15 * s);
+  }
+  absl::StrAppend(&out, "</g>\n");
+  // Legend above the map (not flipped).
+  const double fs = 0.45 * legend_h;
+  absl::StrAppendFormat(&out,
+                        "<text x=\"%.4f\" y=\"%.4f\" font-family=\"sans-serif\" font-size=\"%.4f\">"
+                        "<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
+                        "<tspan fill=\"#8e44ad\">vertical ranks</tspan> · "
+                        "<tspan fill=\"#1f8a5b\">transitions</tspan> · %d ranks, %d turns, %.0f s</text>\n",
+                        o.x + 0.2, -0.35 * legend_h, fs, static_cast<int>(plan.stats.num_ranks),
+                        static_cast<int>(plan.stats.num_turns), plan.stats.estimated_duration_s);
+  absl::StrAppend(&out, "</svg>\n");
+  return out;
+}
+
+}  // namespace covplan

@@ -1,0 +1,58 @@
+#include "planner/tour/robot_model.h"
+
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace covplan {
+namespace {
+
+absl::Status CheckPositive(const char* name, double v, const char* unit) {
+  if (!std::isfinite(v) || v <= 0.0) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s must be a positive number of %s, got %g", name, unit, v));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckPose(const char* name, const std::optional<Pose2>& p) {
+  if (p && (!std::isfinite(p->x) || !std::isfinite(p->y) || !std::isfinite(p->theta))) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s pose must be finite", name));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status RobotModel::Validate() const {
+  for (absl::Status s : {CheckPositive("tool width", tool_width_m, "metres"),
+                         CheckPositive("max speed", max_speed_mps, "m/s"),
+                         CheckPositive("acceleration", acceleration_mps2, "m/s^2"),
+                         CheckPositive("turn rate", turn_rate_deg_s, "deg/s"),
+                         CheckPose("start", start), CheckPose("end", end)}) {
+    if (!s.ok()) return s;
+  }
+  return absl::OkStatus();
+}
+
+double RobotModel::StraightTime(double length_m) const {
+  if (!(length_m > 0.0)) return 0.0;
+  const double v = max_speed_mps, a = acceleration_mps2;
+  // Distance needed to reach top speed and stop again.
+  const double ramp = v * v / a;
+  if (length_m <= ramp) return 2.0 * std::sqrt(length_m / a);  // triangular profile
+  return 2.0 * v / a + (length_m - ramp) / v;                   // trapezoidal profile
+}
+
+double RobotModel::TurnTime(double angle_rad) const {
+  double a = std::fmod(std::abs(angle_rad), 2.0 * M_PI);
+  if (a > M_PI) a = 2.0 * M_PI - a;
+  return a / (turn_rate_deg_s * M_PI / 180.0);
+}
+
+double HeadingChange(double from_rad, double to_rad) {
+  double d = std::fmod(std::abs(to_rad - from_rad), 2.0 * M_PI);
+  return d > M_PI ? 2.0 * M_PI - d : d;
+}
+
+}  // namespace covplan

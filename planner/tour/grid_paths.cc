@@ -1,0 +1,150 @@
+#include "planner/tour/grid_paths.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <queue>
+#include <utility>
+
+namespace covplan {
+
+bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b) {
+  int x = a.col, y = a.row;
+  const int dx = b.col - a.col, dy = b.row - a.row;
+  const int64_t nx = std::abs(dx), ny = std::abs(dy);
+  const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
+  if (!grid.IsFree(y, x)) return false;
+  for (int64_t ix = 0, iy = 0; ix < nx || iy < ny;) {
+    // Compare the parameters at which the segment crosses the next vertical
+    // ((0.5 + ix) / nx) and horizontal ((0.5 + iy) / ny) grid line.
+    const int64_t decision = (1 + 2 * ix) * ny - (1 + 2 * iy) * nx;
+    if (decision == 0) {
+      // Exactly through a grid corner: both side cells are touched.
+      if (!grid.IsFree(y, x + sx) || !grid.IsFree(y + sy, x)) return false;
+      x += sx, y += sy, ++ix, ++iy;
+    } else if (decision < 0) {
+      x += sx, ++ix;
+    } else {
+      y += sy, ++iy;
+    }
+    if (!grid.IsFree(y, x)) return false;
+  }
+  return true;
+}
+
+std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components) {
+  std::vector<int32_t> comp(grid.size(), -1);
+  int32_t next = 0;
+  std::vector<int64_t> stack;
+  for (int64_t i = 0; i < grid.size(); ++i) {
+    if (!grid.free_flags()[i] || comp[i] >= 0) continue;
+    comp[i] = next;
+    stack.push_back(i);
+    while (!stack.empty()) {
+      const CellIndex c = grid.FromIndex(stack.back());
+      stack.pop_back();
+      constexpr int kDr[4] = {1, -1, 0, 0}, kDc[4] = {0, 0, 1, -1};
+      for (int k = 0; k < 4; ++k) {
+        const int r = c.row + kDr[k], cc = c.col + kDc[k];
+        if (!grid.IsFree(r, cc)) continue;
+        const int64_t j = grid.Index(r, cc);
+        if (comp[j] < 0) comp[j] = next, stack.push_back(j);
+      }
+    }
+    ++next;
+  }
+  if (num_components) *num_components = next;
+  return comp;
+}
+
+AnyAngleSearch::AnyAngleSearch(const Grid& grid)
+    : grid_(grid),
+      dist_(grid.size(), kUnreached),
+      parent_(grid.size(), -1),
+      closed_(grid.size(), 0) {}
+
+namespace {
+
+float Euclid(const Grid& g, int64_t a, int64_t b) {
+  const CellIndex ca = g.FromIndex(a), cb = g.FromIndex(b);
+  const float dr = static_cast<float>(ca.row - cb.row), dc = static_cast<float>(ca.col - cb.col);
+  return std::sqrt(dr * dr + dc * dc);
+}
+
+// Calls f(neighbour index) for every allowed move from c: 4-neighbours, and
+// diagonals whose two orthogonal cells are free (no corner cutting).
+template <typename F>
+void ForEachMove(const Grid& g, CellIndex c, F&& f) {
+  constexpr int kDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  constexpr int kDc[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  for (int k = 0; k < 8; ++k) {
+    const int r = c.row + kDr[k], col = c.col + kDc[k];
+    if (!g.IsFree(r, col)) continue;
+    if (k >= 4 && (!g.IsFree(c.row, col) || !g.IsFree(r, c.col))) continue;
+    f(g.Index(r, col));
+  }
+}
+
+}  // namespace
+
+bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
+  std::fill(dist_.begin(), dist_.end(), kUnreached);
+  std::fill(parent_.begin(), parent_.end(), -1);
+  std::fill(closed_.begin(), closed_.end(), 0);
+  if (!grid_.IsFree(source)) return true;
+  source_ = grid_.Index(source.row, source.col);
+  using Entry = std::pair<float, int32_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  dist_[source_] = 0.0f;
+  parent_[source_] = static_cast<int32_t>(source_);
+  open.push({0.0f, static_cast<int32_t>(source_)});
+  int64_t expansions = 0;
+  while (!open.empty()) {
+    const auto [d, s] = open.top();
+    open.pop();
+    if (closed_[s] || d > dist_[s]) continue;
+    if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
+    const CellIndex cs = grid_.FromIndex(s);
+    // Lazy Theta*: the parent was assumed visible; verify now, else take the
+    // best closed neighbour.
+    const int32_t p = parent_[s];
+    if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {
+      float best = kUnreached;
+      int32_t best_parent = -1;
+      ForEachMove(grid_, cs, [&](int64_t n) {
+        if (!closed_[n]) return;
+        const float cand = dist_[n] + Euclid(grid_, n, s);
+        if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
+      });
+      if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
+    }
+    closed_[s] = 1;
+    const int32_t ps = parent_[s];
+    ForEachMove(grid_, cs, [&](int64_t n) {
+      if (closed_[n]) return;
+      const float cand = dist_[ps] + Euclid(grid_, ps, n);
+      if (cand < dist_[n]) {
+        dist_[n] = cand;
+        parent_[n] = ps;
+        open.push({cand, static_cast<int32_t>(n)});
+      }
+    });
+  }
+  return true;
+}
+
+std::vector<CellIndex> AnyAngleSearch::PathTo(CellIndex target) const {
+  std::vector<CellIndex> path;
+  if (!grid_.IsFree(target)) return path;
+  int64_t v = grid_.Index(target.row, target.col);
+  if (dist_[v] >= kUnreached || !closed_[v]) return path;
+  while (true) {
+    path.push_back(grid_.FromIndex(v));
+    if (v == source_) break;
+    v = parent_[v];
+  }
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+}  // namespace covplan

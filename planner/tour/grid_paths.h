@@ -1,0 +1,58 @@
+// Obstacle-free paths on the tool-width grid.
+//
+// The robot drives between cell centres. A straight segment is allowed when
+// every cell it touches is free, including both cells beside a grid corner it
+// passes exactly through (so the tool never enters a blocked cell).
+// AnyAngleSearch is a single-source Lazy Theta* (Nash, Koenig & Tovey 2010)
+// without a goal: one search yields any-angle shortest paths, as chains of
+// corner cells, from the source to every reachable cell.
+//
+//   AnyAngleSearch search(grid);
+//   search.Run(source, stop);
+//   std::vector<CellIndex> corners = search.PathTo(target);  // source..target
+//
+// Thread-safety: an AnyAngleSearch is single-threaded; LineOfSight is
+// stateless.
+#ifndef COVPLAN_PLANNER_TOUR_GRID_PATHS_H_
+#define COVPLAN_PLANNER_TOUR_GRID_PATHS_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "planner/common/stop_token.h"
+#include "planner/grid/grid.h"
+
+namespace covplan {
+
+// True when the straight segment between the centres of a and b touches only
+// free cells.
+bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b);
+
+// Connected components of free cells under 4-connectivity (the moves the
+// line-of-sight rule allows). Returns per-cell component id, -1 for blocked.
+std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components);
+
+class AnyAngleSearch {
+ public:
+  explicit AnyAngleSearch(const Grid& grid);
+
+  // Returns false if stopped early (results then incomplete).
+  bool Run(CellIndex source, const StopToken& stop);
+  bool Reached(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)] < kUnreached; }
+  // Path length in cell units (multiply by cell size for metres).
+  double DistanceCells(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)]; }
+  // Corner cells from the source to `target`, both included; empty if unreached.
+  std::vector<CellIndex> PathTo(CellIndex target) const;
+
+ private:
+  static constexpr float kUnreached = 1e30f;
+  const Grid& grid_;
+  std::vector<float> dist_;
+  std::vector<int32_t> parent_;
+  std::vector<uint8_t> closed_;
+  int64_t source_ = -1;
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_PLANNER_TOUR_GRID_PATHS_H_

@@ -1,0 +1,130 @@
+#include "planner/plan/coverage_planner.h"
+
+#include <cmath>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "planner/plan/svg.h"
+#include "tests/testing/plan_conformance.h"
+
+namespace covplan {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A 12 m x 8 m map at 0.05 m/px: walls around, a room divider with a door,
+// a table-sized hole.
+OccupancyMap OfficeMap() {
+  const double res = 0.05;
+  OccupancyMap m(240, 160, res, {-1.0, 2.0});
+  for (int r = 0; r < 160; ++r) {
+    for (int c = 0; c < 240; ++c) {
+      const bool wall = r < 4 || r >= 156 || c < 4 || c >= 236;
+      const bool divider = c >= 118 && c < 122 && !(r >= 60 && r < 100);
+      const bool table = r >= 30 && r < 50 && c >= 40 && c < 80;
+      m.set(r, c, wall || divider || table ? CellState::kOccupied : CellState::kFree);
+    }
+  }
+  return m;
+}
+
+TEST(BuildGrid, MoreThanHalfFreeRule) {
+  // 4x4 pixels, cell = 2 px: top-left cell has exactly 2 of 4 free (not free),
+  // bottom-right has 3 of 4 (free).
+  OccupancyMap m(4, 4, 0.5, {0, 0});
+  for (int r = 0; r < 4; ++r) for (int c = 0; c < 4; ++c) m.set(r, c, CellState::kOccupied);
+  m.set(3, 0, CellState::kFree);
+  m.set(3, 1, CellState::kFree);
+  m.set(0, 2, CellState::kFree);
+  m.set(0, 3, CellState::kFree);
+  m.set(1, 3, CellState::kFree);
+  GridOptions opt;
+  opt.cell_size = 1.0;
+  auto g = BuildGrid(m, opt);
+  ASSERT_TRUE(g.ok()) << g.status();
+  EXPECT_EQ(g->rows(), 2);
+  EXPECT_EQ(g->cols(), 2);
+  EXPECT_FALSE(g->IsFree(1, 0));  // exactly half
+  EXPECT_TRUE(g->IsFree(0, 1));   // three quarters
+  EXPECT_EQ(g->CountFree(), 1);
+}
+
+TEST(BuildGrid, NonIntegerCellSizeUsesFractionalOverlap) {
+  OccupancyMap m(10, 10, 0.1, {0, 0});
+  for (int r = 0; r < 10; ++r) for (int c = 0; c < 10; ++c) m.set(r, c, CellState::kFree);
+  GridOptions opt;
+  opt.cell_size = 0.3;  // 3 px; 4th column cell is 1/3 inside the map
+  auto g = BuildGrid(m, opt);
+  ASSERT_TRUE(g.ok());
+  EXPECT_EQ(g->cols(), 4);
+  EXPECT_TRUE(g->IsFree(0, 2));
+  EXPECT_FALSE(g->IsFree(0, 3));
+  EXPECT_NEAR(CoveredFreeAreaRatio(m, *g), 0.81, 1e-9);
+}
+
+TEST(PlanCoverage, OfficeMapConforms) {
+  for (TourSolver tour : {TourSolver::kGreedy, TourSolver::kGtsp}) {
+    PlanOptions opt;
+    opt.tour_solver = tour;
+    opt.time_limit_s = 0.3;
+    auto plan = PlanCoverage(OfficeMap(), opt);
+    ASSERT_TRUE(plan.ok()) << plan.status();
+    EXPECT_EQ(testing::CheckRankPlanConformance(*plan, opt.robot), "");
+    EXPECT_GT(plan->stats.covered_free_area_ratio, 0.8);
+    EXPECT_LE(plan->stats.covered_free_area_ratio, 1.0);
+    EXPECT_GT(plan->stats.estimated_duration_s, 0.0);
+    EXPECT_EQ(plan->stats.grid_rows, 10);
+    EXPECT_EQ(plan->stats.grid_cols, 15);
+    const std::string svg = RenderPlanSvg(*plan, nullptr);
+    EXPECT_THAT(svg, HasSubstr("<svg"));
+    EXPECT_THAT(svg, HasSubstr("</svg>"));
+  }
+}
+
+TEST(PlanCoverage, LpAndMinCutGiveSameRankCount) {
+  PlanOptions a, b;
+  a.tour_solver = b.tour_solver = TourSolver::kGreedy;
+  b.partition_solver = PartitionSolver::kLp;
+  auto pa = PlanCoverage(OfficeMap(), a);
+  auto pb = PlanCoverage(OfficeMap(), b);
+  ASSERT_TRUE(pa.ok() && pb.ok());
+  EXPECT_EQ(pa->ranks.size(), pb->ranks.size());
+  EXPECT_EQ(pb->stats.partition_solver, "lp");
+}
+
+TEST(PlanCoverage, BadInputIsInvalidArgument) {
+  struct Case {
+    double tool;
+    const char* message;
+  };
+  for (const Case& c : {Case{NAN, "tool width"}, Case{0.0, "tool width"}, Case{-0.8, "tool width"},
+                        Case{0.01, "narrower than one map pixel"}, Case{20.0, "wider than the map"}}) {
+    PlanOptions opt;
+    opt.robot.tool_width_m = c.tool;
+    auto plan = PlanCoverage(OfficeMap(), opt);
+    EXPECT_EQ(plan.status().code(), absl::StatusCode::kInvalidArgument) << c.tool;
+    EXPECT_THAT(plan.status().message(), HasSubstr(c.message)) << c.tool;
+  }
+  OccupancyMap blocked(50, 50, 0.05, {0, 0});  // all unknown
+  auto plan = PlanCoverage(blocked, PlanOptions());
+  EXPECT_EQ(plan.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(plan.status().message(), HasSubstr("no free cell"));
+  PlanOptions neg;
+  neg.time_limit_s = -1;
+  EXPECT_EQ(PlanCoverage(OfficeMap(), neg).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(PlanCoverage, DisconnectedAreasAreReportedNotPlanned) {
+  OccupancyMap m = OfficeMap();
+  // Close the door: the right room becomes unreachable from the larger side.
+  for (int r = 60; r < 100; ++r) for (int c = 118; c < 122; ++c) m.set(r, c, CellState::kOccupied);
+  PlanOptions opt;
+  opt.tour_solver = TourSolver::kGreedy;
+  auto plan = PlanCoverage(m, opt);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_GT(plan->stats.unreachable_free_cells, 0);
+  EXPECT_EQ(testing::CheckRankPlanConformance(*plan, opt.robot), "");
+}
+
+}  // namespace
+}  // namespace covplan

@@ -1,0 +1,72 @@
+#include "planner/tour/robot_model.h"
+
+#include <cmath>
+
+#include "gtest/gtest.h"
+#include "planner/tour/path_timing.h"
+
+namespace covplan {
+namespace {
+
+TEST(RobotModel, ShortSegmentNeverReachesTopSpeed) {
+  RobotModel robot;  // 1 m/s, 0.5 m/s^2: needs 2 m to reach top speed and stop
+  // 1 m: accelerate 0.5 m, decelerate 0.5 m; t = 2*sqrt(2*0.5/0.5) = 2*sqrt(2).
+  EXPECT_NEAR(robot.StraightTime(1.0), 2.0 * std::sqrt(2.0), 1e-12);
+  // Exactly the ramp distance: 2 s up, 2 s down.
+  EXPECT_NEAR(robot.StraightTime(2.0), 4.0, 1e-12);
+}
+
+TEST(RobotModel, LongSegmentCruises) {
+  RobotModel robot;
+  // 10 m: 2 m ramps (4 s) + 8 m at 1 m/s.
+  EXPECT_NEAR(robot.StraightTime(10.0), 12.0, 1e-12);
+  robot.max_speed_mps = 2.0;
+  robot.acceleration_mps2 = 1.0;
+  // ramps: 4 m in 4 s; cruise 6 m at 2 m/s = 3 s.
+  EXPECT_NEAR(robot.StraightTime(10.0), 7.0, 1e-12);
+}
+
+TEST(RobotModel, TurnTimes) {
+  RobotModel robot;  // 30 deg/s
+  EXPECT_NEAR(robot.TurnTime(M_PI / 2), 3.0, 1e-12);
+  EXPECT_NEAR(robot.TurnTime(M_PI), 6.0, 1e-12);
+  EXPECT_NEAR(robot.TurnTime(-M_PI / 2), 3.0, 1e-12);
+  EXPECT_NEAR(robot.TurnTime(3 * M_PI / 2), 3.0, 1e-12);  // the short way round
+  EXPECT_NEAR(HeadingChange(0.1, 2 * M_PI - 0.1), 0.2, 1e-12);
+}
+
+TEST(RobotModel, ValidateRejectsBadValues) {
+  for (double bad : {0.0, -1.0, NAN, INFINITY}) {
+    RobotModel r;
+    r.max_speed_mps = bad;
+    EXPECT_EQ(r.Validate().code(), absl::StatusCode::kInvalidArgument) << bad;
+    RobotModel w;
+    w.tool_width_m = bad;
+    EXPECT_EQ(w.Validate().code(), absl::StatusCode::kInvalidArgument) << bad;
+    EXPECT_NE(w.Validate().message().find("tool width"), std::string::npos);
+  }
+  RobotModel p;
+  p.start = Pose2{NAN, 0, 0};
+  EXPECT_EQ(p.Validate().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(RobotModel().Validate().ok());
+}
+
+TEST(PathTiming, LShapedPathWithTurns) {
+  RobotModel robot;
+  // Facing +x, drive 10 m east, turn 90 deg, drive 1 m north, then face west.
+  PolylineTiming t = TimePolyline(robot, {{0, 0}, {10, 0}, {10, 1}}, 0.0, M_PI);
+  EXPECT_EQ(t.turns, 2);
+  EXPECT_NEAR(t.turn_time_s, 3.0 + 3.0, 1e-9);
+  EXPECT_NEAR(t.length_m, 11.0, 1e-12);
+  EXPECT_NEAR(t.time_s, 12.0 + 2.0 * std::sqrt(2.0) + 6.0, 1e-9);
+}
+
+TEST(PathTiming, UTurnAndZeroLengthSegments) {
+  RobotModel robot;
+  PolylineTiming t = TimePolyline(robot, {{0, 0}, {0, 0}, {-2, 0}}, 0.0, std::nullopt);
+  EXPECT_EQ(t.turns, 1);
+  EXPECT_NEAR(t.time_s, 6.0 + 4.0, 1e-9);  // 180 deg turn + 2 m ramp-only segment
+}
+
+}  // namespace
+}  // namespace covplan
