@@ -1,0 +1,244 @@
+#include "planner/tour/gtsp/gtsp.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "planner/common/status_macros.h"
+#include "planner/tour/gtsp/gtsp_problem.h"
+#include "planner/tour/gtsp/gtsp_search.h"
+#include "planner/tour/gtsp/rng.h"
+
+namespace covplan {
+namespace {
+
+using gtsp_internal::LnsTrial;
+using gtsp_internal::Problem;
+using gtsp_internal::SearchParams;
+using gtsp_internal::SearchTour;
+using gtsp_internal::SeedFor;
+using gtsp_internal::TrialOutcome;
+
+constexpr int kUnlimitedTrials = std::numeric_limits<int>::max();
+
+struct EffortConfig {
+  int trials;              // when neither max_trials nor "until deadline" applies
+  int cold_trials;         // trials started from a fresh random tour
+  int64_t iterations_per_set;
+  int64_t stall_per_set;
+  int64_t min_iterations;
+};
+
+EffortConfig ConfigFor(GtspEffort effort) {
+  switch (effort) {
+    case GtspEffort::kFast:
+      return {2, 1, 25, 12, 2000};
+    case GtspEffort::kDefault:
+      return {5, 2, 60, 30, 5000};
+    case GtspEffort::kThorough:
+      return {10, 3, 150, 60, 10000};
+  }
+  return {5, 2, 60, 30, 5000};
+}
+
+SearchTour ToSearchTour(const Problem& p, const std::vector<int>& tour) {
+  SearchTour t;
+  t.Reset(p);
+  for (int v : tour) t.seq.push_back(p.to_internal[v]);
+  t.RebuildPositions(p);
+  t.RecomputeCost(p);
+  return t;
+}
+
+}  // namespace
+
+absl::Status GtspInstance::Validate() const {
+  if (num_vertices <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("GTSP instance needs at least one vertex, got num_vertices=", num_vertices));
+  }
+  const size_t expected = static_cast<size_t>(num_vertices) * num_vertices;
+  if (costs.size() != expected) {
+    return absl::InvalidArgumentError(absl::StrCat("GTSP cost matrix has ", costs.size(),
+                                                   " entries, expected num_vertices^2 = ", expected));
+  }
+  if (sets.empty()) return absl::InvalidArgumentError("GTSP instance has no sets");
+  std::vector<int> owner(num_vertices, -1);
+  for (size_t s = 0; s < sets.size(); ++s) {
+    if (sets[s].empty()) return absl::InvalidArgumentError(absl::StrCat("GTSP set ", s, " is empty"));
+    for (int v : sets[s]) {
+      if (v < 0 || v >= num_vertices) {
+        return absl::InvalidArgumentError(absl::StrCat("GTSP set ", s, " contains vertex ", v,
+                                                       ", outside [0, ", num_vertices, ")"));
+      }
+      if (owner[v] >= 0) {
+        return absl::InvalidArgumentError(absl::StrCat("vertex ", v, " is in GTSP set ", owner[v],
+                                                       " and in set ", s, "; sets must be disjoint"));
+      }
+      owner[v] = static_cast<int>(s);
+    }
+  }
+  for (int v = 0; v < num_vertices; ++v) {
+    if (owner[v] < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("vertex ", v, " belongs to no GTSP set; sets must partition the vertices"));
+    }
+  }
+  for (size_t k = 0; k < costs.size(); ++k) {
+    const double c = costs[k];
+    if (!std::isfinite(c) || c < 0.0) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "GTSP cost(", k / num_vertices, ", ", k % num_vertices, ") = ", c,
+          " is not a finite non-negative number (use kInfeasibleCost for forbidden arcs)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status GtspOptions::Validate() const {
+  if (num_threads < 1 || num_threads > 256) {
+    return absl::InvalidArgumentError(absl::StrCat("num_threads must be in [1, 256], got ", num_threads));
+  }
+  if (max_trials < 0) {
+    return absl::InvalidArgumentError(absl::StrCat("max_trials must be >= 0, got ", max_trials));
+  }
+  return absl::OkStatus();
+}
+
+double TourCost(const GtspInstance& instance, const std::vector<int>& tour) {
+  double total = 0.0;
+  for (size_t i = 0; i < tour.size(); ++i) {
+    total += instance.cost(tour[i], tour[(i + 1) % tour.size()]);
+  }
+  return total;
+}
+
+absl::Status ValidateTour(const GtspInstance& instance, const std::vector<int>& tour) {
+  if (tour.size() != instance.sets.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("tour visits ", tour.size(), " vertices, expected one per set (",
+                                                   instance.sets.size(), ")"));
+  }
+  std::vector<int> owner(instance.num_vertices, -1);
+  for (size_t s = 0; s < instance.sets.size(); ++s) {
+    for (int v : instance.sets[s]) {
+      if (v >= 0 && v < instance.num_vertices) owner[v] = static_cast<int>(s);
+    }
+  }
+  std::vector<char> seen(instance.sets.size(), 0);
+  for (int v : tour) {
+    if (v < 0 || v >= instance.num_vertices) {
+      return absl::InvalidArgumentError(absl::StrCat("tour vertex ", v, " out of range [0, ",
+                                                     instance.num_vertices, ")"));
+    }
+    const int s = owner[v];
+    if (s < 0) return absl::InvalidArgumentError(absl::StrCat("tour vertex ", v, " is in no set"));
+    if (seen[s]) return absl::InvalidArgumentError(absl::StrCat("tour visits set ", s, " twice"));
+    seen[s] = 1;
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOptions& options) {
+  RETURN_IF_ERROR(instance.Validate());
+  RETURN_IF_ERROR(options.Validate());
+  if (!options.initial_tour.empty()) {
+    absl::Status st = ValidateTour(instance, options.initial_tour);
+    if (!st.ok()) return absl::InvalidArgumentError(absl::StrCat("initial_tour: ", st.message()));
+  }
+  const absl::Time t_start = absl::Now();
+  const StopToken& stop = options.stop;
+  const Problem problem = Problem::Build(instance);
+  const EffortConfig cfg = ConfigFor(options.effort);
+
+  SearchParams params;
+  params.max_iterations = std::max<int64_t>(cfg.min_iterations, cfg.iterations_per_set * problem.m);
+  params.stall_iterations = std::max<int64_t>(cfg.min_iterations / 2, cfg.stall_per_set * problem.m);
+
+  // Shared best, only for progress reporting; the returned tour is chosen
+  // deterministically from the per-trial results below.
+  std::mutex mu;
+  double reported_cost = std::numeric_limits<double>::infinity();
+  double time_to_best = 0.0;
+  auto on_best = [&](const SearchTour& t) {
+    std::lock_guard<std::mutex> lock(mu);
+    if (t.cost >= reported_cost) return;
+    reported_cost = t.cost;
+    time_to_best = absl::ToDoubleSeconds(absl::Now() - t_start);
+    if (options.on_improvement) options.on_improvement(t.cost, time_to_best);
+  };
+
+  // A greedy tour first, so that there is always an answer.
+  SearchTour best;
+  {
+    LnsTrial greedy(problem, params, SeedFor(options.seed, 0xFFFFFFFFull));
+    greedy.Construct(best, /*mode=cheapest*/ 0);
+    if (!options.initial_tour.empty()) {
+      SearchTour init = ToSearchTour(problem, options.initial_tour);
+      if (init.cost <= best.cost) best = init;
+    }
+    if (!stop.ShouldStop()) greedy.LocalOptimize(best, stop);
+    on_best(best);
+  }
+
+  int total_trials = ConfigFor(options.effort).trials;
+  if (options.max_trials > 0) {
+    total_trials = options.max_trials;
+  } else if (stop.has_deadline() && options.effort == GtspEffort::kThorough) {
+    total_trials = kUnlimitedTrials;
+  }
+  if (problem.m <= 1) total_trials = 0;  // the greedy step is exact for one set
+
+  GtspResult result;
+  const int threads = options.num_threads;
+  int started = 0;
+  while (started < total_trials && !stop.ShouldStop()) {
+    const int round = std::min(threads, total_trials - started);
+    SearchParams round_params = params;
+    if (stop.has_deadline()) {
+      // Spread the remaining time over the remaining rounds so that every
+      // trial completes its annealing schedule before the deadline.
+      const int rounds_left =
+          total_trials == kUnlimitedTrials ? 1 : (total_trials - started + threads - 1) / threads;
+      round_params.time_budget_end = absl::Now() + stop.remaining() / rounds_left;
+    }
+    std::vector<TrialOutcome> outcomes(round);
+    const SearchTour warm = best;
+    auto run = [&](int j) {
+      const int trial = started + j;
+      LnsTrial lns(problem, round_params, SeedFor(options.seed, trial));
+      const bool cold = trial < cfg.cold_trials && options.initial_tour.empty();
+      outcomes[j] = lns.Run(cold ? nullptr : &warm, stop, on_best);
+    };
+    if (round == 1) {
+      run(0);
+    } else {
+      std::vector<std::thread> pool;
+      pool.reserve(round);
+      for (int j = 0; j < round; ++j) pool.emplace_back(run, j);
+      for (std::thread& th : pool) th.join();
+    }
+    for (TrialOutcome& o : outcomes) {
+      result.iterations += o.iterations;
+      if (o.stopped) {
+        result.stopped_early = true;
+      } else {
+        ++result.trials_completed;
+      }
+      if (o.best.cost < best.cost - 1e-9 * std::max(1.0, std::abs(best.cost))) best = std::move(o.best);
+    }
+    started += round;
+  }
+
+  if (started < total_trials) result.stopped_early = true;
+  result.tour.reserve(best.seq.size());
+  for (int v : best.seq) result.tour.push_back(problem.to_external[v]);
+  result.cost = TourCost(instance, result.tour);
+  result.elapsed_s = absl::ToDoubleSeconds(absl::Now() - t_start);
+  result.time_to_best_s = time_to_best;
+  return result;
+}
+
+}  // namespace covplan
