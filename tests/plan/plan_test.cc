@@ -116,8 +116,8 @@ TEST(PlanCoverage, BadInputIsInvalidArgument) {
 
 TEST(PlanCoverage, DisconnectedAreasAreReportedNotPlanned) {
   OccupancyMap m = OfficeMap();
-  // Close the door: the right room becomes unreachable from the larger side.
-  for (int r = 60; r < 100; ++r) for (int c = 118; c < 122; ++c) m.set(r, c, CellState::kOccupied);
+  // A 1.6 m thick wall splits the map: the smaller side becomes unreachable.
+  for (int r = 0; r < 160; ++r) for (int c = 150; c < 182; ++c) m.set(r, c, CellState::kOccupied);
   PlanOptions opt;
   opt.tour_solver = TourSolver::kGreedy;
   auto plan = PlanCoverage(m, opt);

@@ -5,6 +5,7 @@
 #include "gtest/gtest.h"
 #include "planner/partition/mincut_partitioner.h"
 #include "planner/plan/coverage_planner.h"
+#include "planner/tour/grid_paths.h"
 #include "tests/testing/grid_fixtures.h"
 #include "tests/testing/plan_conformance.h"
 

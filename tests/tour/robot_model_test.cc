@@ -36,7 +36,7 @@ TEST(RobotModel, TurnTimes) {
 }
 
 TEST(RobotModel, ValidateRejectsBadValues) {
-  for (double bad : {0.0, -1.0, NAN, INFINITY}) {
+  for (double bad : {0.0, -1.0, static_cast<double>(NAN), static_cast<double>(INFINITY)}) {
     RobotModel r;
     r.max_speed_mps = bad;
     EXPECT_EQ(r.Validate().code(), absl::StatusCode::kInvalidArgument) << bad;
