@@ -16,6 +16,8 @@
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
 #include "planner/plan/coverage_planner.h"
+#include "planner/plan/svg.h"
+#include <fstream>
 
 namespace covplan {
 namespace {
@@ -29,6 +31,7 @@ struct Args {
   int runs = 5;
   int threads = 2;
   bool lp = true;
+  std::string svg_dir;  // write <map>.svg of the GTSP plan here
   std::vector<std::string> maps;
 };
 
@@ -117,6 +120,9 @@ int Run(const Args& a) {
         std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(last.status().message()).c_str());
         return 1;
       }
+      if (!a.svg_dir.empty() && ts == TourSolver::kGtsp) {
+        std::ofstream(a.svg_dir + "/" + Base(path) + ".svg") << RenderPlanSvg(*last, &*map);
+      }
       const PlanStats& s = last->stats;
       const std::string gap = reference > 0
           ? absl::StrFormat("%+.2f %%", 100.0 * (s.estimated_duration_s - reference) / reference)
@@ -154,6 +160,7 @@ int main(int argc, char** argv) {
     else if (k == "--runs") a.runs = std::atoi(next().c_str());
     else if (k == "--threads") a.threads = std::atoi(next().c_str());
     else if (k == "--no-lp") a.lp = false;
+    else if (k == "--svg-dir") a.svg_dir = next();
     else if (k.rfind("--", 0) == 0) {
       std::fprintf(stderr, "unknown flag %s\n", k.c_str());
       return 2;

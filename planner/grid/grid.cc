@@ -20,20 +20,43 @@ absl::Status GridOptions::Validate() const {
   return absl::OkStatus();
 }
 
-Grid::Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free)
-    : rows_(rows), cols_(cols), cell_size_(cell_size), origin_(origin), free_(std::move(free)) {}
+Grid::Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free,
+           std::vector<uint8_t> walls)
+    : rows_(rows),
+      cols_(cols),
+      cell_size_(cell_size),
+      origin_(origin),
+      free_(std::move(free)),
+      walls_(std::move(walls)) {}
+
+int64_t Grid::CountBarriers() const {
+  int64_t n = 0;
+  for (int r = 0; r < rows_; ++r) {
+    for (int c = 0; c < cols_; ++c) {
+      n += IsFree(r, c) && IsFree(r, c + 1) && !Passable(r, c, 0, 1);
+      n += IsFree(r, c) && IsFree(r + 1, c) && !Passable(r, c, 1, 0);
+    }
+  }
+  return n;
+}
 
 Grid Grid::FromAscii(const std::vector<std::string>& rows_top_down, double cell_size) {
   const int rows = static_cast<int>(rows_top_down.size());
   const int cols = rows == 0 ? 0 : static_cast<int>(rows_top_down[0].size());
   std::vector<uint8_t> free(static_cast<size_t>(rows) * cols, 0);
+  std::vector<uint8_t> walls(static_cast<size_t>(rows) * cols, 0);
+  bool any_wall = false;
   for (int i = 0; i < rows; ++i) {
     const int r = rows - 1 - i;
     for (int c = 0; c < cols && c < static_cast<int>(rows_top_down[i].size()); ++c) {
-      free[static_cast<size_t>(r) * cols + c] = rows_top_down[i][c] == '.' ? 1 : 0;
+      const char ch = rows_top_down[i][c];
+      free[static_cast<size_t>(r) * cols + c] = ch != '#' ? 1 : 0;
+      if (ch == '|') walls[static_cast<size_t>(r) * cols + c] |= kWallRight, any_wall = true;
+      if (ch == '_' && r > 0) walls[static_cast<size_t>(r - 1) * cols + c] |= kWallUp, any_wall = true;
     }
   }
-  return Grid(rows, cols, cell_size, {0.0, 0.0}, std::move(free));
+  if (!any_wall) walls.clear();
+  return Grid(rows, cols, cell_size, {0.0, 0.0}, std::move(free), std::move(walls));
 }
 
 int64_t Grid::CountFree() const {
@@ -115,6 +138,31 @@ class FreeAreaIntegrator {
   std::vector<int32_t> prefix_;
 };
 
+// True when any pixel touched by the axis-parallel segment between two pixel
+// coordinates (x0, y) .. (x1, y) (horizontal) is not free. A coordinate on a
+// pixel boundary touches the pixels on both sides.
+bool HorizontalLineBlocked(const OccupancyMap& map, double y, double x0, double x1) {
+  const int r_lo = static_cast<int>(std::floor(y - 1e-9)), r_hi = static_cast<int>(std::floor(y + 1e-9));
+  const int c0 = std::max(0, static_cast<int>(std::floor(x0))), c1 = std::min(map.width() - 1, static_cast<int>(std::ceil(x1)) - 1);
+  for (int r = std::max(0, r_lo); r <= std::min(map.height() - 1, r_hi); ++r) {
+    for (int c = c0; c <= c1; ++c) {
+      if (!map.IsFree(r, c)) return true;
+    }
+  }
+  return false;
+}
+
+bool VerticalLineBlocked(const OccupancyMap& map, double x, double y0, double y1) {
+  const int c_lo = static_cast<int>(std::floor(x - 1e-9)), c_hi = static_cast<int>(std::floor(x + 1e-9));
+  const int r0 = std::max(0, static_cast<int>(std::floor(y0))), r1 = std::min(map.height() - 1, static_cast<int>(std::ceil(y1)) - 1);
+  for (int c = std::max(0, c_lo); c <= std::min(map.width() - 1, c_hi); ++c) {
+    for (int r = r0; r <= r1; ++r) {
+      if (!map.IsFree(r, c)) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& options) {
@@ -164,7 +212,26 @@ absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& optio
         "negate flag and resolution",
         options.cell_size, map.CountFree(), static_cast<int64_t>(map.width()) * map.height()));
   }
-  return Grid(rows, cols, options.cell_size, map.origin(), std::move(free));
+  std::vector<uint8_t> walls;
+  if (options.thin_wall_barriers) {
+    walls.assign(free.size(), 0);
+    auto is_free = [&](int r, int c) {
+      return r >= 0 && c >= 0 && r < rows && c < cols && free[static_cast<size_t>(r) * cols + c];
+    };
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        if (!is_free(r, c)) continue;
+        const double cx = (c + 0.5) * px_per_cell, cy = (r + 0.5) * px_per_cell;
+        if (is_free(r, c + 1) && HorizontalLineBlocked(map, cy, cx, cx + px_per_cell)) {
+          walls[static_cast<size_t>(r) * cols + c] |= Grid::kWallRight;
+        }
+        if (is_free(r + 1, c) && VerticalLineBlocked(map, cx, cy, cy + px_per_cell)) {
+          walls[static_cast<size_t>(r) * cols + c] |= Grid::kWallUp;
+        }
+      }
+    }
+  }
+  return Grid(rows, cols, options.cell_size, map.origin(), std::move(free), std::move(walls));
 }
 
 double CoveredFreeAreaRatio(const OccupancyMap& map, const Grid& grid) {

@@ -6,6 +6,11 @@
 // square origin + (c*s, r*s) .. origin + ((c+1)*s, (r+1)*s). The grid origin
 // equals the map origin.
 //
+// Walls thinner than half a cell do not block a cell, so the grid also keeps
+// *barriers* between 4-adjacent free cells: the straight line between their
+// centres crosses a non-free map pixel. Planners move between neighbours only
+// through Passable() links, so no rank or transition crosses a thin wall.
+//
 //   GridOptions opt; opt.cell_size = 0.8;
 //   absl::StatusOr<Grid> grid = BuildGrid(map, opt);
 //
@@ -13,6 +18,7 @@
 #ifndef COVPLAN_PLANNER_GRID_GRID_H_
 #define COVPLAN_PLANNER_GRID_GRID_H_
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -33,6 +39,7 @@ struct CellIndex {
 struct GridOptions {
   double cell_size = 0.8;          // metres: the tool width
   double min_free_fraction = 0.5;  // a cell is free when free share > this
+  bool thin_wall_barriers = true;  // keep barriers between cells split by a thin wall
   int64_t max_cells = 20'000'000;  // reject grids larger than this
 
   absl::Status Validate() const;
@@ -41,11 +48,19 @@ struct GridOptions {
 class Grid {
  public:
   Grid() = default;
-  // Builds a grid directly from free flags (row-major, row 0 = smallest y).
-  Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free);
+  // Barrier bits per cell (see Passable).
+  static constexpr uint8_t kWallRight = 1;  // between (r, c) and (r, c + 1)
+  static constexpr uint8_t kWallUp = 2;     // between (r, c) and (r + 1, c)
+
+  // Builds a grid directly from free flags (row-major, row 0 = smallest y)
+  // and optional barrier bits (empty = no barriers).
+  Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free,
+       std::vector<uint8_t> walls = {});
 
   // Parses ASCII art for tests: one string per row, *first string is the top
-  // row* (largest y) so the picture reads naturally; '.' free, '#' blocked.
+  // row* (largest y) so the picture reads naturally; '.' free, '#' blocked,
+  // '|' a free cell with a barrier on its right side, '_' a free cell with a
+  // barrier below it.
   static Grid FromAscii(const std::vector<std::string>& rows_top_down, double cell_size = 1.0);
 
   int rows() const { return rows_; }
@@ -61,6 +76,21 @@ class Grid {
   CellIndex FromIndex(int64_t i) const { return {static_cast<int>(i / cols_), static_cast<int>(i % cols_)}; }
   int64_t CountFree() const;
   const std::vector<uint8_t>& free_flags() const { return free_; }
+  const std::vector<uint8_t>& walls() const { return walls_; }
+
+  // True when (r, c) and (r + dr, c + dc) are 4-adjacent free cells with no
+  // barrier between them.
+  bool Passable(int r, int c, int dr, int dc) const {
+    const int r2 = r + dr, c2 = c + dc;
+    if (!IsFree(r, c) || !IsFree(r2, c2)) return false;
+    if (walls_.empty()) return true;
+    if (dr == 0) return !(walls_[Index(r, std::min(c, c2))] & kWallRight);
+    return !(walls_[Index(std::min(r, r2), c)] & kWallUp);
+  }
+  // The free neighbour a rank may continue into / a robot may step to.
+  bool LeftLinked(int r, int c) const { return Passable(r, c, 0, -1); }
+  bool BelowLinked(int r, int c) const { return Passable(r, c, -1, 0); }
+  int64_t CountBarriers() const;
 
   // Centre of a cell in the map frame.
   Point2 CellCenter(int r, int c) const {
@@ -73,7 +103,7 @@ class Grid {
   // One string per row (row 0 first) of '1' free / '0' blocked.
   std::vector<std::string> ToRowStrings() const;
 
-  size_t MemoryBytes() const { return sizeof(*this) + free_.capacity(); }
+  size_t MemoryBytes() const { return sizeof(*this) + free_.capacity() + walls_.capacity(); }
 
  private:
   int rows_ = 0;
@@ -81,6 +111,7 @@ class Grid {
   double cell_size_ = 1.0;
   Point2 origin_;
   std::vector<uint8_t> free_;
+  std::vector<uint8_t> walls_;  // empty, or kWall* bits per cell
 };
 
 // Builds the tool-width grid over `map`. InvalidArgument when the cell is

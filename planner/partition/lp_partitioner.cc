@@ -29,12 +29,12 @@ absl::StatusOr<RankPartition> LpPartitioner::Partition(const Grid& grid,
       // (3.6): y_h - x_h + x_h(left) >= 0
       const int yh = lp.AddColumn(0.0, LinearProgram::kInf, 1.0);
       std::vector<std::pair<int, double>> row_h = {{yh, 1.0}, {v.xh, -1.0}};
-      if (grid.IsFree(r, c - 1)) row_h.push_back({var[grid.Index(r, c - 1)].xh, 1.0});
+      if (grid.LeftLinked(r, c)) row_h.push_back({var[grid.Index(r, c - 1)].xh, 1.0});
       lp.AddRow(0.0, LinearProgram::kInf, row_h);
       // (3.7): y_v - x_v + x_v(below) >= 0
       const int yv = lp.AddColumn(0.0, LinearProgram::kInf, 1.0);
       std::vector<std::pair<int, double>> row_v = {{yv, 1.0}, {v.xv, -1.0}};
-      if (grid.IsFree(r - 1, c)) row_v.push_back({var[grid.Index(r - 1, c)].xv, 1.0});
+      if (grid.BelowLinked(r, c)) row_v.push_back({var[grid.Index(r - 1, c)].xv, 1.0});
       lp.AddRow(0.0, LinearProgram::kInf, row_v);
     }
   }

@@ -30,7 +30,7 @@ void ForEachArc(const Grid& grid, const std::vector<uint32_t>& node, uint32_t s,
     for (int c = 0; c < grid.cols(); ++c) {
       const uint32_t v = node[grid.Index(r, c)];
       if (v == kNone) continue;
-      const bool left_free = grid.IsFree(r, c - 1), below_free = grid.IsFree(r - 1, c);
+      const bool left_free = grid.LeftLinked(r, c), below_free = grid.BelowLinked(r, c);
       // H start: c is H and its left neighbour is not H.  V start: c is V and
       // its lower neighbour is not V. A cell with neither neighbour pays one
       // start whatever its orientation: that unit of flow s->v->t is pushed
@@ -55,7 +55,7 @@ absl::StatusOr<RankPartition> MinCutPartitioner::Partition(const Grid& grid,
     for (int c = 0; c < grid.cols(); ++c) {
       if (!grid.IsFree(r, c)) continue;
       node[grid.Index(r, c)] = n++;
-      constant += !grid.IsFree(r, c - 1) && !grid.IsFree(r - 1, c);
+      constant += !grid.LeftLinked(r, c) && !grid.BelowLinked(r, c);
     }
   }
   if (n == 0) return absl::InvalidArgumentError("grid has no free cell");

@@ -7,20 +7,21 @@ std::vector<Rank> RanksFromOrientation(const Grid& grid, const std::vector<uint8
   auto is = [&](int r, int c, Orientation o) {
     return grid.IsFree(r, c) && orientation[grid.Index(r, c)] == static_cast<uint8_t>(o);
   };
+  const auto kH = Orientation::kHorizontal, kV = Orientation::kVertical;
   for (int r = 0; r < grid.rows(); ++r) {
     for (int c = 0; c < grid.cols(); ++c) {
-      if (!is(r, c, Orientation::kHorizontal) || is(r, c - 1, Orientation::kHorizontal)) continue;
+      if (!is(r, c, kH) || (grid.LeftLinked(r, c) && is(r, c - 1, kH))) continue;
       int e = c;
-      while (is(r, e + 1, Orientation::kHorizontal)) ++e;
-      ranks.push_back({Orientation::kHorizontal, {r, c}, {r, e}});
+      while (grid.Passable(r, e, 0, 1) && is(r, e + 1, kH)) ++e;
+      ranks.push_back({kH, {r, c}, {r, e}});
     }
   }
   for (int c = 0; c < grid.cols(); ++c) {
     for (int r = 0; r < grid.rows(); ++r) {
-      if (!is(r, c, Orientation::kVertical) || is(r - 1, c, Orientation::kVertical)) continue;
+      if (!is(r, c, kV) || (grid.BelowLinked(r, c) && is(r - 1, c, kV))) continue;
       int e = r;
-      while (is(e + 1, c, Orientation::kVertical)) ++e;
-      ranks.push_back({Orientation::kVertical, {r, c}, {e, c}});
+      while (grid.Passable(e, c, 1, 0) && is(e + 1, c, kV)) ++e;
+      ranks.push_back({kV, {r, c}, {e, c}});
     }
   }
   return ranks;
@@ -33,9 +34,9 @@ int64_t CountRankStarts(const Grid& grid, const std::vector<uint8_t>& orientatio
       if (!grid.IsFree(r, c)) continue;
       const uint8_t o = orientation[grid.Index(r, c)];
       if (o == 0) {
-        starts += !(grid.IsFree(r, c - 1) && orientation[grid.Index(r, c - 1)] == 0);
+        starts += !(grid.LeftLinked(r, c) && orientation[grid.Index(r, c - 1)] == 0);
       } else {
-        starts += !(grid.IsFree(r - 1, c) && orientation[grid.Index(r - 1, c)] == 1);
+        starts += !(grid.BelowLinked(r, c) && orientation[grid.Index(r - 1, c)] == 1);
       }
     }
   }

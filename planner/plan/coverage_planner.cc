@@ -32,7 +32,8 @@ Grid KeepLargestComponent(const Grid& grid, int64_t* dropped) {
     free[i] = comp[i] == keep;
     *dropped += comp[i] >= 0 && comp[i] != keep;
   }
-  return Grid(grid.rows(), grid.cols(), grid.cell_size(), grid.origin(), std::move(free));
+  return Grid(grid.rows(), grid.cols(), grid.cell_size(), grid.origin(), std::move(free),
+              grid.walls());
 }
 
 }  // namespace

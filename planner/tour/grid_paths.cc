@@ -19,15 +19,20 @@ bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b) {
     // ((0.5 + ix) / nx) and horizontal ((0.5 + iy) / ny) grid line.
     const int64_t decision = (1 + 2 * ix) * ny - (1 + 2 * iy) * nx;
     if (decision == 0) {
-      // Exactly through a grid corner: both side cells are touched.
-      if (!grid.IsFree(y, x + sx) || !grid.IsFree(y + sy, x)) return false;
+      // Exactly through a grid corner: all four cells around it are touched,
+      // and no barrier may meet the corner.
+      if (!grid.Passable(y, x, 0, sx) || !grid.Passable(y, x + sx, sy, 0) ||
+          !grid.Passable(y, x, sy, 0) || !grid.Passable(y + sy, x, 0, sx)) {
+        return false;
+      }
       x += sx, y += sy, ++ix, ++iy;
     } else if (decision < 0) {
+      if (!grid.Passable(y, x, 0, sx)) return false;
       x += sx, ++ix;
     } else {
+      if (!grid.Passable(y, x, sy, 0)) return false;
       y += sy, ++iy;
     }
-    if (!grid.IsFree(y, x)) return false;
   }
   return true;
 }
@@ -46,7 +51,7 @@ std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components) {
       constexpr int kDr[4] = {1, -1, 0, 0}, kDc[4] = {0, 0, 1, -1};
       for (int k = 0; k < 4; ++k) {
         const int r = c.row + kDr[k], cc = c.col + kDc[k];
-        if (!grid.IsFree(r, cc)) continue;
+        if (!grid.Passable(c.row, c.col, kDr[k], kDc[k])) continue;
         const int64_t j = grid.Index(r, cc);
         if (comp[j] < 0) comp[j] = next, stack.push_back(j);
       }
@@ -78,10 +83,16 @@ void ForEachMove(const Grid& g, CellIndex c, F&& f) {
   constexpr int kDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   constexpr int kDc[8] = {0, 0, 1, -1, 1, -1, 1, -1};
   for (int k = 0; k < 8; ++k) {
-    const int r = c.row + kDr[k], col = c.col + kDc[k];
-    if (!g.IsFree(r, col)) continue;
-    if (k >= 4 && (!g.IsFree(c.row, col) || !g.IsFree(r, c.col))) continue;
-    f(g.Index(r, col));
+    const int dr = kDr[k], dc = kDc[k];
+    if (k < 4) {
+      if (g.Passable(c.row, c.col, dr, dc)) f(g.Index(c.row + dr, c.col + dc));
+      continue;
+    }
+    // Diagonal: both L-shaped routes around the corner must be open.
+    if (g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
+        g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc)) {
+      f(g.Index(c.row + dr, c.col + dc));
+    }
   }
 }
 

@@ -1,8 +1,9 @@
 // Obstacle-free paths on the tool-width grid.
 //
 // The robot drives between cell centres. A straight segment is allowed when
-// every cell it touches is free, including both cells beside a grid corner it
-// passes exactly through (so the tool never enters a blocked cell).
+// every cell it touches is free and every cell boundary it crosses is
+// passable (no thin-wall barrier); through an exact grid corner, all four
+// cells and boundaries around it must be open.
 // AnyAngleSearch is a single-source Lazy Theta* (Nash, Koenig & Tovey 2010)
 // without a goal: one search yields any-angle shortest paths, as chains of
 // corner cells, from the source to every reachable cell.
@@ -28,8 +29,8 @@ namespace covplan {
 // free cells.
 bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b);
 
-// Connected components of free cells under 4-connectivity (the moves the
-// line-of-sight rule allows). Returns per-cell component id, -1 for blocked.
+// Connected components of free cells under 4-connectivity through passable
+// boundaries (the moves the line-of-sight rule allows). Returns per-cell component id, -1 for blocked.
 std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components);
 
 class AnyAngleSearch {

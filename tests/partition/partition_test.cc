@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <random>
 #include <cstdint>
 #include <vector>
 
@@ -70,6 +71,56 @@ TEST(MinCutPartitioner, LShapeNeedsTwoRanks) {
   ASSERT_TRUE(p.ok()) << p.status();
   EXPECT_EQ(p->ranks.size(), 2u);
   EXPECT_EQ(CheckExactCover(g, p->ranks), "");
+}
+
+TEST(Partitioners, RanksNeverCrossBarriers) {
+  // A thin wall between columns 2 and 3 of the middle row, and below the
+  // top-left cell: the row splits into two ranks.
+  Grid g = Grid::FromAscii({
+      "_.....",
+      "..|...",
+      "......",
+  });
+  for (const RankPartitioner* p : {static_cast<const RankPartitioner*>(new MinCutPartitioner()),
+                                   static_cast<const RankPartitioner*>(new LpPartitioner())}) {
+    auto part = p->Partition(g, StopToken());
+    ASSERT_TRUE(part.ok()) << part.status();
+    for (const Rank& r : part->ranks) {
+      if (r.orientation == Orientation::kHorizontal && r.first.row == 1) {
+        EXPECT_FALSE(r.first.col <= 2 && r.last.col >= 3) << "rank crosses the wall";
+      }
+      if (r.orientation == Orientation::kVertical && r.first.col == 0) {
+        EXPECT_FALSE(r.first.row <= 1 && r.last.row >= 2) << "rank crosses the wall";
+      }
+    }
+    EXPECT_EQ(CountRankStarts(g, part->orientation), static_cast<int64_t>(part->ranks.size()));
+    EXPECT_EQ(CheckExactCover(g, part->ranks), "");
+    delete p;
+  }
+  // Without walls this grid needs 3 ranks (one per row); the wall in the
+  // middle row costs one more, the one under the top-left cell none.
+  auto cut = MinCutPartitioner().Partition(g, StopToken());
+  EXPECT_EQ(cut->ranks.size(), 4u);
+  EXPECT_EQ(BruteForceMinRanks(g), 4);
+}
+
+TEST(Partitioners, MinCutEqualsLpWithRandomBarriers) {
+  for (uint32_t seed = 0; seed < 100; ++seed) {
+    Grid base = RandomGrid(4 + seed % 9, 4 + (seed * 5) % 11, 0.85, 7000 + seed);
+    std::mt19937 rng(seed);
+    std::vector<uint8_t> walls(base.size());
+    for (auto& w : walls) w = rng() % 5 == 0 ? Grid::kWallRight : (rng() % 5 == 0 ? Grid::kWallUp : 0);
+    Grid g(base.rows(), base.cols(), 1.0, {0, 0}, base.free_flags(), walls);
+    if (g.CountFree() == 0) continue;
+    auto cut = MinCutPartitioner().Partition(g, StopToken());
+    auto lp = LpPartitioner().Partition(g, StopToken());
+    ASSERT_TRUE(cut.ok() && lp.ok());
+    ASSERT_EQ(cut->ranks.size(), lp->ranks.size()) << "seed " << seed;
+    ASSERT_EQ(CheckExactCover(g, cut->ranks), "");
+    if (g.CountFree() <= 14) {
+      EXPECT_EQ(static_cast<int64_t>(cut->ranks.size()), BruteForceMinRanks(g)) << "seed " << seed;
+    }
+  }
 }
 
 TEST(MinCutPartitioner, RejectsGridWithoutFreeCells) {

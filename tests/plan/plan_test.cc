@@ -128,3 +128,35 @@ TEST(PlanCoverage, DisconnectedAreasAreReportedNotPlanned) {
 
 }  // namespace
 }  // namespace covplan
+
+namespace covplan {
+namespace {
+
+TEST(BuildGrid, ThinWallBecomesBarrier) {
+  // 4 m x 2 m free room at 0.05 m/px with a 0.1 m wall at x = 2 m, open
+  // only in the top 0.4 m: the wall is far thinner than a 0.8 m cell.
+  OccupancyMap m(80, 40, 0.05, {0, 0});
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 80; ++c) m.set(r, c, (c == 39 || c == 40) && r < 32 ? CellState::kOccupied : CellState::kFree);
+  GridOptions opt;
+  opt.cell_size = 0.8;
+  auto g = BuildGrid(m, opt);
+  ASSERT_TRUE(g.ok());
+  ASSERT_EQ(g->cols(), 5);
+  // Column 2 (1.6..2.4 m) contains the wall but is >50 % free.
+  EXPECT_TRUE(g->IsFree(0, 2));
+  EXPECT_GT(g->CountBarriers(), 0);
+  // No horizontal link across the wall in the walled rows.
+  EXPECT_FALSE(g->Passable(0, 2, 0, 1) && g->Passable(0, 1, 0, 1));
+  opt.thin_wall_barriers = false;
+  EXPECT_EQ(BuildGrid(m, opt)->CountBarriers(), 0);
+
+  PlanOptions po;
+  po.tour_solver = TourSolver::kGreedy;
+  auto plan = PlanCoverage(m, po);
+  ASSERT_TRUE(plan.ok()) << plan.status();
+  EXPECT_EQ(testing::CheckRankPlanConformance(*plan, po.robot), "");
+}
+
+}  // namespace
+}  // namespace covplan

@@ -39,6 +39,10 @@ inline std::string CheckExactCover(const Grid& grid, const std::vector<Rank>& ra
         return "rank " + std::to_string(k) + " covers blocked cell (" + std::to_string(row) + "," +
                std::to_string(col) + ")";
       }
+      if (i > 0 && !grid.Passable(row - (h ? 0 : 1), col - (h ? 1 : 0), h ? 0 : 1, h ? 1 : 0)) {
+        return "rank " + std::to_string(k) + " crosses a barrier at (" + std::to_string(row) + "," +
+               std::to_string(col) + ")";
+      }
       ++count[grid.Index(row, col)];
     }
   }

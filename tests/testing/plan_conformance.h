@@ -16,8 +16,10 @@
 
 namespace covplan::testing {
 
-// First point (sampled every 1 % of a cell) of the path outside free cells.
+// First point (sampled every 1 % of a cell) of the path outside free cells,
+// or the first move between cells across a thin-wall barrier.
 inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoint>& path) {
+  CellIndex prev{-1, -1};
   for (size_t i = 0; i < path.size(); ++i) {
     const Waypoint& b = path[i];
     const Waypoint& a = i == 0 ? b : path[i - 1];
@@ -26,9 +28,24 @@ inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoi
     for (int k = 0; k <= steps; ++k) {
       const double t = static_cast<double>(k) / steps;
       const Point2 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
-      if (!grid.IsFree(grid.CellAt(p))) {
+      const CellIndex cell = grid.CellAt(p);
+      if (!grid.IsFree(cell)) {
         return absl::StrFormat("segment %d passes (%.3f, %.3f) outside free cells", i, p.x, p.y);
       }
+      if (prev.row >= 0 && cell != prev) {
+        const int dr = cell.row - prev.row, dc = cell.col - prev.col;
+        bool ok = false;
+        if (std::abs(dr) + std::abs(dc) == 1) {
+          ok = grid.Passable(prev.row, prev.col, dr, dc);
+        } else if (std::abs(dr) == 1 && std::abs(dc) == 1) {
+          ok = (grid.Passable(prev.row, prev.col, 0, dc) && grid.Passable(prev.row, prev.col + dc, dr, 0)) ||
+               (grid.Passable(prev.row, prev.col, dr, 0) && grid.Passable(prev.row + dr, prev.col, 0, dc));
+        }
+        if (!ok) {
+          return absl::StrFormat("segment %d crosses a barrier near (%.3f, %.3f)", i, p.x, p.y);
+        }
+      }
+      prev = cell;
     }
   }
   return "";
