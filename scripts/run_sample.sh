@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The main job: install dependencies, build, start covplan-server with its
+# embedded defaults (on-disk map store under ./covplan-data, no external
+# services), plan the shipped sample map through the server, print the
+# figures and write plan.json and plan.svg.
+#   scripts/run_sample.sh [MAP] [extra `covplan plan` flags...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+MAP=${1:-maps/sample_office.yaml}
+shift || true
+OUT_DIR=${OUT_DIR:-.}
+
+bash scripts/install-deps.sh
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build -j"$(nproc)" --target covplan-server covplan
+
+free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
+PORT=${PORT:-$(free_port)}
+METRICS_PORT=${METRICS_PORT:-$(free_port)}
+LOG=$(mktemp -t covplan-server.XXXXXX.log)
+./build/bin/covplan-server --port "$PORT" --metrics_port "$METRICS_PORT" \
+  --store_dir ./covplan-data/maps 2>"$LOG" &
+SERVER=$!
+cleanup() { kill -TERM "$SERVER" 2>/dev/null || true; wait "$SERVER" 2>/dev/null || true; }
+trap cleanup EXIT
+
+# Wait (bounded) for the gRPC port to accept connections.
+for _ in $(seq 1 100); do
+  if (exec 3<>/dev/tcp/127.0.0.1/"$PORT") 2>/dev/null; then break; fi
+  if ! kill -0 "$SERVER" 2>/dev/null; then echo "covplan-server exited:"; cat "$LOG"; exit 1; fi
+  sleep 0.1
+done
+echo "covplan-server on 127.0.0.1:$PORT (metrics on :$METRICS_PORT, log $LOG)"
+
+./build/bin/covplan plan --map "$MAP" --server "127.0.0.1:$PORT" \
+  --out "$OUT_DIR/plan.json" --svg "$OUT_DIR/plan.svg" "$@"
+echo "wrote $OUT_DIR/plan.json and $OUT_DIR/plan.svg"
