@@ -1,0 +1,509 @@
+#include "server/convert.h"
+
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "google/protobuf/util/json_util.h"
+#include "planner/common/status_macros.h"
+#include "planner/grid/grid.h"
+#include "planner/grid/map_io.h"
+#include "planner/partition/rank.h"
+#include "server/digest.h"
+
+namespace covplan {
+namespace {
+
+absl::Status Annotate(const absl::Status& status, absl::string_view prefix) {
+  if (status.ok()) return status;
+  return absl::Status(status.code(), absl::StrCat(prefix, status.message()));
+}
+
+bool IsPositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
+
+absl::Status CheckPositive(double v, absl::string_view field, absl::string_view unit) {
+  if (IsPositiveFinite(v)) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrFormat("%s must be a positive, finite number of %s (got %g)", field, unit, v));
+}
+
+absl::Status CheckFinite(double v, absl::string_view field) {
+  if (std::isfinite(v)) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrFormat("%s must be finite (got %g)", field, v));
+}
+
+// Width and height from an image header, if the header is complete enough to
+// read them; decoding proper is left to the map reader, which reports errors.
+std::optional<std::pair<int64_t, int64_t>> SniffDimensions(const std::string& bytes) {
+  switch (DetectImageFormat(bytes)) {
+    case ImageFormat::kPng: {
+      if (bytes.size() < 24) return std::nullopt;
+      auto be32 = [&](size_t at) {
+        int64_t v = 0;
+        for (size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<uint8_t>(bytes[at + i]);
+        return v;
+      };
+      return std::make_pair(be32(16), be32(20));
+    }
+    case ImageFormat::kPgm: {
+      size_t pos = 2;
+      int64_t values[2] = {0, 0};
+      for (int64_t& value : values) {
+        while (pos < bytes.size()) {  // whitespace and comments
+          if (std::isspace(static_cast<unsigned char>(bytes[pos]))) {
+            ++pos;
+          } else if (bytes[pos] == '#') {
+            while (pos < bytes.size() && bytes[pos] != '\n') ++pos;
+          } else {
+            break;
+          }
+        }
+        int digits = 0;
+        while (pos < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[pos])) &&
+               digits < 12) {
+          value = value * 10 + (bytes[pos++] - '0');
+          ++digits;
+        }
+        if (digits == 0) return std::nullopt;
+      }
+      return std::make_pair(values[0], values[1]);
+    }
+    case ImageFormat::kUnknown:
+      break;
+  }
+  return std::nullopt;
+}
+
+void AppendField(std::string* out, absl::string_view name, absl::string_view value) {
+  absl::StrAppend(out, name, ":", value.size(), ":", value, "\n");
+}
+
+absl::StatusOr<std::string> ReadFile(const std::string& path, int64_t max_bytes) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    return absl::NotFoundError(absl::StrCat("map file not found: ", path));
+  }
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) return absl::InvalidArgumentError(absl::StrCat("cannot read ", path, ": ", ec.message()));
+  if (static_cast<int64_t>(size) > max_bytes) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%s is %d bytes, above the limit of %d bytes", path, static_cast<int64_t>(size), max_bytes));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::InvalidArgumentError(absl::StrCat("cannot open ", path));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+}  // namespace
+
+absl::Status InputLimits::Validate() const {
+  if (max_image_bytes <= 0 || max_map_pixels <= 0 || max_grid_cells <= 0) {
+    return absl::InvalidArgumentError("input limits must be positive");
+  }
+  return absl::OkStatus();
+}
+
+std::string ComputeMapId(const v1::Map& map) {
+  std::string canonical = "covplan.map.v1\n";
+  const v1::RasterMap& r = map.raster();
+  AppendField(&canonical, "image", r.image());
+  AppendField(&canonical, "yaml", r.yaml());
+  // %a prints doubles exactly, so equal values give equal ids.
+  if (r.has_resolution()) AppendField(&canonical, "resolution", absl::StrFormat("%a", r.resolution()));
+  if (r.has_origin_x_m()) AppendField(&canonical, "origin_x_m", absl::StrFormat("%a", r.origin_x_m()));
+  if (r.has_origin_y_m()) AppendField(&canonical, "origin_y_m", absl::StrFormat("%a", r.origin_y_m()));
+  if (r.has_negate()) AppendField(&canonical, "negate", r.negate() ? "1" : "0");
+  if (r.has_occupied_thresh()) {
+    AppendField(&canonical, "occupied_thresh", absl::StrFormat("%a", r.occupied_thresh()));
+  }
+  if (r.has_free_thresh()) AppendField(&canonical, "free_thresh", absl::StrFormat("%a", r.free_thresh()));
+
+  return Sha256Hex(canonical);
+}
+
+absl::Status ValidateMapId(absl::string_view map_id) {
+  bool ok = map_id.size() == 64;
+  for (char c : map_id) ok = ok && (std::isdigit(static_cast<unsigned char>(c)) || (c >= 'a' && c <= 'f'));
+  if (ok) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrCat(
+      "map_id '", map_id.substr(0, 80), "' is malformed: expected 64 lowercase hex digits"));
+}
+
+absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits& limits) {
+  if (map.source_case() != v1::Map::kRaster) {
+    return absl::InvalidArgumentError("map has no source: set map.raster");
+  }
+  const v1::RasterMap& r = map.raster();
+  if (r.image().empty()) return absl::InvalidArgumentError("map.raster.image is empty");
+  if (static_cast<int64_t>(r.image().size()) > limits.max_image_bytes) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("map.raster.image is too large: %d bytes, above the limit of %d bytes",
+                        static_cast<int64_t>(r.image().size()), limits.max_image_bytes));
+  }
+  if (DetectImageFormat(r.image()) == ImageFormat::kUnknown) {
+    return absl::InvalidArgumentError(
+        "map.raster.image is neither a PGM (P2/P5) nor a PNG image (corrupt or unsupported data)");
+  }
+  if (auto dims = SniffDimensions(r.image())) {
+    const int64_t pixels = dims->first * dims->second;
+    if (pixels > limits.max_map_pixels) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "map.raster.image is too large: %d x %d = %d pixels, above the limit of %d pixels",
+          dims->first, dims->second, pixels, limits.max_map_pixels));
+    }
+  }
+
+  MapLoadOptions options;
+  if (!r.yaml().empty()) {
+    absl::StatusOr<MapYaml> parsed = ParseMapYaml(r.yaml(), options);
+    if (!parsed.ok()) return Annotate(parsed.status(), "map.raster.yaml: ");
+    options = parsed->options;  // its `image:` is ignored: the bytes are the image
+  } else if (!r.has_resolution()) {
+    return absl::InvalidArgumentError(
+        "map.raster.resolution is required for a bare image (no YAML given)");
+  }
+  if (r.has_resolution()) {
+    options.resolution = r.resolution();
+    options.override_resolution = true;
+  }
+  if (r.has_origin_x_m()) options.origin.x = r.origin_x_m();
+  if (r.has_origin_y_m()) options.origin.y = r.origin_y_m();
+  if (r.has_negate()) options.negate = r.negate();
+  if (r.has_occupied_thresh()) options.occupied_thresh = r.occupied_thresh();
+  if (r.has_free_thresh()) options.free_thresh = r.free_thresh();
+  options.max_pixels = limits.max_map_pixels;
+  options.max_file_bytes = limits.max_image_bytes;
+
+  RETURN_IF_ERROR(CheckPositive(options.resolution, "map resolution", "metres per pixel"));
+  RETURN_IF_ERROR(CheckFinite(options.origin.x, "map origin x"));
+  RETURN_IF_ERROR(CheckFinite(options.origin.y, "map origin y"));
+  for (auto [value, name] : {std::pair{options.occupied_thresh, "occupied_thresh"},
+                             std::pair{options.free_thresh, "free_thresh"}}) {
+    if (!std::isfinite(value) || value < 0.0 || value > 1.0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("map %s must be in [0, 1] (got %g)", name, value));
+    }
+  }
+  if (options.free_thresh >= options.occupied_thresh) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "map free_thresh (%g) must be below occupied_thresh (%g)", options.free_thresh,
+        options.occupied_thresh));
+  }
+
+  absl::StatusOr<OccupancyMap> decoded = DecodeMapImage(r.image(), options);
+  if (!decoded.ok()) return Annotate(decoded.status(), "map.raster.image: ");
+  if (decoded->width() <= 0 || decoded->height() <= 0) {
+    return absl::InvalidArgumentError("map.raster.image has no pixels");
+  }
+  if (decoded->CountFree() == 0) {
+    return absl::InvalidArgumentError(
+        "map has no free pixel: nothing to cover (check negate and the thresholds)");
+  }
+  return decoded;
+}
+
+absl::StatusOr<PlanOptions> PlanOptionsFromProto(const v1::PlanRequest& request) {
+  PlanOptions options;
+  const v1::RobotModel& robot = request.robot();
+  RETURN_IF_ERROR(CheckPositive(robot.tool_width_m(), "robot.tool_width_m", "metres"));
+  options.robot.tool_width_m = robot.tool_width_m();
+  if (robot.has_max_speed_mps()) {
+    RETURN_IF_ERROR(CheckPositive(robot.max_speed_mps(), "robot.max_speed_mps", "m/s"));
+    options.robot.max_speed_mps = robot.max_speed_mps();
+  }
+  if (robot.has_acceleration_mps2()) {
+    RETURN_IF_ERROR(CheckPositive(robot.acceleration_mps2(), "robot.acceleration_mps2", "m/s^2"));
+    options.robot.acceleration_mps2 = robot.acceleration_mps2();
+  }
+  if (robot.has_turn_rate_deg_s()) {
+    RETURN_IF_ERROR(CheckPositive(robot.turn_rate_deg_s(), "robot.turn_rate_deg_s", "deg/s"));
+    options.robot.turn_rate_deg_s = robot.turn_rate_deg_s();
+  }
+  for (auto [present, pose, name] :
+       {std::tuple{robot.has_start(), &robot.start(), "robot.start"},
+        std::tuple{robot.has_end(), &robot.end(), "robot.end"}}) {
+    if (!present) continue;
+    if (!std::isfinite(pose->x()) || !std::isfinite(pose->y()) || !std::isfinite(pose->theta())) {
+      return absl::InvalidArgumentError(absl::StrCat(name, " must have finite x, y and theta"));
+    }
+  }
+  if (robot.has_start()) options.robot.start = Pose2{robot.start().x(), robot.start().y(), robot.start().theta()};
+  if (robot.has_end()) options.robot.end = Pose2{robot.end().x(), robot.end().y(), robot.end().theta()};
+
+  switch (request.partition_solver()) {
+    case v1::PARTITION_SOLVER_UNSPECIFIED:
+    case v1::MINCUT:
+      options.partition_solver = PartitionSolver::kMinCut;
+      break;
+    case v1::LP:
+      options.partition_solver = PartitionSolver::kLp;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("unknown partition_solver ", static_cast<int>(request.partition_solver())));
+  }
+  switch (request.tour_solver()) {
+    case v1::TOUR_SOLVER_UNSPECIFIED:
+    case v1::GTSP:
+      options.tour_solver = TourSolver::kGtsp;
+      break;
+    case v1::GREEDY:
+      options.tour_solver = TourSolver::kGreedy;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("unknown tour_solver ", static_cast<int>(request.tour_solver())));
+  }
+  const double limit = request.time_limit_s();
+  if (!std::isfinite(limit) || limit < 0.0 || limit > 3600.0) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("time_limit_s must be in [0, 3600] seconds (got %g)", limit));
+  }
+  if (limit > 0.0) options.time_limit_s = limit;
+  options.seed = request.seed();
+  const double fraction = request.min_free_fraction();
+  if (fraction != 0.0) {
+    if (!std::isfinite(fraction) || fraction < 0.0 || fraction >= 1.0) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("min_free_fraction must be in (0, 1) (got %g)", fraction));
+    }
+    options.min_free_fraction = fraction;
+  }
+  RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+DecompositionOptions DecompositionOptionsFor(const PlanOptions& options,
+                                             const InputLimits& limits) {
+  DecompositionOptions d = options.decomposition();
+  d.grid.max_cells = limits.max_grid_cells;
+  return d;
+}
+
+absl::Status ValidatePlanForMap(const PlanOptions& options, const OccupancyMap& map,
+                                const InputLimits& limits) {
+  const double tool = options.robot.tool_width_m;
+  const double res = map.resolution();
+  if (tool < res) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "robot.tool_width_m (%g m) is narrower than one map pixel (%g m)", tool, res));
+  }
+  const double width_m = map.width() * res;
+  const double height_m = map.height() * res;
+  if (tool > width_m || tool > height_m) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "robot.tool_width_m (%g m) is wider than the map (%g m x %g m)", tool, width_m, height_m));
+  }
+  const double cells = std::ceil(width_m / tool) * std::ceil(height_m / tool);
+  if (cells > static_cast<double>(limits.max_grid_cells)) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the grid would have %.0f tool-width cells, above the limit of %d; use a wider tool "
+        "or a smaller map",
+        cells, limits.max_grid_cells));
+  }
+  return absl::OkStatus();
+}
+
+void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
+  if (plan.grid != nullptr) {
+    const Grid& grid = *plan.grid;
+    v1::Grid* g = out->mutable_grid();
+    g->set_rows(grid.rows());
+    g->set_cols(grid.cols());
+    g->set_cell_size_m(grid.cell_size());
+    g->set_origin_x_m(grid.origin().x);
+    g->set_origin_y_m(grid.origin().y);
+    for (std::string& row : grid.ToRowStrings()) g->add_free_cells(std::move(row));
+  }
+  for (const Rank& rank : plan.ranks) {
+    v1::Rank* r = out->add_ranks();
+    r->set_orientation(rank.orientation == Orientation::kHorizontal ? v1::HORIZONTAL
+                                                                    : v1::VERTICAL);
+    r->mutable_first_cell()->set_row(rank.first.row);
+    r->mutable_first_cell()->set_col(rank.first.col);
+    r->mutable_last_cell()->set_row(rank.last.row);
+    r->mutable_last_cell()->set_col(rank.last.col);
+  }
+  for (int index : plan.rank_order) out->add_rank_order(index);
+  for (bool reversed : plan.rank_reversed) out->add_rank_reversed(reversed);
+  for (const Waypoint& w : plan.path) {
+    v1::Waypoint* p = out->add_path();
+    p->set_x(w.x);
+    p->set_y(w.y);
+    p->set_theta(w.theta);
+    switch (w.kind) {
+      case SegmentKind::kStart: p->set_kind(v1::START); break;
+      case SegmentKind::kCoverage: p->set_kind(v1::COVERAGE); break;
+      case SegmentKind::kTransition: p->set_kind(v1::TRANSITION); break;
+    }
+    p->set_rank(w.rank);
+  }
+  const PlanStats& s = plan.stats;
+  v1::PlanStats* o = out->mutable_stats();
+  o->set_num_ranks(static_cast<int32_t>(s.num_ranks));
+  o->set_num_turns(static_cast<int32_t>(s.num_turns));
+  o->set_coverage_length_m(s.coverage_length_m);
+  o->set_transition_length_m(s.transition_length_m);
+  o->set_covered_free_area_ratio(s.covered_free_area_ratio);
+  o->set_estimated_duration_s(s.estimated_duration_s);
+  o->set_turning_time_s(s.turning_time_s);
+  o->set_planning_ms(s.planning_ms);
+  o->set_grid_ms(s.grid_ms);
+  o->set_partition_ms(s.partition_ms);
+  o->set_transitions_ms(s.transitions_ms);
+  o->set_tour_ms(s.tour_ms);
+  o->set_free_cells(static_cast<int32_t>(s.free_cells));
+  o->set_grid_rows(static_cast<int32_t>(s.grid_rows));
+  o->set_grid_cols(static_cast<int32_t>(s.grid_cols));
+  o->set_map_free_area_m2(s.map_free_area_m2);
+  o->set_tour_cut_short(s.tour_cut_short);
+  o->set_decomposition_cached(s.decomposition_cached);
+  o->set_partition_solver(s.partition_solver);
+  o->set_tour_solver(s.tour_solver);
+}
+
+absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
+  const v1::Grid& g = response.grid();
+  if (g.rows() <= 0 || g.cols() <= 0 || g.free_cells_size() != g.rows()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "plan grid is inconsistent: %d rows x %d cols with %d row strings", g.rows(), g.cols(),
+        g.free_cells_size()));
+  }
+  if (!IsPositiveFinite(g.cell_size_m())) {
+    return absl::InvalidArgumentError("plan grid cell_size_m must be positive");
+  }
+  std::vector<uint8_t> free;
+  free.reserve(static_cast<size_t>(g.rows()) * g.cols());
+  for (const std::string& row : g.free_cells()) {
+    if (static_cast<int>(row.size()) != g.cols()) {
+      return absl::InvalidArgumentError("plan grid row length differs from cols");
+    }
+    for (char c : row) {
+      if (c != '0' && c != '1') return absl::InvalidArgumentError("plan grid rows must be '0'/'1'");
+      free.push_back(c == '1');
+    }
+  }
+  CoveragePlan plan;
+  plan.grid = std::make_shared<const Grid>(g.rows(), g.cols(), g.cell_size_m(),
+                                           Point2{g.origin_x_m(), g.origin_y_m()}, std::move(free));
+  for (const v1::Rank& r : response.ranks()) {
+    Rank rank;
+    if (r.orientation() != v1::HORIZONTAL && r.orientation() != v1::VERTICAL) {
+      return absl::InvalidArgumentError("plan rank has no orientation");
+    }
+    rank.orientation = r.orientation() == v1::HORIZONTAL ? Orientation::kHorizontal
+                                                         : Orientation::kVertical;
+    rank.first = {r.first_cell().row(), r.first_cell().col()};
+    rank.last = {r.last_cell().row(), r.last_cell().col()};
+    if (!plan.grid->InBounds(rank.first.row, rank.first.col) ||
+        !plan.grid->InBounds(rank.last.row, rank.last.col)) {
+      return absl::InvalidArgumentError("plan rank lies outside the grid");
+    }
+    plan.ranks.push_back(rank);
+  }
+  for (int32_t index : response.rank_order()) {
+    if (index < 0 || index >= static_cast<int>(plan.ranks.size())) {
+      return absl::InvalidArgumentError("plan rank_order refers to a missing rank");
+    }
+    plan.rank_order.push_back(index);
+  }
+  plan.rank_reversed.assign(response.rank_reversed().begin(), response.rank_reversed().end());
+  for (const v1::Waypoint& p : response.path()) {
+    Waypoint w;
+    w.x = p.x();
+    w.y = p.y();
+    w.theta = p.theta();
+    w.kind = p.kind() == v1::COVERAGE     ? SegmentKind::kCoverage
+             : p.kind() == v1::TRANSITION ? SegmentKind::kTransition
+                                          : SegmentKind::kStart;
+    w.rank = p.rank();
+    plan.path.push_back(w);
+  }
+  const v1::PlanStats& s = response.stats();
+  PlanStats& o = plan.stats;
+  o.num_ranks = s.num_ranks();
+  o.num_turns = s.num_turns();
+  o.coverage_length_m = s.coverage_length_m();
+  o.transition_length_m = s.transition_length_m();
+  o.covered_free_area_ratio = s.covered_free_area_ratio();
+  o.estimated_duration_s = s.estimated_duration_s();
+  o.turning_time_s = s.turning_time_s();
+  o.planning_ms = s.planning_ms();
+  o.grid_ms = s.grid_ms();
+  o.partition_ms = s.partition_ms();
+  o.transitions_ms = s.transitions_ms();
+  o.tour_ms = s.tour_ms();
+  o.free_cells = s.free_cells();
+  o.grid_rows = s.grid_rows();
+  o.grid_cols = s.grid_cols();
+  o.map_free_area_m2 = s.map_free_area_m2();
+  o.tour_cut_short = s.tour_cut_short();
+  o.decomposition_cached = s.decomposition_cached();
+  o.partition_solver = s.partition_solver();
+  o.tour_solver = s.tour_solver();
+  return plan;
+}
+
+absl::StatusOr<std::string> PlanToJson(const v1::PlanResponse& response) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.add_whitespace = true;
+  options.always_print_primitive_fields = true;
+  options.preserve_proto_field_names = true;
+  std::string json;
+  const auto status = google::protobuf::util::MessageToJsonString(response, &json, options);
+  if (!status.ok()) {
+    return absl::InternalError(absl::StrCat("cannot print plan as JSON: ", status.ToString()));
+  }
+  return json;
+}
+
+v1::MapInfo MapInfoFor(const OccupancyMap& map, const std::string& map_id) {
+  v1::MapInfo info;
+  info.set_map_id(map_id);
+  info.set_width_px(map.width());
+  info.set_height_px(map.height());
+  info.set_resolution(map.resolution());
+  info.set_origin_x_m(map.origin().x);
+  info.set_origin_y_m(map.origin().y);
+  info.set_free_area_m2(map.FreeAreaM2());
+  return info;
+}
+
+absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path,
+                                         const MapFileOverrides& overrides,
+                                         const InputLimits& limits) {
+  v1::Map map;
+  v1::RasterMap* raster = map.mutable_raster();
+  std::filesystem::path file(path);
+  const std::string ext = absl::AsciiStrToLower(file.extension().string());
+  if (ext == ".yaml" || ext == ".yml") {
+    ASSIGN_OR_RETURN(std::string yaml, ReadFile(path, 1 << 20));
+    absl::StatusOr<MapYaml> parsed = ParseMapYaml(yaml, MapLoadOptions());
+    if (!parsed.ok()) return Annotate(parsed.status(), absl::StrCat(path, ": "));
+    if (parsed->image.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(path, ": the YAML names no image"));
+    }
+    std::filesystem::path image(parsed->image);
+    if (image.is_relative()) image = file.parent_path() / image;
+    ASSIGN_OR_RETURN(*raster->mutable_image(), ReadFile(image.string(), limits.max_image_bytes));
+    raster->set_yaml(std::move(yaml));
+  } else {
+    ASSIGN_OR_RETURN(*raster->mutable_image(), ReadFile(path, limits.max_image_bytes));
+  }
+  if (overrides.resolution) raster->set_resolution(*overrides.resolution);
+  if (overrides.negate) raster->set_negate(*overrides.negate);
+  if (overrides.occupied_thresh) raster->set_occupied_thresh(*overrides.occupied_thresh);
+  if (overrides.free_thresh) raster->set_free_thresh(*overrides.free_thresh);
+  return map;
+}
+
+}  // namespace covplan

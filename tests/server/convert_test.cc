@@ -1,0 +1,268 @@
+// The proto <-> planner edge: map decoding and validation, request
+// validation, plan round trips and the JSON shape of plan.json.
+#include "server/convert.h"
+
+#include <cmath>
+#include <limits>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "planner/grid/grid.h"
+#include "tests/server/test_maps.h"
+
+namespace covplan {
+namespace {
+
+using ::covplan::testing::AsciiToPgm;
+using ::covplan::testing::RasterMap;
+using ::covplan::testing::TwoRooms;
+using ::testing::HasSubstr;
+
+MATCHER_P2(StatusIs, code, substring, "") {
+  const absl::Status& s = arg.status();
+  if (s.code() != code) {
+    *result_listener << "code " << absl::StatusCodeToString(s.code()) << ": " << s.message();
+    return false;
+  }
+  if (std::string(s.message()).find(substring) == std::string::npos) {
+    *result_listener << "message: " << s.message();
+    return false;
+  }
+  return true;
+}
+
+v1::PlanRequest RequestWithTool(double tool) {
+  v1::PlanRequest request;
+  request.mutable_robot()->set_tool_width_m(tool);
+  return request;
+}
+
+TEST(MapFromProtoTest, DecodesAsciiPgmWithRowsFlipped) {
+  const std::string pgm = AsciiToPgm({"#..", "..."}, 2);
+  absl::StatusOr<OccupancyMap> map = MapFromProto(RasterMap(pgm, 0.1), InputLimits());
+  ASSERT_TRUE(map.ok()) << map.status();
+  EXPECT_EQ(map->width(), 6);
+  EXPECT_EQ(map->height(), 4);
+  EXPECT_DOUBLE_EQ(map->resolution(), 0.1);
+  // Image top-left is occupied; map row 0 is the bottom, so it is the top row.
+  EXPECT_EQ(map->at(3, 0), CellState::kOccupied);
+  EXPECT_EQ(map->at(0, 0), CellState::kFree);
+  EXPECT_EQ(map->CountFree(), 24 - 4);
+}
+
+TEST(MapFromProtoTest, YamlSuppliesResolutionAndOriginAndIgnoresImageKey) {
+  v1::Map map;
+  map.mutable_raster()->set_image(AsciiToPgm({"...", "..."}, 1));
+  map.mutable_raster()->set_yaml(
+      "image: does_not_exist.pgm\nresolution: 0.5\norigin: [1.0, -2.0, 0.0]\n"
+      "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n");
+  absl::StatusOr<OccupancyMap> decoded = MapFromProto(map, InputLimits());
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_DOUBLE_EQ(decoded->resolution(), 0.5);
+  EXPECT_DOUBLE_EQ(decoded->origin().x, 1.0);
+  EXPECT_DOUBLE_EQ(decoded->origin().y, -2.0);
+  // An explicit override wins over the YAML.
+  map.mutable_raster()->set_resolution(0.25);
+  decoded = MapFromProto(map, InputLimits());
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_DOUBLE_EQ(decoded->resolution(), 0.25);
+}
+
+TEST(MapFromProtoTest, RejectsBadMapsWithUsefulMessages) {
+  const std::string pgm = AsciiToPgm(TwoRooms(), 4);
+  const InputLimits limits;
+  const auto kInvalid = absl::StatusCode::kInvalidArgument;
+  EXPECT_THAT(MapFromProto(v1::Map(), limits), StatusIs(kInvalid, "no source"));
+  EXPECT_THAT(MapFromProto(RasterMap("", 0.1), limits), StatusIs(kInvalid, "empty"));
+  EXPECT_THAT(MapFromProto(RasterMap(pgm, 0.0), limits), StatusIs(kInvalid, "resolution"));
+  EXPECT_THAT(MapFromProto(RasterMap(pgm, -0.1), limits), StatusIs(kInvalid, "resolution"));
+  EXPECT_THAT(MapFromProto(RasterMap(pgm, std::nan("")), limits), StatusIs(kInvalid, "resolution"));
+  EXPECT_THAT(MapFromProto(RasterMap("GIF89a....", 0.1), limits),
+              StatusIs(kInvalid, "neither a PGM"));
+  EXPECT_THAT(MapFromProto(RasterMap(pgm.substr(0, pgm.size() / 2), 0.1), limits),
+              StatusIs(kInvalid, "map.raster.image"));
+  static const char kTruncatedPng[] = "\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0";
+  EXPECT_THAT(MapFromProto(RasterMap(std::string(kTruncatedPng, sizeof(kTruncatedPng) - 1), 0.1),
+                           limits),
+              StatusIs(kInvalid, "map.raster.image"));
+  EXPECT_THAT(MapFromProto(RasterMap(AsciiToPgm({"###", "###"}, 2), 0.1), limits),
+              StatusIs(kInvalid, "no free pixel"));
+
+  v1::Map bare = RasterMap(pgm, 0.1);
+  bare.mutable_raster()->clear_resolution();
+  EXPECT_THAT(MapFromProto(bare, limits), StatusIs(kInvalid, "resolution is required"));
+
+  v1::Map bad_yaml = bare;
+  bad_yaml.mutable_raster()->set_yaml("image: [unclosed\n  resolution: :\n");
+  EXPECT_THAT(MapFromProto(bad_yaml, limits), StatusIs(kInvalid, "map.raster.yaml"));
+
+  v1::Map thresholds = RasterMap(pgm, 0.1);
+  thresholds.mutable_raster()->set_free_thresh(0.9);
+  EXPECT_THAT(MapFromProto(thresholds, limits), StatusIs(kInvalid, "free_thresh"));
+}
+
+TEST(MapFromProtoTest, EnforcesSizeLimits) {
+  const std::string pgm = AsciiToPgm(TwoRooms(), 4);  // 48 x 32 pixels
+  InputLimits limits;
+  limits.max_image_bytes = 100;
+  EXPECT_THAT(MapFromProto(RasterMap(pgm, 0.1), limits),
+              StatusIs(absl::StatusCode::kInvalidArgument, "too large"));
+  limits = InputLimits();
+  limits.max_map_pixels = 1000;
+  EXPECT_THAT(MapFromProto(RasterMap(pgm, 0.1), limits),
+              StatusIs(absl::StatusCode::kInvalidArgument, "48 x 32 = 1536 pixels"));
+  // A header claiming a huge image is rejected before any decoding.
+  EXPECT_THAT(MapFromProto(RasterMap("P5\n100000 100000\n255\n", 0.1), InputLimits()),
+              StatusIs(absl::StatusCode::kInvalidArgument, "too large"));
+}
+
+TEST(PlanOptionsFromProtoTest, ValidatesRobotAndSolvers) {
+  const auto kInvalid = absl::StatusCode::kInvalidArgument;
+  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(0)), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(-1)), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(std::nan(""))), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(std::numeric_limits<double>::infinity())),
+              StatusIs(kInvalid, "tool_width_m"));
+  v1::PlanRequest request = RequestWithTool(0.5);
+  request.mutable_robot()->set_max_speed_mps(0);
+  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "max_speed_mps"));
+  request = RequestWithTool(0.5);
+  request.set_time_limit_s(-1);
+  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "time_limit_s"));
+  request = RequestWithTool(0.5);
+  request.set_min_free_fraction(1.5);
+  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "min_free_fraction"));
+  request = RequestWithTool(0.5);
+  request.set_partition_solver(static_cast<v1::PartitionSolver>(42));
+  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "partition_solver"));
+
+  request = RequestWithTool(0.5);
+  request.set_partition_solver(v1::LP);
+  request.set_tour_solver(v1::GREEDY);
+  request.mutable_robot()->set_turn_rate_deg_s(90);
+  request.set_seed(11);
+  absl::StatusOr<PlanOptions> options = PlanOptionsFromProto(request);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(options->partition_solver, PartitionSolver::kLp);
+  EXPECT_EQ(options->tour_solver, TourSolver::kGreedy);
+  EXPECT_DOUBLE_EQ(options->robot.turn_rate_deg_s, 90);
+  EXPECT_DOUBLE_EQ(options->robot.tool_width_m, 0.5);
+  EXPECT_EQ(options->seed, 11u);
+}
+
+TEST(ValidatePlanForMapTest, ToolMustFitPixelAndMap) {
+  absl::StatusOr<OccupancyMap> map = MapFromProto(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1),
+                                                  InputLimits());  // 4.8 m x 3.2 m
+  ASSERT_TRUE(map.ok());
+  const InputLimits limits;
+  auto check = [&](double tool, const InputLimits& l) {
+    absl::StatusOr<PlanOptions> options = PlanOptionsFromProto(RequestWithTool(tool));
+    EXPECT_TRUE(options.ok());
+    return ValidatePlanForMap(*options, *map, l);
+  };
+  EXPECT_TRUE(check(0.4, limits).ok());
+  EXPECT_THAT(absl::StatusOr<int>(check(0.05, limits)),
+              StatusIs(absl::StatusCode::kInvalidArgument, "narrower than one map pixel"));
+  EXPECT_THAT(absl::StatusOr<int>(check(3.5, limits)),
+              StatusIs(absl::StatusCode::kInvalidArgument, "wider than the map"));
+  InputLimits tight;
+  tight.max_grid_cells = 10;
+  EXPECT_THAT(absl::StatusOr<int>(check(0.4, tight)),
+              StatusIs(absl::StatusCode::kInvalidArgument, "above the limit"));
+}
+
+TEST(MapIdTest, ContentDerivedAndWellFormed) {
+  const std::string pgm = AsciiToPgm(TwoRooms(), 4);
+  const std::string a = ComputeMapId(RasterMap(pgm, 0.1));
+  EXPECT_EQ(a, ComputeMapId(RasterMap(pgm, 0.1)));
+  EXPECT_NE(a, ComputeMapId(RasterMap(pgm, 0.2)));
+  EXPECT_NE(a, ComputeMapId(RasterMap(AsciiToPgm(TwoRooms(), 2), 0.1)));
+  EXPECT_EQ(a.size(), 64u);
+  EXPECT_TRUE(ValidateMapId(a).ok());
+  EXPECT_THAT(absl::StatusOr<int>(ValidateMapId("../../etc/passwd")),
+              StatusIs(absl::StatusCode::kInvalidArgument, "malformed"));
+}
+
+CoveragePlan SmallPlan() {
+  CoveragePlan plan;
+  plan.grid = std::make_shared<const Grid>(Grid::FromAscii({"...", ".#."}, 0.5));
+  plan.ranks = {Rank{Orientation::kHorizontal, {1, 0}, {1, 2}},
+                Rank{Orientation::kVertical, {0, 0}, {0, 0}},
+                Rank{Orientation::kVertical, {0, 2}, {0, 2}}};
+  plan.rank_order = {0, 2, 1};
+  plan.rank_reversed = {false, true, false};
+  plan.path = {Waypoint{0.25, 0.75, 0, SegmentKind::kStart, -1},
+               Waypoint{1.25, 0.75, 0, SegmentKind::kCoverage, 0},
+               Waypoint{1.25, 0.25, -M_PI / 2, SegmentKind::kTransition, -1}};
+  plan.stats.num_ranks = 3;
+  plan.stats.num_turns = 1;
+  plan.stats.coverage_length_m = 1.0;
+  plan.stats.free_cells = 5;
+  plan.stats.tour_cut_short = true;
+  plan.stats.partition_solver = "mincut";
+  return plan;
+}
+
+TEST(PlanProtoTest, RoundTripsThroughProto) {
+  const CoveragePlan plan = SmallPlan();
+  v1::PlanResponse response;
+  PlanToProto(plan, &response);
+  EXPECT_EQ(response.grid().rows(), 2);
+  EXPECT_EQ(response.grid().cols(), 3);
+  // Row 0 is the smallest y: the bottom row of the ASCII picture.
+  EXPECT_EQ(response.grid().free_cells(0), "101");
+  EXPECT_EQ(response.grid().free_cells(1), "111");
+  EXPECT_EQ(response.ranks(1).orientation(), v1::VERTICAL);
+  EXPECT_EQ(response.path(2).kind(), v1::TRANSITION);
+
+  absl::StatusOr<CoveragePlan> back = PlanFromProto(response);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->grid->free_flags(), plan.grid->free_flags());
+  ASSERT_EQ(back->ranks.size(), 3u);
+  EXPECT_EQ(back->ranks[0].last, (CellIndex{1, 2}));
+  EXPECT_EQ(back->ranks[2].orientation, Orientation::kVertical);
+  EXPECT_EQ(back->rank_order, plan.rank_order);
+  EXPECT_EQ(back->rank_reversed, plan.rank_reversed);
+  ASSERT_EQ(back->path.size(), 3u);
+  EXPECT_EQ(back->path[1].kind, SegmentKind::kCoverage);
+  EXPECT_DOUBLE_EQ(back->path[2].theta, -M_PI / 2);
+  EXPECT_TRUE(back->stats.tour_cut_short);
+  EXPECT_EQ(back->stats.partition_solver, "mincut");
+
+  v1::PlanResponse again;
+  PlanToProto(*back, &again);
+  EXPECT_EQ(again.SerializeAsString(), response.SerializeAsString());
+}
+
+TEST(PlanProtoTest, RejectsInconsistentResponses) {
+  v1::PlanResponse response;
+  PlanToProto(SmallPlan(), &response);
+  v1::PlanResponse broken = response;
+  broken.mutable_grid()->set_free_cells(0, "10");
+  EXPECT_THAT(PlanFromProto(broken), StatusIs(absl::StatusCode::kInvalidArgument, "row length"));
+  broken = response;
+  broken.add_rank_order(7);
+  EXPECT_THAT(PlanFromProto(broken), StatusIs(absl::StatusCode::kInvalidArgument, "rank_order"));
+}
+
+TEST(PlanJsonTest, SnakeCaseNamesEnumNamesAndDefaultsPrinted) {
+  v1::PlanResponse response;
+  PlanToProto(SmallPlan(), &response);
+  response.set_plan_id("p-1");
+  absl::StatusOr<std::string> json = PlanToJson(response);
+  ASSERT_TRUE(json.ok());
+  EXPECT_THAT(*json, HasSubstr("\"free_cells\": ["));
+  EXPECT_THAT(*json, HasSubstr("\"cell_size_m\": 0.5"));
+  EXPECT_THAT(*json, HasSubstr("\"orientation\": \"HORIZONTAL\""));
+  EXPECT_THAT(*json, HasSubstr("\"orientation\": \"VERTICAL\""));
+  EXPECT_THAT(*json, HasSubstr("\"kind\": \"COVERAGE\""));
+  EXPECT_THAT(*json, HasSubstr("\"first_cell\""));
+  EXPECT_THAT(*json, HasSubstr("\"num_ranks\": 3"));        // int32: a number, not a string
+  EXPECT_THAT(*json, HasSubstr("\"transition_length_m\": 0"));  // primitive default printed
+  EXPECT_THAT(*json, HasSubstr("\"tour_cut_short\": true"));
+  EXPECT_THAT(*json, HasSubstr("\"map_id\": \"\""));
+  EXPECT_THAT(*json, ::testing::Not(HasSubstr("numRanks")));
+}
+
+}  // namespace
+}  // namespace covplan
