@@ -1,0 +1,79 @@
+#include "client/args.h"
+
+#include <cmath>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+
+namespace covplan {
+
+std::optional<std::string> ParsedArgs::Get(const std::string& name) const {
+  auto it = values.find(name);
+  if (it == values.end()) return std::nullopt;
+  return it->second;
+}
+
+absl::StatusOr<std::optional<double>> ParsedArgs::GetDouble(const std::string& name) const {
+  std::optional<std::string> text = Get(name);
+  if (!text) return std::optional<double>();
+  double value = 0;
+  if (!absl::SimpleAtod(*text, &value) || !std::isfinite(value)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", name, " expects a number, got '", *text, "'"));
+  }
+  return std::optional<double>(value);
+}
+
+absl::StatusOr<std::optional<int64_t>> ParsedArgs::GetInt(const std::string& name) const {
+  std::optional<std::string> text = Get(name);
+  if (!text) return std::optional<int64_t>();
+  int64_t value = 0;
+  if (!absl::SimpleAtoi(*text, &value)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", name, " expects an integer, got '", *text, "'"));
+  }
+  return std::optional<int64_t>(value);
+}
+
+absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
+                                     const std::set<std::string>& value_flags,
+                                     const std::set<std::string>& bool_flags) {
+  ParsedArgs parsed;
+  std::set<std::string> seen;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) {
+      return absl::InvalidArgumentError(absl::StrCat("unexpected argument '", arg, "'"));
+    }
+    std::string name = arg.substr(2);
+    std::optional<std::string> value;
+    if (size_t eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    if (!seen.insert(name).second) {
+      return absl::InvalidArgumentError(absl::StrCat("--", name, " given more than once"));
+    }
+    if (value_flags.count(name) != 0) {
+      if (!value) {
+        if (i + 1 >= args.size()) {
+          return absl::InvalidArgumentError(absl::StrCat("--", name, " needs a value"));
+        }
+        value = args[++i];
+      }
+      parsed.values[name] = *value;
+    } else if (bool_flags.count(name) != 0) {
+      if (!value || *value == "true" || *value == "1") {
+        parsed.switches.insert(name);
+      } else if (*value != "false" && *value != "0") {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--", name, " is a switch: use --", name, " or --", name, "=false"));
+      }
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat("unknown flag --", name));
+    }
+  }
+  return parsed;
+}
+
+}  // namespace covplan

@@ -1,0 +1,42 @@
+// Hand-rolled parsing of a subcommand's flags: `--flag value`, `--flag=value`
+// and boolean switches `--flag` (or `--flag=true|false`). Subcommands do not
+// use global absl flags, so each one declares exactly what it accepts.
+//
+//   ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, {"map", "resolution"}, {"local"}));
+//   std::string map = a.Get("map").value_or("");
+//   ASSIGN_OR_RETURN(std::optional<double> res, a.GetDouble("resolution"));
+//
+// Thread-safety: plain value types and free functions.
+#ifndef COVPLAN_CLIENT_ARGS_H_
+#define COVPLAN_CLIENT_ARGS_H_
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+
+namespace covplan {
+
+struct ParsedArgs {
+  std::map<std::string, std::string> values;  // flag name (without --) -> value
+  std::set<std::string> switches;             // boolean flags that are on
+
+  std::optional<std::string> Get(const std::string& name) const;
+  bool Has(const std::string& name) const { return switches.count(name) != 0; }
+  // InvalidArgument when present but not a number (or not finite).
+  absl::StatusOr<std::optional<double>> GetDouble(const std::string& name) const;
+  absl::StatusOr<std::optional<int64_t>> GetInt(const std::string& name) const;
+};
+
+// InvalidArgument on unknown flags, a missing value, a repeated flag or a
+// positional argument.
+absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
+                                     const std::set<std::string>& value_flags,
+                                     const std::set<std::string>& bool_flags);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_CLIENT_ARGS_H_

@@ -1,0 +1,37 @@
+// `covplan load`: drives Plan calls at a fixed concurrency against a server
+// and prints one JSON object: requests, ok, per-code counts, latency
+// percentiles and `late` (replies that arrived after their deadline).
+//
+//   covplan load --server 127.0.0.1:50051 --map maps/sample_office.yaml
+//       --concurrency 4 --duration 10 --deadline-ms 500
+//
+// Thread-safety: not applicable (command entry point).
+#ifndef COVPLAN_CLIENT_LOAD_COMMAND_H_
+#define COVPLAN_CLIENT_LOAD_COMMAND_H_
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace covplan {
+
+int RunLoadCommand(const std::vector<std::string>& args);
+
+// Summary of a load run (exposed for tests).
+struct LoadReport {
+  int64_t requests = 0;
+  int64_t ok = 0;
+  int64_t late = 0;
+  int64_t cut_short = 0;
+  std::map<std::string, int64_t> codes;  // status code name -> count
+  std::vector<double> latencies_ms;      // every reply
+  double duration_s = 0;
+  int concurrency = 0;
+  int64_t deadline_ms = 0;
+
+  std::string ToJson() const;  // percentiles are computed here
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_CLIENT_LOAD_COMMAND_H_

@@ -1,0 +1,54 @@
+// covplan: the command-line client.
+//
+//   covplan plan --map FILE [--resolution M] [--tool-width M] [--local | --server HOST:PORT]
+//                [--out plan.json] [--svg plan.svg] ...
+//   covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S] [--deadline-ms D]
+//   covplan gtsp ...
+//
+// Subcommands parse their own flags (client/args.h); no global flags.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "client/load_command.h"
+#include "client/plan_command.h"
+#ifdef COVPLAN_HAVE_GTSP_COMMAND
+#include "client/gtsp_command.h"
+#endif
+
+namespace {
+
+constexpr char kUsage[] =
+    "usage: covplan <command> [flags]\n"
+    "commands:\n"
+    "  plan   plan a coverage path (--local or through a server); writes plan.json / SVG\n"
+    "  load   load-test a server's Plan method; prints one JSON object\n"
+    "  gtsp   solve a GTSPLIB instance with the tour solver\n"
+    "Run 'covplan <command> --help' for its flags.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fputs(kUsage, stderr);
+    return 2;
+  }
+  const std::string command = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  if (command == "plan") return covplan::RunPlanCommand(args);
+  if (command == "load") return covplan::RunLoadCommand(args);
+  if (command == "gtsp") {
+#ifdef COVPLAN_HAVE_GTSP_COMMAND
+    return covplan::RunGtspCommand(args);
+#else
+    std::fputs("covplan: the gtsp command is not part of this build\n", stderr);
+    return 2;
+#endif
+  }
+  if (command == "--help" || command == "-h" || command == "help") {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  std::fprintf(stderr, "covplan: unknown command '%s'\n%s", command.c_str(), kUsage);
+  return 2;
+}

@@ -1,0 +1,219 @@
+#include "client/plan_command.h"
+
+#include <cstdio>
+#include <fstream>
+#include <optional>
+#include <random>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "client/args.h"
+#include "client/remote.h"
+#include "planner/common/status_macros.h"
+#include "planner/grid/grid.h"
+#include "planner/plan/svg.h"
+
+namespace covplan {
+namespace {
+
+constexpr char kUsage[] =
+    "usage: covplan plan --map FILE [--resolution M] [--tool-width M]\n"
+    "                    [--local | --server HOST:PORT] [--out plan.json] [--svg plan.svg]\n"
+    "                    [--time-limit S] [--seed N] [--partition mincut|lp] [--tour gtsp|greedy]\n"
+    "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
+    "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
+    "                    [--min-free-fraction F] [--deadline-ms D]\n"
+    "FILE is a map_server .yaml (with the image it names) or a bare .pgm/.png (needs\n"
+    "--resolution). Without --local the server defaults to 127.0.0.1:50051.\n";
+
+absl::Status WriteFile(const std::string& path, const std::string& contents) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot open ", path, " for writing"));
+  out << contents;
+  out.close();
+  if (!out) return absl::InternalError(absl::StrCat("cannot write ", path));
+  return absl::OkStatus();
+}
+
+std::string ServerError(const std::string& target, const absl::Status& status) {
+  return absl::StrCat("server ", target, " replied ", absl::StatusCodeToString(status.code()),
+                      ": ", status.message());
+}
+
+struct PlanCommand {
+  std::string map_path;
+  MapFileOverrides overrides;
+  v1::PlanRequest request;
+  bool local = false;
+  std::string server = "127.0.0.1:50051";
+  std::optional<std::string> out;
+  std::optional<std::string> svg;
+  std::optional<int64_t> deadline_ms;
+};
+
+absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
+  ASSIGN_OR_RETURN(
+      ParsedArgs a,
+      ParseArgs(args,
+                {"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
+                 "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
+                 "occupied-thresh", "min-free-fraction", "deadline-ms"},
+                {"local", "negate"}));
+  PlanCommand c;
+  if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
+  c.map_path = *a.Get("map");
+  if (a.Has("local") && a.Get("server")) {
+    return absl::InvalidArgumentError("--local and --server exclude each other");
+  }
+  c.local = a.Has("local");
+  if (a.Get("server")) c.server = *a.Get("server");
+  c.out = a.Get("out");
+  c.svg = a.Get("svg");
+  ASSIGN_OR_RETURN(c.overrides.resolution, a.GetDouble("resolution"));
+  ASSIGN_OR_RETURN(c.overrides.free_thresh, a.GetDouble("free-thresh"));
+  ASSIGN_OR_RETURN(c.overrides.occupied_thresh, a.GetDouble("occupied-thresh"));
+  if (a.Has("negate")) c.overrides.negate = true;
+  ASSIGN_OR_RETURN(c.deadline_ms, a.GetInt("deadline-ms"));
+  if (c.deadline_ms && *c.deadline_ms <= 0) {
+    return absl::InvalidArgumentError("--deadline-ms must be positive");
+  }
+
+  v1::PlanRequest& r = c.request;
+  v1::RobotModel* robot = r.mutable_robot();
+  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
+  robot->set_tool_width_m(tool.value_or(0.8));
+  ASSIGN_OR_RETURN(std::optional<double> speed, a.GetDouble("max-speed"));
+  if (speed) robot->set_max_speed_mps(*speed);
+  ASSIGN_OR_RETURN(std::optional<double> accel, a.GetDouble("acceleration"));
+  if (accel) robot->set_acceleration_mps2(*accel);
+  ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
+  if (turn) robot->set_turn_rate_deg_s(*turn);
+  ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
+  if (limit) r.set_time_limit_s(*limit);
+  ASSIGN_OR_RETURN(std::optional<double> fraction, a.GetDouble("min-free-fraction"));
+  if (fraction) r.set_min_free_fraction(*fraction);
+  ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
+  if (seed) {
+    if (*seed < 0 || *seed > UINT32_MAX) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
+    r.set_seed(static_cast<uint32_t>(*seed));
+  }
+  if (auto p = a.Get("partition")) {
+    if (*p == "mincut") r.set_partition_solver(v1::MINCUT);
+    else if (*p == "lp") r.set_partition_solver(v1::LP);
+    else return absl::InvalidArgumentError(absl::StrCat("--partition must be mincut or lp, got '", *p, "'"));
+  }
+  if (auto t = a.Get("tour")) {
+    if (*t == "gtsp") r.set_tour_solver(v1::GTSP);
+    else if (*t == "greedy") r.set_tour_solver(v1::GREEDY);
+    else return absl::InvalidArgumentError(absl::StrCat("--tour must be gtsp or greedy, got '", *t, "'"));
+  }
+  return c;
+}
+
+absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& map,
+                                         const InputLimits& limits) {
+  if (c.local) {
+    v1::PlanRequest request = c.request;
+    *request.mutable_map() = map;
+    return PlanLocally(request, limits);
+  }
+  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(c.server);
+  v1::PutMapRequest put;
+  *put.mutable_map() = map;
+  put.set_name(c.map_path);
+  absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
+  if (!stored.ok()) return absl::Status(stored.status().code(), ServerError(c.server, stored.status()));
+  v1::PlanRequest request = c.request;
+  request.set_map_id(stored->map_id());
+  std::optional<absl::Duration> timeout;
+  if (c.deadline_ms) timeout = absl::Milliseconds(*c.deadline_ms);
+  absl::StatusOr<v1::PlanResponse> plan = remote->Plan(request, timeout);
+  if (!plan.ok()) return absl::Status(plan.status().code(), ServerError(c.server, plan.status()));
+  return plan;
+}
+
+absl::Status Run(const std::vector<std::string>& args) {
+  absl::StatusOr<PlanCommand> parsed = ParsePlanCommand(args);
+  if (!parsed.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(parsed.status().message(), " (see covplan plan --help)"));
+  }
+  const PlanCommand& c = *parsed;
+  InputLimits limits;
+  ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(c.map_path, c.overrides, limits));
+  if (map.raster().yaml().empty() && !map.raster().has_resolution()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(c.map_path, " is a bare image: --resolution M (metres per pixel) is required"));
+  }
+  ASSIGN_OR_RETURN(v1::PlanResponse response, Execute(c, map, limits));
+  std::fputs(FormatPlanSummary(response).c_str(), stdout);
+  if (c.out) {
+    ASSIGN_OR_RETURN(std::string json, PlanToJson(response));
+    RETURN_IF_ERROR(WriteFile(*c.out, json));
+  }
+  if (c.svg) {
+    // In server mode the map is decoded here too, for the SVG background.
+    ASSIGN_OR_RETURN(OccupancyMap decoded, MapFromProto(map, limits));
+    ASSIGN_OR_RETURN(CoveragePlan plan, PlanFromProto(response));
+    RETURN_IF_ERROR(WriteFile(*c.svg, RenderPlanSvg(plan, &decoded)));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
+                                             const InputLimits& limits) {
+  if (!request.has_map()) return absl::InvalidArgumentError("local planning needs an inline map");
+  ASSIGN_OR_RETURN(OccupancyMap map, MapFromProto(request.map(), limits));
+  ASSIGN_OR_RETURN(PlanOptions options, PlanOptionsFromProto(request));
+  RETURN_IF_ERROR(ValidatePlanForMap(options, map, limits));
+  const DecompositionOptions decomposition_options = DecompositionOptionsFor(options, limits);
+  ASSIGN_OR_RETURN(std::shared_ptr<const Decomposition> decomposition,
+                   BuildDecomposition(map, decomposition_options, options.stop));
+  if (decomposition->grid == nullptr || decomposition->grid->CountFree() == 0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "no grid cell is free at tool width %g m", options.robot.tool_width_m));
+  }
+  ASSIGN_OR_RETURN(CoveragePlan plan, PlanOnDecomposition(*decomposition, options));
+  v1::PlanResponse response;
+  PlanToProto(plan, &response);
+  response.set_plan_id(absl::StrFormat("local-%016x", std::random_device{}() * 0x9e3779b97f4a7c15ull));
+  response.set_map_id(ComputeMapId(request.map()));
+  return response;
+}
+
+std::string FormatPlanSummary(const v1::PlanResponse& r) {
+  const v1::PlanStats& s = r.stats();
+  return absl::StrFormat(
+      "plan       %s (map %s)\n"
+      "grid       %d x %d cells of %.3f m, %d free\n"
+      "ranks      %d (partition %s)\n"
+      "tour       %s, %d turns%s\n"
+      "length     coverage %.1f m, transitions %.1f m\n"
+      "coverage   %.1f %% of the free area\n"
+      "duration   %.1f s estimated (turning %.1f s)\n"
+      "timings    planning %.1f ms: grid %.1f, partition %.1f, transitions %.1f, tour %.1f ms%s\n",
+      r.plan_id(), r.map_id().substr(0, 12), s.grid_rows(), s.grid_cols(),
+      r.grid().cell_size_m(), s.free_cells(), s.num_ranks(), s.partition_solver(),
+      s.tour_solver(), s.num_turns(), s.tour_cut_short() ? " (search cut short by the budget)" : "",
+      s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
+      s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
+      s.partition_ms(), s.transitions_ms(), s.tour_ms(),
+      s.decomposition_cached() ? " (decomposition cached)" : "");
+}
+
+int RunPlanCommand(const std::vector<std::string>& args) {
+  for (const std::string& arg : args) {
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+  }
+  const absl::Status status = Run(args);
+  if (status.ok()) return 0;
+  std::fprintf(stderr, "covplan plan: %s\n", std::string(status.message()).c_str());
+  return 1;
+}
+
+}  // namespace covplan

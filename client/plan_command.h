@@ -1,0 +1,34 @@
+// `covplan plan`: plan a map locally (--local) or through a server, print a
+// summary, write plan.json (the Plan response as canonical protobuf JSON) and
+// optionally an SVG.
+//
+//   covplan plan --map maps/sample_office.yaml --tool-width 0.8 --server 127.0.0.1:50051
+//       --out plan.json --svg plan.svg
+//
+// Thread-safety: not applicable (command entry points).
+#ifndef COVPLAN_CLIENT_PLAN_COMMAND_H_
+#define COVPLAN_CLIENT_PLAN_COMMAND_H_
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "covplan/v1/covplan.pb.h"
+#include "server/convert.h"
+
+namespace covplan {
+
+// Returns the process exit code; errors go to stderr.
+int RunPlanCommand(const std::vector<std::string>& args);
+
+// Plans in-process through the same convert code the server uses, so --local
+// and server mode produce the same JSON (up to plan_id and timings).
+absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
+                                             const InputLimits& limits);
+
+// The human summary printed to stdout.
+std::string FormatPlanSummary(const v1::PlanResponse& response);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_CLIENT_PLAN_COMMAND_H_

@@ -1,0 +1,42 @@
+// A small synchronous client of covplan.v1.CoveragePlanner, the only client
+// unit that includes gRPC headers (each costs seconds to compile).
+// gRPC errors come back as absl::Status with the same code and message.
+//
+//   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect("127.0.0.1:50051");
+//   ASSIGN_OR_RETURN(v1::PutMapResponse put, remote->PutMap(request, absl::Seconds(30)));
+//   ASSIGN_OR_RETURN(v1::PlanResponse plan, remote->Plan(plan_request, absl::Seconds(5)));
+//
+// Thread-safety: all methods may be called concurrently (gRPC stubs are).
+#ifndef COVPLAN_CLIENT_REMOTE_H_
+#define COVPLAN_CLIENT_REMOTE_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "covplan/v1/covplan.pb.h"
+
+namespace covplan {
+
+class RemotePlanner {
+ public:
+  static std::unique_ptr<RemotePlanner> Connect(const std::string& target);
+  ~RemotePlanner();
+
+  absl::StatusOr<v1::PutMapResponse> PutMap(const v1::PutMapRequest& request,
+                                            absl::Duration timeout);
+  // No timeout: the call has no deadline (the server's default budget applies).
+  absl::StatusOr<v1::PlanResponse> Plan(const v1::PlanRequest& request,
+                                        std::optional<absl::Duration> timeout);
+
+ private:
+  struct Impl;
+  explicit RemotePlanner(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_CLIENT_REMOTE_H_

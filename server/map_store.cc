@@ -1,0 +1,222 @@
+#include "server/map_store.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/time/clock.h"
+#include "server/convert.h"
+#include "server/digest.h"
+
+namespace covplan {
+namespace {
+
+constexpr char kMagic[] = "covplan-map 1";
+constexpr char kSuffix[] = ".map";
+
+absl::Status ErrnoError(absl::string_view what, const std::string& path) {
+  return absl::InternalError(absl::StrCat(what, " ", path, ": ", std::strerror(errno)));
+}
+
+absl::Status WriteAll(int fd, absl::string_view data, const std::string& path) {
+  while (!data.empty()) {
+    const ssize_t n = ::write(fd, data.data(), data.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return ErrnoError("cannot write", path);
+    }
+    data.remove_prefix(static_cast<size_t>(n));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status FsyncDir(const std::string& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return ErrnoError("cannot open directory", dir);
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  if (rc != 0) return ErrnoError("cannot fsync directory", dir);
+  return absl::OkStatus();
+}
+
+// Writes `contents` to `path` atomically: temp file, fsync, rename, fsync dir.
+absl::Status AtomicWrite(const std::string& dir, const std::string& path, absl::string_view contents) {
+  static std::atomic<uint64_t> counter{0};
+  const std::string tmp =
+      absl::StrCat(path, ".tmp.", ::getpid(), ".", counter.fetch_add(1, std::memory_order_relaxed));
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return ErrnoError("cannot create", tmp);
+  absl::Status status = WriteAll(fd, contents, tmp);
+  if (status.ok() && ::fsync(fd) != 0) status = ErrnoError("cannot fsync", tmp);
+  if (::close(fd) != 0 && status.ok()) status = ErrnoError("cannot close", tmp);
+  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0) status = ErrnoError("cannot rename", tmp);
+  if (!status.ok()) {
+    ::unlink(tmp.c_str());
+    return status;
+  }
+  return FsyncDir(dir);
+}
+
+bool IsMapFileName(const std::string& name, std::string* map_id) {
+  const size_t suffix = sizeof(kSuffix) - 1;
+  if (name.size() <= suffix || name.compare(name.size() - suffix, suffix, kSuffix) != 0) return false;
+  *map_id = name.substr(0, name.size() - suffix);
+  return ValidateMapId(*map_id).ok();
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return absl::InternalError(absl::StrCat("cannot create store directory ", dir, ": ", ec.message()));
+  std::unique_ptr<MapStore> store(new MapStore(dir));
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp.") != std::string::npos) {  // left over by a crash mid-write
+      std::filesystem::remove(entry.path(), ec);
+      continue;
+    }
+    std::string map_id;
+    if (!IsMapFileName(name, &map_id)) continue;
+    absl::StatusOr<v1::GetMapResponse> stored = store->ReadVerified(entry.path().string());
+    absl::MutexLock lock(&store->mu_);
+    if (stored.ok() && stored->info().map_id() == map_id) {
+      store->index_[map_id] = stored->info();
+    } else {
+      store->corrupted_.insert(map_id);
+    }
+  }
+  if (ec) return absl::InternalError(absl::StrCat("cannot list ", dir, ": ", ec.message()));
+  return store;
+}
+
+std::string MapStore::PathFor(const std::string& map_id) const {
+  return absl::StrCat(dir_, "/", map_id, kSuffix);
+}
+
+absl::StatusOr<v1::GetMapResponse> MapStore::ReadVerified(const std::string& path) const {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat("cannot open ", path));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  const std::string contents = buffer.str();
+  // Three header lines, then the payload.
+  size_t pos = 0;
+  absl::string_view lines[3];
+  for (absl::string_view& line : lines) {
+    const size_t end = contents.find('\n', pos);
+    if (end == std::string::npos) return absl::DataLossError(absl::StrCat(path, ": truncated header"));
+    line = absl::string_view(contents).substr(pos, end - pos);
+    pos = end + 1;
+  }
+  uint64_t size = 0;
+  if (lines[0] != kMagic || lines[1].size() != 64 || !absl::SimpleAtoi(lines[2], &size)) {
+    return absl::DataLossError(absl::StrCat(path, ": bad header"));
+  }
+  const absl::string_view payload = absl::string_view(contents).substr(pos);
+  if (payload.size() != size) {
+    return absl::DataLossError(absl::StrCat(path, ": payload is ", payload.size(),
+                                            " bytes, header says ", size, " (truncated?)"));
+  }
+  if (Sha256Hex(payload) != lines[1]) {
+    return absl::DataLossError(absl::StrCat(path, ": checksum mismatch"));
+  }
+  v1::GetMapResponse stored;
+  if (!stored.ParseFromArray(payload.data(), static_cast<int>(payload.size()))) {
+    return absl::DataLossError(absl::StrCat(path, ": payload does not parse"));
+  }
+  return stored;
+}
+
+void MapStore::MarkCorrupted(const std::string& map_id) const {
+  absl::MutexLock lock(&mu_);
+  corrupted_.insert(map_id);
+  index_.erase(map_id);
+}
+
+absl::StatusOr<bool> MapStore::Put(const v1::MapInfo& info, const v1::Map& map) {
+  const std::string& map_id = info.map_id();
+  if (absl::Status s = ValidateMapId(map_id); !s.ok()) return s;
+  absl::MutexLock write_lock(&write_mu_);
+  {
+    absl::MutexLock lock(&mu_);
+    if (index_.count(map_id) != 0) return false;
+  }
+  v1::GetMapResponse stored;
+  *stored.mutable_info() = info;
+  stored.mutable_info()->set_created_unix_ms(absl::ToUnixMillis(absl::Now()));
+  *stored.mutable_map() = map;
+  stored.mutable_info()->set_size_bytes(static_cast<int32_t>(map.ByteSizeLong()));
+  std::string payload;
+  if (!stored.SerializeToString(&payload)) return absl::InternalError("cannot serialise map");
+  const std::string contents =
+      absl::StrCat(kMagic, "\n", Sha256Hex(payload), "\n", payload.size(), "\n", payload);
+  if (absl::Status s = AtomicWrite(dir_, PathFor(map_id), contents); !s.ok()) return s;
+  absl::MutexLock lock(&mu_);
+  index_[map_id] = stored.info();
+  corrupted_.erase(map_id);
+  return true;
+}
+
+absl::StatusOr<v1::GetMapResponse> MapStore::Get(const std::string& map_id) const {
+  if (absl::Status s = ValidateMapId(map_id); !s.ok()) return s;
+  {
+    absl::MutexLock lock(&mu_);
+    if (corrupted_.count(map_id) != 0) {
+      return absl::DataLossError(absl::StrCat("map ", map_id,
+                                              " is corrupted on disk; PutMap it again"));
+    }
+    if (index_.count(map_id) == 0) {
+      return absl::NotFoundError(absl::StrCat("unknown map_id ", map_id, "; PutMap it first"));
+    }
+  }
+  absl::StatusOr<v1::GetMapResponse> stored = ReadVerified(PathFor(map_id));
+  if (!stored.ok() || stored->info().map_id() != map_id) {
+    MarkCorrupted(map_id);
+    return absl::DataLossError(absl::StrCat(
+        "map ", map_id, " is corrupted on disk (",
+        stored.ok() ? "id mismatch" : stored.status().message(), "); PutMap it again"));
+  }
+  return stored;
+}
+
+std::vector<v1::MapInfo> MapStore::List(std::vector<std::string>* corrupted) const {
+  absl::MutexLock lock(&mu_);
+  std::vector<v1::MapInfo> maps;
+  maps.reserve(index_.size());
+  for (const auto& [id, info] : index_) maps.push_back(info);
+  if (corrupted != nullptr) corrupted->assign(corrupted_.begin(), corrupted_.end());
+  return maps;
+}
+
+absl::StatusOr<bool> MapStore::Delete(const std::string& map_id) {
+  if (absl::Status s = ValidateMapId(map_id); !s.ok()) return s;
+  absl::MutexLock write_lock(&write_mu_);
+  bool known = false;
+  {
+    absl::MutexLock lock(&mu_);
+    known = index_.erase(map_id) > 0;
+    known = corrupted_.erase(map_id) > 0 || known;
+  }
+  if (!known) return false;
+  const std::string path = PathFor(map_id);
+  if (::unlink(path.c_str()) != 0 && errno != ENOENT) return ErrnoError("cannot delete", path);
+  if (absl::Status s = FsyncDir(dir_); !s.ok()) return s;
+  return true;
+}
+
+int64_t MapStore::size() const {
+  absl::MutexLock lock(&mu_);
+  return static_cast<int64_t>(index_.size());
+}
+
+}  // namespace covplan

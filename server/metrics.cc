@@ -1,0 +1,73 @@
+#include "server/metrics.h"
+
+namespace covplan {
+namespace {
+
+prometheus::Histogram::BucketBoundaries LatencyBuckets() {
+  return {0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.15, 0.25, 0.5, 1, 2.5, 5, 10, 30, 60};
+}
+
+prometheus::Gauge* NewGauge(prometheus::Registry& registry, const std::string& name,
+                            const std::string& help) {
+  return &prometheus::BuildGauge().Name(name).Help(help).Register(registry).Add({});
+}
+
+prometheus::Counter* NewCounter(prometheus::Registry& registry, const std::string& name,
+                                const std::string& help) {
+  return &prometheus::BuildCounter().Name(name).Help(help).Register(registry).Add({});
+}
+
+}  // namespace
+
+ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry>()) {
+  prometheus::Registry& r = *registry_;
+  requests_ = &prometheus::BuildCounter()
+                   .Name("covplan_requests_total")
+                   .Help("gRPC requests handled, by method and status code")
+                   .Register(r);
+  request_duration_ = &prometheus::BuildHistogram()
+                           .Name("covplan_request_duration_seconds")
+                           .Help("gRPC request latency from arrival to reply, by method")
+                           .Register(r);
+  solve_duration_ = &prometheus::BuildHistogram()
+                         .Name("covplan_plan_solve_duration_seconds")
+                         .Help("Time a worker spent on one Plan request")
+                         .Register(r)
+                         .Add({}, LatencyBuckets());
+  cut_short_ = NewCounter(r, "covplan_plans_cut_short_total",
+                          "Plans whose tour search was stopped by the deadline or budget");
+  queue_depth_ = NewGauge(r, "covplan_worker_queue_depth", "Requests waiting for a worker");
+  in_flight_ = NewGauge(r, "covplan_solves_in_flight", "Requests being worked on now");
+  worker_threads_ = NewGauge(r, "covplan_worker_threads", "Size of the worker pool");
+  queue_capacity_ = NewGauge(r, "covplan_worker_queue_capacity", "Bound of the worker queue");
+  cache_hits_ = NewCounter(r, "covplan_decomposition_cache_hits_total",
+                           "Decomposition lookups served from the cache or a concurrent build");
+  cache_misses_ = NewCounter(r, "covplan_decomposition_cache_misses_total",
+                             "Decomposition lookups that had to build");
+  cache_evictions_ = NewCounter(r, "covplan_decomposition_cache_evictions_total",
+                                "Decompositions evicted to stay within the byte budget");
+  cache_bytes_ = NewGauge(r, "covplan_decomposition_cache_bytes", "Bytes held by the cache");
+  cache_entries_ = NewGauge(r, "covplan_decomposition_cache_entries", "Entries in the cache");
+  cache_budget_bytes_ = NewGauge(r, "covplan_decomposition_cache_budget_bytes",
+                                 "Memory budget of the cache");
+  maps_stored_ = NewGauge(r, "covplan_maps_stored", "Maps in the registry");
+  plans_retained_ = NewGauge(r, "covplan_plans_retained", "Plans addressable by plan_id");
+}
+
+void ServerMetrics::RecordRequest(const std::string& method, const std::string& code,
+                                  double seconds) {
+  requests_->Add({{"method", method}, {"code", code}}).Increment();
+  request_duration_->Add({{"method", method}}, LatencyBuckets()).Observe(seconds);
+}
+
+void ServerMetrics::RecordSolve(double seconds, bool cut_short) {
+  solve_duration_->Observe(seconds);
+  if (cut_short) cut_short_->Increment();
+}
+
+void ServerMetrics::OnCacheSize(size_t bytes, size_t entries) {
+  cache_bytes_->Set(static_cast<double>(bytes));
+  cache_entries_->Set(static_cast<double>(entries));
+}
+
+}  // namespace covplan

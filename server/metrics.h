@@ -1,0 +1,79 @@
+// The server's Prometheus metrics (prometheus-cpp), conventional names and
+// base units:
+//   covplan_requests_total{method,code}               counter
+//   covplan_request_duration_seconds{method}          histogram
+//   covplan_plan_solve_duration_seconds               histogram
+//   covplan_plans_cut_short_total                     counter
+//   covplan_worker_queue_depth / covplan_solves_in_flight   gauges
+//   covplan_worker_threads / covplan_worker_queue_capacity  gauges
+//   covplan_decomposition_cache_{hits,misses,evictions}_total  counters
+//   covplan_decomposition_cache_{bytes,entries,budget_bytes}   gauges
+//   covplan_maps_stored / covplan_plans_retained       gauges
+//
+//   ServerMetrics metrics;
+//   exposer.RegisterCollectable(metrics.registry());
+//   metrics.RecordRequest("Plan", "OK", 0.042);
+//
+// Thread-safety: all methods are thread-safe (prometheus-cpp metrics are).
+#ifndef COVPLAN_SERVER_METRICS_H_
+#define COVPLAN_SERVER_METRICS_H_
+
+#include <memory>
+#include <string>
+
+#include "prometheus/counter.h"
+#include "prometheus/family.h"
+#include "prometheus/gauge.h"
+#include "prometheus/histogram.h"
+#include "prometheus/registry.h"
+#include "server/decomposition_cache.h"
+
+namespace covplan {
+
+class ServerMetrics : public CacheObserver {
+ public:
+  ServerMetrics();
+
+  std::shared_ptr<prometheus::Registry> registry() const { return registry_; }
+
+  // `code` is the gRPC status code name, e.g. "OK", "INVALID_ARGUMENT".
+  void RecordRequest(const std::string& method, const std::string& code, double seconds);
+  void RecordSolve(double seconds, bool cut_short);
+
+  prometheus::Gauge& queue_depth() { return *queue_depth_; }
+  prometheus::Gauge& in_flight() { return *in_flight_; }
+  prometheus::Gauge& worker_threads() { return *worker_threads_; }
+  prometheus::Gauge& queue_capacity() { return *queue_capacity_; }
+  prometheus::Gauge& cache_budget_bytes() { return *cache_budget_bytes_; }
+  prometheus::Gauge& maps_stored() { return *maps_stored_; }
+  prometheus::Gauge& plans_retained() { return *plans_retained_; }
+
+  // CacheObserver.
+  void OnCacheHit() override { cache_hits_->Increment(); }
+  void OnCacheMiss() override { cache_misses_->Increment(); }
+  void OnCacheEviction() override { cache_evictions_->Increment(); }
+  void OnCacheSize(size_t bytes, size_t entries) override;
+
+ private:
+  std::shared_ptr<prometheus::Registry> registry_;
+  prometheus::Family<prometheus::Counter>* requests_;
+  prometheus::Family<prometheus::Histogram>* request_duration_;
+  prometheus::Histogram* solve_duration_;
+  prometheus::Counter* cut_short_;
+  prometheus::Gauge* queue_depth_;
+  prometheus::Gauge* in_flight_;
+  prometheus::Gauge* worker_threads_;
+  prometheus::Gauge* queue_capacity_;
+  prometheus::Counter* cache_hits_;
+  prometheus::Counter* cache_misses_;
+  prometheus::Counter* cache_evictions_;
+  prometheus::Gauge* cache_bytes_;
+  prometheus::Gauge* cache_entries_;
+  prometheus::Gauge* cache_budget_bytes_;
+  prometheus::Gauge* maps_stored_;
+  prometheus::Gauge* plans_retained_;
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_SERVER_METRICS_H_

@@ -1,0 +1,51 @@
+// Keeps recent Plan responses addressable by plan_id for a limited time
+// (GetPlan now; the later Replan builds on it). Bounded both by age (ttl)
+// and by count, oldest dropped first.
+//
+//   PlanRegistry plans(absl::Minutes(10), /*max_plans=*/1000);
+//   plans.Put(response);                       // keyed by response->plan_id()
+//   std::shared_ptr<const v1::PlanResponse> p = plans.Get(id);  // null once expired
+//
+// Thread-safety: all methods are thread-safe.
+#ifndef COVPLAN_SERVER_PLAN_REGISTRY_H_
+#define COVPLAN_SERVER_PLAN_REGISTRY_H_
+
+#include <deque>
+#include <memory>
+#include <string>
+#include <unordered_map>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "covplan/v1/covplan.pb.h"
+
+namespace covplan {
+
+class PlanRegistry {
+ public:
+  PlanRegistry(absl::Duration ttl, size_t max_plans) : ttl_(ttl), max_plans_(max_plans) {}
+
+  void Put(std::shared_ptr<const v1::PlanResponse> plan, absl::Time now = absl::Now());
+  std::shared_ptr<const v1::PlanResponse> Get(const std::string& plan_id,
+                                              absl::Time now = absl::Now());
+  size_t size() const;
+
+ private:
+  void Expire(absl::Time now) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+
+  struct Entry {
+    std::string plan_id;
+    absl::Time expires;
+  };
+  const absl::Duration ttl_;
+  const size_t max_plans_;
+  mutable absl::Mutex mu_;
+  std::deque<Entry> order_ ABSL_GUARDED_BY(mu_);  // oldest first
+  std::unordered_map<std::string, std::shared_ptr<const v1::PlanResponse>> plans_
+      ABSL_GUARDED_BY(mu_);
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_SERVER_PLAN_REGISTRY_H_

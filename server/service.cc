@@ -1,0 +1,368 @@
+#include "server/service.h"
+
+#include <algorithm>
+#include <random>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "planner/common/status_macros.h"
+#include "planner/grid/grid.h"
+#include "server/log.h"
+
+namespace covplan {
+namespace {
+
+grpc::Status ToGrpc(const absl::Status& status) {
+  if (status.ok()) return grpc::Status::OK;
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+}
+
+std::string CodeName(const absl::Status& status) {
+  return absl::StatusCodeToString(status.code());
+}
+
+absl::Time DeadlineOf(const grpc::CallbackServerContext& context) {
+  const auto deadline = context.deadline();
+  // gRPC reports "no deadline" as a far-future time point.
+  if (deadline >= std::chrono::system_clock::now() + std::chrono::hours(24 * 365)) {
+    return absl::InfiniteFuture();
+  }
+  return absl::FromChrono(deadline);
+}
+
+bool IsStop(const absl::Status& status) {
+  return absl::IsDeadlineExceeded(status) || absl::IsCancelled(status);
+}
+
+// The status for work that stopped early: the client's cancellation wins,
+// otherwise the deadline was too short for even a first plan.
+absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
+                           const CallInfo& call) {
+  if (cancel.cancelled()) return absl::CancelledError("call cancelled by the client");
+  if (absl::IsDeadlineExceeded(status) || call.deadline != absl::InfiniteFuture()) {
+    return absl::DeadlineExceededError(absl::StrFormat(
+        "deadline of %d ms too short for a first plan (%s)",
+        absl::ToInt64Milliseconds(call.deadline - call.start), status.message()));
+  }
+  return status;
+}
+
+// Lets one worker call and the reactor share the cancellation token; the
+// reactor deletes itself when gRPC is done with the call.
+class PlanReactor final : public grpc::ServerUnaryReactor {
+ public:
+  void OnCancel() override { cancel_.Cancel(); }
+  void OnDone() override { delete this; }
+  const StopToken& cancel() const { return cancel_; }
+
+ private:
+  StopToken cancel_;
+};
+
+}  // namespace
+
+absl::Status ServiceOptions::Validate() const {
+  if (absl::Status s = limits.Validate(); !s.ok()) return s;
+  if (worker_threads < 1) return absl::InvalidArgumentError("worker_threads must be >= 1");
+  if (max_queue < 0) return absl::InvalidArgumentError("max_queue must be >= 0");
+  if (!(default_budget_s > 0)) return absl::InvalidArgumentError("default_budget_s must be > 0");
+  if (deadline_margin < absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("deadline_margin must be >= 0");
+  }
+  return absl::OkStatus();
+}
+
+CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, MapStore* store,
+                                               ServerMetrics* metrics)
+    : options_(options),
+      store_(store),
+      metrics_(metrics),
+      cache_(options.cache_budget_bytes, metrics),
+      plans_(options.plan_ttl, options.max_retained_plans),
+      id_salt_(std::random_device{}()),
+      pool_(options.worker_threads, options.max_queue) {
+  metrics_->worker_threads().Set(options.worker_threads);
+  metrics_->queue_capacity().Set(options.max_queue);
+  metrics_->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
+  metrics_->maps_stored().Set(static_cast<double>(store_->size()));
+}
+
+CoveragePlannerService::~CoveragePlannerService() { Shutdown(); }
+
+void CoveragePlannerService::Shutdown() { pool_.Shutdown(); }
+
+CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
+                                           const char* method) {
+  CallInfo call;
+  call.method = method;
+  call.start = absl::Now();
+  call.deadline = DeadlineOf(*context);
+  const auto& metadata = context->client_metadata();
+  if (auto it = metadata.find("x-request-id"); it != metadata.end() && it->second.size() <= 64) {
+    call.request_id.assign(it->second.data(), it->second.size());
+    for (char& c : call.request_id) {
+      if (c <= ' ' || c > '~' || c == '"') c = '_';
+    }
+  }
+  if (call.request_id.empty()) {
+    call.request_id = absl::StrFormat("%08x-%06x", static_cast<uint32_t>(id_salt_),
+                                      next_id_.fetch_add(1, std::memory_order_relaxed));
+  }
+  context->AddInitialMetadata("x-request-id", call.request_id);
+  return call;
+}
+
+void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
+                                        const absl::Status& status, const std::string& detail) {
+  const absl::Time now = absl::Now();
+  const double seconds = absl::ToDoubleSeconds(now - call.start);
+  metrics_->RecordRequest(call.method, CodeName(status), seconds);
+  const bool late = now > call.deadline;
+  LogLine(status.ok() ? "info" : "warn", "request finished",
+          {{"req", call.request_id},
+           {"method", call.method},
+           {"code", CodeName(status)},
+           {"ms", absl::StrFormat("%.1f", seconds * 1e3)},
+           {"late", late ? "true" : "false"},
+           {"detail", status.ok() ? detail : std::string(status.message())}});
+  reactor->Finish(ToGrpc(status));
+}
+
+bool CoveragePlannerService::Submit(std::function<void()> work) {
+  const bool accepted = pool_.TrySubmit(std::move(work));
+  UpdateQueueGauges();
+  return accepted;
+}
+
+void CoveragePlannerService::UpdateQueueGauges() {
+  metrics_->queue_depth().Set(pool_.queued());
+}
+
+std::string CoveragePlannerService::NewPlanId() {
+  return absl::StrFormat("p-%08x-%08x", static_cast<uint32_t>(id_salt_ >> 8),
+                         next_id_.fetch_add(1, std::memory_order_relaxed));
+}
+
+// ---------------------------------------------------------------- maps
+
+absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
+                                               v1::PutMapResponse* response) {
+  ASSIGN_OR_RETURN(OccupancyMap map, MapFromProto(request.map(), options_.limits));
+  const std::string map_id = ComputeMapId(request.map());
+  v1::MapInfo info = MapInfoFor(map, map_id);
+  info.set_name(request.name());
+  ASSIGN_OR_RETURN(bool created, store_->Put(info, request.map()));
+  if (!created) {
+    ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
+    info = stored.info();
+  }
+  response->set_map_id(map_id);
+  response->set_created(created);
+  *response->mutable_info() = info;
+  metrics_->maps_stored().Set(static_cast<double>(store_->size()));
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerContext* context,
+                                                         const v1::PutMapRequest* request,
+                                                         v1::PutMapResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  CallInfo call = StartCall(context, "PutMap");
+  if (draining()) {
+    FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (!Submit([this, reactor, call, request, response] {
+        UpdateQueueGauges();
+        const absl::Status status = RunPutMap(*request, response);
+        FinishCall(reactor, call, status, response->map_id());
+      })) {
+    FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
+  }
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerContext* context,
+                                                         const v1::GetMapRequest* request,
+                                                         v1::GetMapResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  CallInfo call = StartCall(context, "GetMap");
+  if (!Submit([this, reactor, call, request, response] {
+        UpdateQueueGauges();
+        absl::StatusOr<v1::GetMapResponse> stored = store_->Get(request->map_id());
+        if (stored.ok()) {
+          *response->mutable_info() = stored->info();
+          if (request->include_content()) *response->mutable_map() = std::move(*stored->mutable_map());
+        }
+        FinishCall(reactor, call, stored.status(), request->map_id());
+      })) {
+    FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
+  }
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerContext* context,
+                                                           const v1::ListMapsRequest*,
+                                                           v1::ListMapsResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  CallInfo call = StartCall(context, "ListMaps");
+  std::vector<std::string> corrupted;  // in-memory index only: cheap
+  for (v1::MapInfo& info : store_->List(&corrupted)) *response->add_maps() = std::move(info);
+  for (std::string& id : corrupted) response->add_corrupted(std::move(id));
+  FinishCall(reactor, call, absl::OkStatus());
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServerContext* context,
+                                                            const v1::DeleteMapRequest* request,
+                                                            v1::DeleteMapResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  CallInfo call = StartCall(context, "DeleteMap");
+  if (!Submit([this, reactor, call, request, response] {
+        UpdateQueueGauges();
+        absl::StatusOr<bool> deleted = store_->Delete(request->map_id());
+        if (deleted.ok()) {
+          response->set_deleted(*deleted);
+          cache_.EraseWithPrefix(request->map_id() + "/");
+          metrics_->maps_stored().Set(static_cast<double>(store_->size()));
+        }
+        FinishCall(reactor, call, deleted.status(), request->map_id());
+      })) {
+    FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
+  }
+  return reactor;
+}
+
+// ---------------------------------------------------------------- plans
+
+absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
+                                             const StopToken& cancel,
+                                             v1::PlanResponse* response) {
+  const absl::Time start = absl::Now();
+  if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
+  ASSIGN_OR_RETURN(PlanOptions options, PlanOptionsFromProto(request));
+
+  // The budget: the request's time limit (or the server default), and never
+  // past the call's deadline minus the margin kept for sending the reply.
+  double budget_s = request.time_limit_s() > 0 ? request.time_limit_s() : options_.default_budget_s;
+  StopToken stop = cancel;
+  if (call.deadline != absl::InfiniteFuture()) {
+    const absl::Time reply_by = call.deadline - options_.deadline_margin;
+    if (reply_by <= start) {
+      return absl::DeadlineExceededError(absl::StrFormat(
+          "deadline of %d ms leaves no time to plan",
+          absl::ToInt64Milliseconds(call.deadline - call.start)));
+    }
+    stop = cancel.WithEarlierDeadline(reply_by);
+    budget_s = std::min(budget_s, absl::ToDoubleSeconds(reply_by - start));
+  }
+  options.time_limit_s = std::max(budget_s, 1e-3);
+  options.stop = stop;
+
+  std::string map_id;
+  switch (request.map_ref_case()) {
+    case v1::PlanRequest::kMapId:
+      RETURN_IF_ERROR(ValidateMapId(request.map_id()));
+      map_id = request.map_id();
+      break;
+    case v1::PlanRequest::kMap:
+      map_id = ComputeMapId(request.map());
+      break;
+    default:
+      return absl::InvalidArgumentError("PlanRequest needs map_id or an inline map");
+  }
+  const DecompositionOptions decomposition_options = DecompositionOptionsFor(options, options_.limits);
+  RETURN_IF_ERROR(decomposition_options.Validate());
+  const std::string key = absl::StrCat(map_id, "/", decomposition_options.CacheKey());
+
+  bool cached = false;
+  absl::StatusOr<std::shared_ptr<const Decomposition>> decomposition = cache_.GetOrBuild(
+      key, stop,
+      [&](const StopToken& build_stop) -> absl::StatusOr<std::shared_ptr<const Decomposition>> {
+        OccupancyMap map;
+        if (request.has_map()) {
+          ASSIGN_OR_RETURN(map, MapFromProto(request.map(), options_.limits));
+        } else {
+          ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
+          ASSIGN_OR_RETURN(map, MapFromProto(stored.map(), options_.limits));
+        }
+        RETURN_IF_ERROR(ValidatePlanForMap(options, map, options_.limits));
+        ASSIGN_OR_RETURN(std::shared_ptr<const Decomposition> built,
+                         BuildDecomposition(map, decomposition_options, build_stop));
+        if (built == nullptr || built->grid == nullptr || built->grid->CountFree() == 0) {
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "no grid cell is free at tool width %g m: no %g m square is more than %g%% free",
+              options.robot.tool_width_m, options.robot.tool_width_m,
+              100 * options.min_free_fraction));
+        }
+        return built;
+      },
+      &cached);
+  if (!decomposition.ok()) {
+    return IsStop(decomposition.status()) ? StoppedStatus(decomposition.status(), cancel, call)
+                                          : decomposition.status();
+  }
+
+  absl::StatusOr<CoveragePlan> plan = PlanOnDecomposition(**decomposition, options);
+  if (!plan.ok()) {
+    return IsStop(plan.status()) ? StoppedStatus(plan.status(), cancel, call) : plan.status();
+  }
+  plan->stats.decomposition_cached = cached;
+  PlanToProto(*plan, response);
+  response->set_plan_id(NewPlanId());
+  response->set_map_id(map_id);
+  metrics_->RecordSolve(absl::ToDoubleSeconds(absl::Now() - start), plan->stats.tour_cut_short);
+  plans_.Put(std::make_shared<const v1::PlanResponse>(*response));
+  metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerContext* context,
+                                                       const v1::PlanRequest* request,
+                                                       v1::PlanResponse* response) {
+  auto* reactor = new PlanReactor();
+  CallInfo call = StartCall(context, "Plan");
+  if (draining()) {
+    FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (!Submit([this, reactor, call, request, response] {
+        UpdateQueueGauges();
+        metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+        const absl::Status status = RunPlan(call, *request, reactor->cancel(), response);
+        metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
+        std::string detail;
+        if (status.ok()) {
+          detail = absl::StrFormat("plan=%s ranks=%d cut_short=%d cached=%d",
+                                   response->plan_id(), response->stats().num_ranks(),
+                                   response->stats().tour_cut_short(),
+                                   response->stats().decomposition_cached());
+        }
+        FinishCall(reactor, call, status, detail);
+      })) {
+    FinishCall(reactor, call, absl::ResourceExhaustedError(absl::StrFormat(
+                                  "server busy: %d workers and a queue of %d are full; retry later",
+                                  options_.worker_threads, options_.max_queue)));
+  }
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerContext* context,
+                                                          const v1::GetPlanRequest* request,
+                                                          v1::PlanResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  CallInfo call = StartCall(context, "GetPlan");
+  std::shared_ptr<const v1::PlanResponse> plan = plans_.Get(request->plan_id());
+  metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
+  if (plan == nullptr) {
+    FinishCall(reactor, call, absl::NotFoundError(absl::StrCat(
+                                  "unknown or expired plan_id '", request->plan_id(), "'")));
+    return reactor;
+  }
+  *response = *plan;  // a copy of a retained plan: in-memory, no blocking
+  FinishCall(reactor, call, absl::OkStatus(), request->plan_id());
+  return reactor;
+}
+
+}  // namespace covplan

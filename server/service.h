@@ -1,0 +1,120 @@
+// The covplan.v1.CoveragePlanner service on gRPC's callback API.
+//
+// Handlers never block gRPC threads: anything that decodes, touches the disk
+// or plans is queued on a bounded WorkerPool and the reply is sent with
+// Finish() from the worker. A full queue answers RESOURCE_EXHAUSTED at once.
+// A Plan's gRPC deadline (minus ServiceOptions::deadline_margin) is its
+// anytime budget; a cancelled call cancels its StopToken so the work stops.
+//
+//   MapStore store = ...; ServerMetrics metrics;
+//   CoveragePlannerService service(ServiceOptions{}, store.get(), &metrics);
+//   builder.RegisterService(&service);
+//   ...
+//   service.StartDraining();  // new PutMap/Plan calls get UNAVAILABLE
+//   server->Shutdown(deadline);
+//   service.Shutdown();       // finishes queued work, joins the pool
+//
+// Thread-safety: handlers are called concurrently by gRPC; all state is
+// internally synchronised.
+#ifndef COVPLAN_SERVER_SERVICE_H_
+#define COVPLAN_SERVER_SERVICE_H_
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+#include "covplan/v1/covplan.grpc.pb.h"
+#include "server/convert.h"
+#include "server/decomposition_cache.h"
+#include "server/map_store.h"
+#include "server/metrics.h"
+#include "server/plan_registry.h"
+#include "server/worker_pool.h"
+
+namespace covplan {
+
+struct ServiceOptions {
+  InputLimits limits;
+  int worker_threads = 2;
+  int max_queue = 16;                        // waiting requests beyond the workers
+  size_t cache_budget_bytes = 256ull << 20;  // decomposition cache
+  double default_budget_s = 2.0;             // tour search budget without a deadline
+  absl::Duration deadline_margin = absl::Milliseconds(25);  // kept for the reply
+  absl::Duration plan_ttl = absl::Minutes(10);
+  size_t max_retained_plans = 256;
+
+  absl::Status Validate() const;
+};
+
+// What a handler knows about its call, for logs and metrics.
+struct CallInfo {
+  const char* method = "";
+  std::string request_id;
+  absl::Time start;
+  absl::Time deadline = absl::InfiniteFuture();
+};
+
+class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService {
+ public:
+  CoveragePlannerService(const ServiceOptions& options, MapStore* store, ServerMetrics* metrics);
+  ~CoveragePlannerService() override;
+
+  grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
+                                   const v1::PutMapRequest* request,
+                                   v1::PutMapResponse* response) override;
+  grpc::ServerUnaryReactor* GetMap(grpc::CallbackServerContext* context,
+                                   const v1::GetMapRequest* request,
+                                   v1::GetMapResponse* response) override;
+  grpc::ServerUnaryReactor* ListMaps(grpc::CallbackServerContext* context,
+                                     const v1::ListMapsRequest* request,
+                                     v1::ListMapsResponse* response) override;
+  grpc::ServerUnaryReactor* DeleteMap(grpc::CallbackServerContext* context,
+                                      const v1::DeleteMapRequest* request,
+                                      v1::DeleteMapResponse* response) override;
+  grpc::ServerUnaryReactor* Plan(grpc::CallbackServerContext* context,
+                                 const v1::PlanRequest* request,
+                                 v1::PlanResponse* response) override;
+  grpc::ServerUnaryReactor* GetPlan(grpc::CallbackServerContext* context,
+                                    const v1::GetPlanRequest* request,
+                                    v1::PlanResponse* response) override;
+
+  void StartDraining() { draining_.store(true); }
+  bool draining() const { return draining_.load(); }
+  // Runs what is queued (cancelled calls finish quickly) and joins workers.
+  void Shutdown();
+
+  const DecompositionCache& cache() const { return cache_; }
+
+  // Finishes `reactor` with `status`, records metrics and logs one line.
+  void FinishCall(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
+                  const absl::Status& status, const std::string& detail = "");
+  // The Plan work proper (runs on a worker).
+  absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
+                       const StopToken& cancel, v1::PlanResponse* response);
+  // Queues `work` (which must Finish the call) or answers RESOURCE_EXHAUSTED.
+  bool Submit(std::function<void()> work);
+  void UpdateQueueGauges();
+
+ private:
+  CallInfo StartCall(grpc::CallbackServerContext* context, const char* method);
+  absl::Status RunPutMap(const v1::PutMapRequest& request, v1::PutMapResponse* response);
+  std::string NewPlanId();
+
+  const ServiceOptions options_;
+  MapStore* const store_;
+  ServerMetrics* const metrics_;
+  DecompositionCache cache_;
+  PlanRegistry plans_;
+  std::atomic<bool> draining_{false};
+  std::atomic<uint64_t> next_id_{1};
+  std::atomic<int> in_flight_{0};
+  uint64_t id_salt_;
+  WorkerPool pool_;  // last: its threads stop before the rest is destroyed
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_SERVER_SERVICE_H_

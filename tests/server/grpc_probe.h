@@ -1,0 +1,36 @@
+// Test-only probes of a running server without extra generated code: the
+// gRPC health check and reflection's service list via the generic stub
+// (messages hand-encoded; the protos are tiny and stable), and an HTTP GET
+// for /metrics.
+//
+//   absl::StatusOr<int> status = HealthStatus(channel, "");  // 1 = SERVING
+//   absl::StatusOr<std::vector<std::string>> names = ReflectionServices(channel);
+//   absl::StatusOr<std::string> body = HttpGet(9464, "/metrics");
+//
+// Thread-safety: stateless; each call uses its own completion queue/socket.
+#ifndef COVPLAN_TESTS_SERVER_GRPC_PROBE_H_
+#define COVPLAN_TESTS_SERVER_GRPC_PROBE_H_
+
+#include <grpcpp/channel.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+
+namespace covplan::testing {
+
+// grpc.health.v1 ServingStatus: 0 UNKNOWN, 1 SERVING, 2 NOT_SERVING.
+absl::StatusOr<int> HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
+                                 const std::string& service);
+
+absl::StatusOr<std::vector<std::string>> ReflectionServices(
+    const std::shared_ptr<grpc::Channel>& channel);
+
+// GET http://127.0.0.1:port/path; returns the body of a 200 reply.
+absl::StatusOr<std::string> HttpGet(int port, const std::string& path);
+
+}  // namespace covplan::testing
+
+#endif  // COVPLAN_TESTS_SERVER_GRPC_PROBE_H_

@@ -1,0 +1,123 @@
+// The on-disk map registry: persistence across reopen, idempotent puts,
+// checksum verification of damaged files, deletion.
+#include "server/map_store.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "gtest/gtest.h"
+#include "server/convert.h"
+#include "tests/server/test_maps.h"
+
+namespace covplan {
+namespace {
+
+using ::covplan::testing::AsciiToPgm;
+using ::covplan::testing::RasterMap;
+using ::covplan::testing::TwoRooms;
+
+class MapStoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (std::filesystem::temp_directory_path() / "covplan_store_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+    map_ = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);
+    info_.set_map_id(ComputeMapId(map_));
+    info_.set_name("rooms");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+  std::string dir_;
+  v1::Map map_;
+  v1::MapInfo info_;
+};
+
+TEST_F(MapStoreTest, PutIsIdempotentAndSurvivesReopen) {
+  {
+    absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+    ASSERT_TRUE(store.ok()) << store.status();
+    absl::StatusOr<bool> created = (*store)->Put(info_, map_);
+    ASSERT_TRUE(created.ok()) << created.status();
+    EXPECT_TRUE(*created);
+    created = (*store)->Put(info_, map_);
+    ASSERT_TRUE(created.ok());
+    EXPECT_FALSE(*created);
+  }
+  // No temporary files left behind.
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().extension(), ".map");
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+
+  absl::StatusOr<std::unique_ptr<MapStore>> reopened = MapStore::Open(dir_);
+  ASSERT_TRUE(reopened.ok());
+  EXPECT_EQ((*reopened)->size(), 1);
+  absl::StatusOr<v1::GetMapResponse> got = (*reopened)->Get(info_.map_id());
+  ASSERT_TRUE(got.ok()) << got.status();
+  EXPECT_EQ(got->map().raster().image(), map_.raster().image());
+  EXPECT_EQ(got->info().name(), "rooms");
+  EXPECT_GT(got->info().created_unix_ms(), 0);
+}
+
+TEST_F(MapStoreTest, DamagedFileIsDetectedAndNotServed) {
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->Put(info_, map_).ok());
+  const std::string path = dir_ + "/" + info_.map_id() + ".map";
+  {  // Flip one byte in the payload.
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(-10, std::ios::end);
+    f.put('\x55');
+  }
+  absl::StatusOr<v1::GetMapResponse> got = (*store)->Get(info_.map_id());
+  EXPECT_EQ(got.status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_NE(got.status().message().find("corrupted"), std::string::npos);
+
+  absl::StatusOr<std::unique_ptr<MapStore>> reopened = MapStore::Open(dir_);
+  ASSERT_TRUE(reopened.ok());
+  std::vector<std::string> corrupted;
+  EXPECT_TRUE((*reopened)->List(&corrupted).empty());
+  EXPECT_EQ(corrupted, std::vector<std::string>{info_.map_id()});
+  EXPECT_EQ((*reopened)->Get(info_.map_id()).status().code(), absl::StatusCode::kDataLoss);
+
+  // Putting it again repairs it.
+  absl::StatusOr<bool> created = (*reopened)->Put(info_, map_);
+  ASSERT_TRUE(created.ok());
+  EXPECT_TRUE(*created);
+  EXPECT_TRUE((*reopened)->Get(info_.map_id()).ok());
+}
+
+TEST_F(MapStoreTest, TruncatedFileIsDetected) {
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->Put(info_, map_).ok());
+  const std::string path = dir_ + "/" + info_.map_id() + ".map";
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+  absl::StatusOr<std::unique_ptr<MapStore>> reopened = MapStore::Open(dir_);
+  ASSERT_TRUE(reopened.ok());
+  EXPECT_EQ((*reopened)->Get(info_.map_id()).status().code(), absl::StatusCode::kDataLoss);
+}
+
+TEST_F(MapStoreTest, DeleteAndUnknownIds) {
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->Put(info_, map_).ok());
+  EXPECT_EQ((*store)->Get(std::string(64, 'b')).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ((*store)->Get("../x").status().code(), absl::StatusCode::kInvalidArgument);
+  absl::StatusOr<bool> deleted = (*store)->Delete(info_.map_id());
+  ASSERT_TRUE(deleted.ok());
+  EXPECT_TRUE(*deleted);
+  deleted = (*store)->Delete(info_.map_id());
+  ASSERT_TRUE(deleted.ok());
+  EXPECT_FALSE(*deleted);
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/" + info_.map_id() + ".map"));
+}
+
+}  // namespace
+}  // namespace covplan

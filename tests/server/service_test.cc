@@ -1,0 +1,308 @@
+// In-process gRPC tests of the covplan service: PutMap then Plan round trip,
+// idempotent PutMap, the registry RPCs, every bad input answered with
+// INVALID_ARGUMENT and a useful message, health, reflection and /metrics.
+#include <grpcpp/grpcpp.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/covplan_server.h"
+#include "tests/server/grpc_probe.h"
+#include "tests/server/test_maps.h"
+
+namespace covplan {
+namespace {
+
+using ::covplan::testing::AsciiToPgm;
+using ::covplan::testing::PlanRequestFor;
+using ::covplan::testing::RasterMap;
+using ::covplan::testing::TwoRooms;
+using ::testing::Contains;
+using ::testing::HasSubstr;
+
+std::string MakeTempDir() {
+  std::string pattern = (std::filesystem::temp_directory_path() / "covplan_service_XXXXXX").string();
+  const char* dir = mkdtemp(pattern.data());
+  return dir == nullptr ? std::string() : std::string(dir);
+}
+
+class ServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = MakeTempDir();
+    ASSERT_FALSE(dir_.empty());
+    ServerConfig config;
+    config.port = 0;
+    // Stopping the metrics HTTP server takes ~2 s (civetweb's poll loop), so
+    // only the metrics test starts it.
+    config.metrics_port = with_metrics_ ? 0 : -1;
+    config.store_dir = dir_ + "/maps";
+    config.service.worker_threads = 2;
+    config.service.limits.max_image_bytes = 1 << 20;
+    config.service.limits.max_map_pixels = 1'000'000;
+    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = std::move(*server);
+    channel_ = grpc::CreateChannel(absl::StrCat("127.0.0.1:", server_->port()),
+                                   grpc::InsecureChannelCredentials());
+    stub_ = v1::CoveragePlanner::NewStub(channel_);
+  }
+  void TearDown() override {
+    server_.reset();
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+
+  grpc::Status PutMap(const v1::Map& map, v1::PutMapResponse* response) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    v1::PutMapRequest request;
+    *request.mutable_map() = map;
+    request.set_name("two rooms");
+    return stub_->PutMap(&context, request, response);
+  }
+  grpc::Status Plan(const v1::PlanRequest& request, v1::PlanResponse* response) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+    return stub_->Plan(&context, request, response);
+  }
+  std::string PutTwoRooms() {
+    v1::PutMapResponse put;
+    const grpc::Status status = PutMap(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1), &put);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return put.map_id();
+  }
+
+  bool with_metrics_ = false;
+  std::string dir_;
+  std::unique_ptr<CovplanServer> server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::CoveragePlanner::Stub> stub_;
+};
+
+TEST_F(ServiceTest, PutMapThenPlanCoversEveryFreeCell) {
+  const std::string map_id = PutTwoRooms();
+  ASSERT_EQ(map_id.size(), 64u);
+  v1::PlanResponse plan;
+  const grpc::Status status = Plan(PlanRequestFor(map_id, 0.4), &plan);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(plan.map_id(), map_id);
+  EXPECT_FALSE(plan.plan_id().empty());
+  // 0.4 m cells over 0.4 m characters: the grid is the ASCII picture.
+  EXPECT_EQ(plan.grid().rows(), 8);
+  EXPECT_EQ(plan.grid().cols(), 12);
+  EXPECT_EQ(plan.grid().free_cells(0), "000000000000");
+  EXPECT_EQ(plan.grid().free_cells(3), "011110110110");  // "#....#..#..#" is row 3 from the bottom
+  int free_cells = 0;
+  for (const std::string& row : plan.grid().free_cells()) {
+    free_cells += static_cast<int>(std::count(row.begin(), row.end(), '1'));
+  }
+  EXPECT_EQ(plan.stats().free_cells(), free_cells);
+  int cells_in_ranks = 0;
+  for (const v1::Rank& rank : plan.ranks()) {
+    cells_in_ranks += rank.orientation() == v1::HORIZONTAL
+                          ? rank.last_cell().col() - rank.first_cell().col() + 1
+                          : rank.last_cell().row() - rank.first_cell().row() + 1;
+  }
+  EXPECT_EQ(cells_in_ranks, free_cells);
+  EXPECT_EQ(plan.stats().num_ranks(), plan.ranks_size());
+  EXPECT_EQ(plan.rank_order_size(), plan.ranks_size());
+  ASSERT_GT(plan.path_size(), 1);
+  EXPECT_EQ(plan.path(0).kind(), v1::START);
+  EXPECT_GT(plan.stats().coverage_length_m(), 0);
+  EXPECT_FALSE(plan.stats().decomposition_cached());
+
+  // Same request again: the decomposition comes from the cache.
+  v1::PlanResponse again;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &again).ok());
+  EXPECT_TRUE(again.stats().decomposition_cached());
+  EXPECT_EQ(again.ranks_size(), plan.ranks_size());
+  EXPECT_NE(again.plan_id(), plan.plan_id());
+
+  // The plan stays addressable by its id.
+  grpc::ClientContext context;
+  v1::GetPlanRequest get;
+  get.set_plan_id(plan.plan_id());
+  v1::PlanResponse retained;
+  ASSERT_TRUE(stub_->GetPlan(&context, get, &retained).ok());
+  EXPECT_EQ(retained.SerializeAsString(), plan.SerializeAsString());
+}
+
+TEST_F(ServiceTest, InlineMapPlansWithoutPutMap) {
+  v1::PlanRequest request = PlanRequestFor("", 0.4);
+  *request.mutable_map() = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);
+  v1::PlanResponse plan;
+  const grpc::Status status = Plan(request, &plan);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(plan.map_id(), ComputeMapId(request.map()));
+  EXPECT_GT(plan.ranks_size(), 0);
+}
+
+TEST_F(ServiceTest, PutMapIsIdempotentAndRegistryWorks) {
+  const v1::Map map = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);
+  v1::PutMapResponse first, second;
+  ASSERT_TRUE(PutMap(map, &first).ok());
+  ASSERT_TRUE(PutMap(map, &second).ok());
+  EXPECT_EQ(first.map_id(), second.map_id());
+  EXPECT_TRUE(first.created());
+  EXPECT_FALSE(second.created());
+  EXPECT_EQ(second.info().width_px(), 48);
+  EXPECT_EQ(second.info().height_px(), 32);
+  EXPECT_EQ(second.info().name(), "two rooms");
+
+  {
+    grpc::ClientContext context;
+    v1::ListMapsResponse list;
+    ASSERT_TRUE(stub_->ListMaps(&context, v1::ListMapsRequest(), &list).ok());
+    ASSERT_EQ(list.maps_size(), 1);
+    EXPECT_EQ(list.maps(0).map_id(), first.map_id());
+  }
+  {
+    grpc::ClientContext context;
+    v1::GetMapRequest get;
+    get.set_map_id(first.map_id());
+    get.set_include_content(true);
+    v1::GetMapResponse got;
+    ASSERT_TRUE(stub_->GetMap(&context, get, &got).ok());
+    EXPECT_EQ(got.map().raster().image(), map.raster().image());
+  }
+  {
+    grpc::ClientContext context;
+    v1::DeleteMapRequest del;
+    del.set_map_id(first.map_id());
+    v1::DeleteMapResponse deleted;
+    ASSERT_TRUE(stub_->DeleteMap(&context, del, &deleted).ok());
+    EXPECT_TRUE(deleted.deleted());
+  }
+  v1::PlanResponse plan;
+  const grpc::Status status = Plan(PlanRequestFor(first.map_id(), 0.4), &plan);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(status.error_message(), HasSubstr("unknown map_id"));
+}
+
+struct BadInput {
+  std::string name;
+  std::function<void(v1::PlanRequest*)> mutate;
+  std::string message;
+};
+
+TEST_F(ServiceTest, EveryBadInputIsInvalidArgumentWithAMessage) {
+  const std::string pgm = AsciiToPgm(TwoRooms(), 4);
+  const std::vector<BadInput> cases = {
+      {"zero resolution", [&](v1::PlanRequest* r) { *r->mutable_map() = RasterMap(pgm, 0); },
+       "resolution"},
+      {"negative resolution", [&](v1::PlanRequest* r) { *r->mutable_map() = RasterMap(pgm, -1); },
+       "resolution"},
+      {"NaN resolution",
+       [&](v1::PlanRequest* r) { *r->mutable_map() = RasterMap(pgm, std::nan("")); }, "resolution"},
+      {"zero tool width", [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(0); },
+       "tool_width_m"},
+      {"negative tool width", [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(-0.4); },
+       "tool_width_m"},
+      {"NaN tool width",
+       [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(std::nan("")); },
+       "tool_width_m"},
+      {"tool narrower than a pixel",
+       [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(0.05); },
+       "narrower than one map pixel"},
+      {"tool wider than the map",
+       [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(10); }, "wider than the map"},
+      {"no free cell",
+       [](v1::PlanRequest* r) {
+         *r->mutable_map() = RasterMap(AsciiToPgm({"####", "####"}, 4), 0.1);
+       },
+       "no free"},
+      {"image too large",
+       [](v1::PlanRequest* r) {
+         *r->mutable_map() = RasterMap(AsciiToPgm(std::vector<std::string>(80, std::string(80, '.')), 16), 0.01);
+       },
+       "too large"},
+      {"corrupt image",
+       [&](v1::PlanRequest* r) { *r->mutable_map() = RasterMap(pgm.substr(0, 40), 0.1); },
+       "map.raster.image"},
+      {"not an image",
+       [](v1::PlanRequest* r) { *r->mutable_map() = RasterMap("hello world", 0.1); },
+       "neither a PGM"},
+      {"corrupt YAML",
+       [&](v1::PlanRequest* r) {
+         *r->mutable_map() = RasterMap(pgm, 0.1);
+         r->mutable_map()->mutable_raster()->clear_resolution();
+         r->mutable_map()->mutable_raster()->set_yaml("resolution: [0.1\norigin: {");
+       },
+       "map.raster.yaml"},
+      {"malformed map_id", [](v1::PlanRequest* r) { r->set_map_id("not-an-id"); }, "malformed"},
+      {"no map at all", [](v1::PlanRequest* r) { r->clear_map_ref(); }, "map_id or an inline map"},
+  };
+  for (const BadInput& c : cases) {
+    SCOPED_TRACE(c.name);
+    v1::PlanRequest request = PlanRequestFor("", 0.4);
+    *request.mutable_map() = RasterMap(pgm, 0.1);
+    c.mutate(&request);
+    v1::PlanResponse response;
+    const grpc::Status status = Plan(request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+    EXPECT_THAT(status.error_message(), HasSubstr(c.message));
+  }
+  // PutMap validates the map too.
+  v1::PutMapResponse put;
+  const grpc::Status status = PutMap(RasterMap(pgm.substr(0, 30), 0.1), &put);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("map.raster.image"));
+}
+
+TEST_F(ServiceTest, UnknownMapIdIsNotFound) {
+  v1::PlanResponse response;
+  const grpc::Status status = Plan(PlanRequestFor(std::string(64, 'a'), 0.4), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(status.error_message(), HasSubstr("PutMap it first"));
+}
+
+TEST_F(ServiceTest, HealthIsServingAndReflectionListsTheService) {
+  absl::StatusOr<int> health = testing::HealthStatus(channel_, "");
+  ASSERT_TRUE(health.ok()) << health.status();
+  EXPECT_EQ(*health, 1);  // SERVING
+  health = testing::HealthStatus(channel_, "covplan.v1.CoveragePlanner");
+  ASSERT_TRUE(health.ok()) << health.status();
+  EXPECT_EQ(*health, 1);
+  absl::StatusOr<std::vector<std::string>> services = testing::ReflectionServices(channel_);
+  ASSERT_TRUE(services.ok()) << services.status();
+  EXPECT_THAT(*services, Contains("covplan.v1.CoveragePlanner"));
+  EXPECT_THAT(*services, Contains("grpc.health.v1.Health"));
+}
+
+class MetricsServiceTest : public ServiceTest {
+ protected:
+  MetricsServiceTest() { with_metrics_ = true; }
+};
+
+TEST_F(MetricsServiceTest, MetricsEndpointExposesTheFamilies) {
+  const std::string map_id = PutTwoRooms();
+  v1::PlanResponse plan;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &plan).ok());
+  ASSERT_GT(server_->metrics_port(), 0);
+  absl::StatusOr<std::string> body = testing::HttpGet(server_->metrics_port(), "/metrics");
+  ASSERT_TRUE(body.ok()) << body.status();
+  for (const char* family :
+       {"covplan_requests_total{code=\"OK\",method=\"Plan\"} 1",
+        "covplan_request_duration_seconds_bucket{method=\"Plan\"",
+        "covplan_plan_solve_duration_seconds_count 1", "covplan_plans_cut_short_total",
+        "covplan_worker_queue_depth", "covplan_solves_in_flight",
+        "covplan_decomposition_cache_misses_total 1", "covplan_decomposition_cache_hits_total",
+        "covplan_decomposition_cache_evictions_total", "covplan_decomposition_cache_bytes",
+        "covplan_maps_stored 1"}) {
+    EXPECT_THAT(*body, HasSubstr(family));
+  }
+}
+
+TEST_F(ServiceTest, DrainingServiceRefusesNewWork) {
+  server_->service().StartDraining();
+  v1::PutMapResponse put;
+  const grpc::Status status = PutMap(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1), &put);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE);
+}
+
+}  // namespace
+}  // namespace covplan
