@@ -23,6 +23,8 @@ using gtsp_internal::SeedFor;
 using gtsp_internal::TrialOutcome;
 
 constexpr int kUnlimitedTrials = std::numeric_limits<int>::max();
+// Rounds of trials the time is divided into when running until a deadline.
+constexpr int kDeadlineRounds = 3;
 
 struct EffortConfig {
   int trials;              // when neither max_trials nor "until deadline" applies
@@ -184,10 +186,17 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
   }
 
   int total_trials = ConfigFor(options.effort).trials;
+  // kThorough with a deadline (and no trial limit) uses all the time given:
+  // a few long annealing runs paced by the clock instead of iteration counts
+  // (longer anneals beat many short ones on large instances), then more warm
+  // restarts if time remains.
+  const bool until_deadline =
+      options.max_trials == 0 && stop.has_deadline() && options.effort == GtspEffort::kThorough;
   if (options.max_trials > 0) {
     total_trials = options.max_trials;
-  } else if (stop.has_deadline() && options.effort == GtspEffort::kThorough) {
+  } else if (until_deadline) {
     total_trials = kUnlimitedTrials;
+    params.max_iterations = std::numeric_limits<int64_t>::max() / 2;
   }
   if (problem.m <= 1) total_trials = 0;  // the greedy step is exact for one set
 
@@ -200,8 +209,9 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
     if (stop.has_deadline()) {
       // Spread the remaining time over the remaining rounds so that every
       // trial completes its annealing schedule before the deadline.
-      const int rounds_left =
-          total_trials == kUnlimitedTrials ? 1 : (total_trials - started + threads - 1) / threads;
+      const int rounds_done = started / threads;
+      const int rounds_left = until_deadline ? std::max(1, kDeadlineRounds - rounds_done)
+                                             : (total_trials - started + threads - 1) / threads;
       round_params.time_budget_end = absl::Now() + stop.remaining() / rounds_left;
     }
     std::vector<TrialOutcome> outcomes(round);

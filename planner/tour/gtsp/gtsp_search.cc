@@ -19,7 +19,7 @@ double Eps(double cost) { return 1e-9 + 1e-12 * std::abs(cost); }
 }  // namespace
 
 LnsTrial::LnsTrial(const Problem& p, const SearchParams& params, uint64_t seed)
-    : p_(p), params_(params), rng_(seed) {
+    : p_(p), params_(params), rng_(seed), local_(p) {
   drop_.assign(p.m, 0);
   for (int i = 0; i < kNumRemovals; ++i) {
     removal_weight_[i] = 1.0;
@@ -79,6 +79,22 @@ void LnsTrial::Evaluate(const SearchTour& t, int set, double noise, Insertion& o
       }
     }
     return;
+  }
+  if (params_.insertion_neighbors > 0) {
+    // Arcs next to the nearest sets: on geometric instances the best position
+    // is almost always among them, at a fraction of the memory traffic.
+    int found = 0;
+    const std::vector<int>& near = p_.near_sets[set];
+    const int limit = std::min<int>(params_.insertion_neighbors, static_cast<int>(near.size()));
+    for (int q = 0; q < limit; ++q) {
+      const int j = t.pos[near[q]];
+      if (j < 0) continue;
+      ++found;
+      const int v = t.seq[j];
+      EvaluateEdge(t.seq[t.prev(j)], v, set, noise, out);
+      EvaluateEdge(v, t.seq[t.next(j)], set, noise, out);
+    }
+    if (found >= 2 || found == t.size()) return;
   }
   // Memory-bound: every edge reads two rows of the set's cost blocks that are
   // rarely cached, so fetch a few edges ahead.
@@ -224,55 +240,6 @@ void LnsTrial::Remove(SearchTour& t, int heuristic, int k) {
   for (int s : removed_) drop_[s] = 0;
 }
 
-bool LnsTrial::MoveOpt(SearchTour& t, const StopToken& stop) {
-  bool any = false;
-  for (int pass = 0; pass < 50 && t.size() >= 3; ++pass) {
-    bool improved = false;
-    order_.assign(t.seq.begin(), t.seq.end());
-    for (int v0 : order_) {
-      const int s = p_.set_of[v0];
-      const int i = t.pos[s];
-      const int v = t.seq[i];
-      const int a = t.seq[t.prev(i)], b = t.seq[t.next(i)];
-      const double saving = p_.c(a, v) + p_.c(v, b) - p_.c(a, b);
-      Insertion ins;
-      ins.cost = saving - Eps(t.cost);
-      EvaluateEdge(a, b, s, 0.0, ins);
-      for (int nb : p_.near_sets[s]) {
-        const int j = t.pos[nb];
-        if (j < 0) continue;
-        const int pj = t.prev(j), nj = t.next(j);
-        if (pj != i && j != i) EvaluateEdge(t.seq[pj], t.seq[j], s, 0.0, ins);
-        if (nj != i && j != i) EvaluateEdge(t.seq[j], t.seq[nj], s, 0.0, ins);
-      }
-      if (ins.v < 0) continue;
-      t.seq.erase(t.seq.begin() + i);
-      t.pos[s] = -1;
-      t.RebuildPositions(p_, i);
-      t.cost -= saving;
-      t.InsertAfter(p_, t.pos[p_.set_of[ins.after]], ins.v);
-      improved = true;
-    }
-    if (!improved) break;
-    any = true;
-    if (stop.ShouldStop()) break;
-  }
-  if (any) t.RecomputeCost(p_);
-  return any;
-}
-
-bool LnsTrial::LocalOptimize(SearchTour& t, const StopToken& stop) {
-  bool any = false;
-  for (int round = 0; round < 20; ++round) {
-    const bool a = ClusterOptimize(p_, t, cluster_scratch_);
-    const bool b = MoveOpt(t, stop);
-    if (!a && !b) break;
-    any = true;
-    if (!b || stop.ShouldStop()) break;
-  }
-  return any;
-}
-
 void LnsTrial::Construct(SearchTour& t, int mode) {
   t.Reset(p_);
   removed_.resize(p_.m);
@@ -302,7 +269,10 @@ TrialOutcome LnsTrial::Run(const SearchTour* start, const StopToken& stop,
   const int kmax = std::max(1, std::min({p_.m - 1, params_.max_removals_cap,
                                          std::max(5, static_cast<int>(std::lround(
                                                          params_.max_removal_fraction * p_.m)))}));
-  const double log_ratio = std::log(params_.accept_end / params_.accept_start);
+  // A warm start is already good: begin cooler so as not to throw it away.
+  const double accept_start = params_.accept_start * (start != nullptr ? params_.warm_start_factor : 1.0);
+  const double log_ratio = std::log(params_.accept_end / accept_start);
+  int64_t half_way = 0;
   SearchTour cand;
   int64_t last_improvement = 0;
   for (int64_t it = 0;; ++it) {
@@ -312,9 +282,16 @@ TrialOutcome LnsTrial::Run(const SearchTour* start, const StopToken& stop,
     }
     double progress = static_cast<double>(it) / static_cast<double>(params_.max_iterations);
     if (timed) progress = std::max(progress, absl::ToDoubleSeconds(absl::Now() - t0) / budget_s);
-    if (progress >= 1.0 || it - last_improvement > params_.stall_iterations) break;
+    if (progress >= 1.0) break;
+    // Stagnation only counts in the cool half: a hot start rarely beats the
+    // best tour (warm starts begin at it).
+    if (progress < 0.5) {
+      half_way = it;
+    } else if (it - std::max(last_improvement, half_way) > params_.stall_iterations) {
+      break;
+    }
     ++out.iterations;
-    const double accept_frac = params_.accept_start * std::exp(log_ratio * progress);
+    const double accept_frac = accept_start * std::exp(log_ratio * progress);
     const double temperature = accept_frac * current.cost / std::log(2.0);
 
     const int r = Roulette(removal_weight_, kNumRemovals);
@@ -324,11 +301,12 @@ TrialOutcome LnsTrial::Run(const SearchTour* start, const StopToken& stop,
     cand.pos = current.pos;
     cand.cost = current.cost;
     Remove(cand, r, k);
+    touched_.assign(removed_.begin(), removed_.end());
     InsertSets(cand, h % 3, kNoiseLevels[h / 3]);
     cand.RecomputeCost(p_);
     if (cand.cost < out.best.cost * (1.0 + params_.local_window) ||
         rng_.Uniform() < params_.local_probability) {
-      LocalOptimize(cand, stop);
+      local_.Run(cand, &touched_, stop);
     }
 
     double score = 0.0;

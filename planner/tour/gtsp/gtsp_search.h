@@ -22,6 +22,7 @@
 
 #include "absl/time/time.h"
 #include "planner/common/stop_token.h"
+#include "planner/tour/gtsp/gtsp_local.h"
 #include "planner/tour/gtsp/gtsp_problem.h"
 #include "planner/tour/gtsp/rng.h"
 
@@ -29,7 +30,9 @@ namespace covplan::gtsp_internal {
 
 struct SearchParams {
   int64_t max_iterations = 10000;    // per trial
-  int64_t stall_iterations = 5000;   // end the trial after this many without a new trial best
+  // End the trial after this many iterations without a new trial best (only
+  // counted in the second half of the annealing schedule).
+  int64_t stall_iterations = 5000;
   double max_removal_fraction = 0.25;
   int max_removals_cap = 60;
   // Simulated annealing: a tour `accept_start` (relative) worse than the
@@ -37,10 +40,14 @@ struct SearchParams {
   // `accept_end` worse at the end; geometric in between.
   double accept_start = 0.03;
   double accept_end = 0.0003;
+  double warm_start_factor = 0.3;  // accept_start multiplier for warm starts
   // Candidates within this relative distance of the trial best are always
   // locally optimised; others with probability `local_probability`.
   double local_window = 0.02;
   double local_probability = 0.1;
+  // Insertion positions tried for a set: the arcs around its this-many
+  // nearest sets in the tour (0 = every arc of the tour, as in GLNS).
+  int insertion_neighbors = 12;
   // If finite, the annealing schedule also advances with wall-clock time so
   // that the trial cools down by this time (used only with a deadline).
   absl::Time time_budget_end = absl::InfiniteFuture();
@@ -72,9 +79,8 @@ class LnsTrial {
   // InsertSets. Exposed for the driver's greedy start.
   void Construct(SearchTour& t, int mode);
 
-  // Local re-optimisation: exact vertex re-selection and or-opt moves until no
-  // improvement (or stop). Returns true if the tour improved.
-  bool LocalOptimize(SearchTour& t, const StopToken& stop);
+  // Full local re-optimisation (see LocalSearch). True if improved.
+  bool LocalOptimize(SearchTour& t, const StopToken& stop) { return local_.Run(t, nullptr, stop); }
 
  private:
   enum InsertMode { kNearest = 0, kFarthest = 1, kRandomOrder = 2 };
@@ -85,15 +91,15 @@ class LnsTrial {
   void InsertSets(SearchTour& t, int mode, double noise);
   void Evaluate(const SearchTour& t, int set, double noise, Insertion& out);
   void EvaluateEdge(int a, int b, int set, double noise, Insertion& io);
-  bool MoveOpt(SearchTour& t, const StopToken& stop);
   int Roulette(const double* weights, int count);
 
   const Problem& p_;
   SearchParams params_;
   Rng rng_;
-  ClusterOptScratch cluster_scratch_;
+  LocalSearch local_;
   // Scratch buffers reused by every iteration.
   std::vector<int> removed_;
+  std::vector<int> touched_;  // sets re-inserted by the current iteration
   std::vector<char> drop_;
   std::vector<Insertion> cache_;
   std::vector<int> idx_;
