@@ -92,7 +92,6 @@ TEST(GtspDeadlineTest, CancellationFromAnotherThread) {
   ASSERT_TRUE(r.ok()) << r.status();
   EXPECT_LT(wall, 0.040 + 0.100);
   EXPECT_TRUE(r->stopped_early);
-  EXPECT_GT(r->iterations, 0);
   EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
 }
 

@@ -37,7 +37,7 @@ struct EffortConfig {
 EffortConfig ConfigFor(GtspEffort effort) {
   switch (effort) {
     case GtspEffort::kFast:
-      return {2, 1, 25, 12, 2000};
+      return {2, 1, 12, 10, 3000};
     case GtspEffort::kDefault:
       return {5, 2, 60, 30, 5000};
     case GtspEffort::kThorough:
