@@ -6,6 +6,7 @@
 #include <grpcpp/server.h>
 #include <grpcpp/server_builder.h>
 
+#include <algorithm>
 #include <exception>
 
 #include "absl/strings/str_cat.h"
@@ -17,6 +18,7 @@ namespace covplan {
 absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const ServerConfig& config) {
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
   std::unique_ptr<CovplanServer> server(new CovplanServer());
+  server->drain_notice_ = config.drain_notice;
   absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(config.store_dir);
   if (!store.ok()) return store.status();
   server->store_ = std::move(*store);
@@ -80,9 +82,12 @@ void CovplanServer::Drain(absl::Duration grace) {
     server_->GetHealthCheckService()->SetServingStatus(false);
     service_->StartDraining();
     LogLine("info", "draining", {{"grace_ms", absl::StrCat(absl::ToInt64Milliseconds(grace))}});
+    const absl::Time give_up = absl::Now() + grace;
+    absl::SleepFor(std::min(drain_notice_, grace));
     // Waits for in-flight calls until the deadline, then cancels the rest;
     // their StopTokens fire and the workers finish them quickly.
-    server_->Shutdown(absl::ToChronoTime(absl::Now() + grace));
+    server_->Shutdown(absl::ToChronoTime(give_up));
+    LogLine("info", "gRPC server shut down");
   }
   if (service_ != nullptr) service_->Shutdown();
   if (server_ != nullptr) server_->Wait();

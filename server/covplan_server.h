@@ -37,6 +37,9 @@ struct ServerConfig {
   int metrics_port = 9464;           // 0: pick a free port; -1: no metrics endpoint
   std::string store_dir = "./covplan-data/maps";
   int max_message_bytes = 80 << 20;  // largest request accepted
+  // On Drain, how long health reports NOT_SERVING (and new work is refused)
+  // before the listener closes, so load balancers see it.
+  absl::Duration drain_notice = absl::ZeroDuration();
   ServiceOptions service;
 };
 
@@ -50,8 +53,9 @@ class CovplanServer {
   int metrics_port() const { return metrics_port_; }
   CoveragePlannerService& service() { return *service_; }
 
-  // Reports NOT_SERVING, refuses new work, lets in-flight calls finish for
-  // up to `grace` (then cancels them), and stops.
+  // Reports NOT_SERVING and refuses new work (for the configured drain
+  // notice), lets in-flight calls finish for up to `grace` in all (then
+  // cancels them), and stops.
   void Drain(absl::Duration grace);
 
  private:
@@ -62,6 +66,7 @@ class CovplanServer {
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<prometheus::Exposer> exposer_;
+  absl::Duration drain_notice_;
   int port_ = 0;
   int metrics_port_ = -1;
   absl::Mutex drain_mu_;

@@ -33,6 +33,8 @@ ABSL_FLAG(int64_t, max_image_mb, 64, "Largest accepted map image, MiB");
 ABSL_FLAG(int64_t, max_map_pixels, 64'000'000, "Largest accepted map, pixels");
 ABSL_FLAG(int64_t, max_grid_cells, 4'000'000, "Largest accepted tool-width grid, cells");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");
+ABSL_FLAG(double, drain_notice_s, 1.0,
+          "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage("covplan-server: coverage path planning gRPC service");
@@ -51,6 +53,7 @@ int main(int argc, char** argv) {
   config.metrics_address = absl::GetFlag(FLAGS_metrics_address);
   config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   config.store_dir = absl::GetFlag(FLAGS_store_dir);
+  config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
   covplan::ServiceOptions& service = config.service;
   service.worker_threads = absl::GetFlag(FLAGS_threads);
   service.max_queue = absl::GetFlag(FLAGS_max_queue);

@@ -18,9 +18,7 @@ grpc::Status ToGrpc(const absl::Status& status) {
   return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
 }
 
-std::string CodeName(const absl::Status& status) {
-  return absl::StatusCodeToString(status.code());
-}
+std::string CodeName(const absl::Status& status) { return absl::StatusCodeToString(status.code()); }
 
 absl::Time DeadlineOf(const grpc::CallbackServerContext& context) {
   const auto deadline = context.deadline();
@@ -41,9 +39,9 @@ absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
                            const CallInfo& call) {
   if (cancel.cancelled()) return absl::CancelledError("call cancelled by the client");
   if (absl::IsDeadlineExceeded(status) || call.deadline != absl::InfiniteFuture()) {
-    return absl::DeadlineExceededError(absl::StrFormat(
-        "deadline of %d ms too short for a first plan (%s)",
-        absl::ToInt64Milliseconds(call.deadline - call.start), status.message()));
+    return absl::DeadlineExceededError(
+        absl::StrFormat("deadline of %d ms too short for a first plan (%s)",
+                        absl::ToInt64Milliseconds(call.deadline - call.start), status.message()));
   }
   return status;
 }
@@ -81,7 +79,10 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       cache_(options.cache_budget_bytes, metrics),
       plans_(options.plan_ttl, options.max_retained_plans),
       id_salt_(std::random_device{}()),
-      pool_(options.worker_threads, options.max_queue) {
+      io_pool_(/*threads=*/2, /*max_queue=*/64),
+      // Admission is bounded by TryAdmitSolve; the pool's own bound is slack
+      // for solves that have released their slot but not yet returned.
+      pool_(options.worker_threads, 2 * (options.worker_threads + options.max_queue)) {
   metrics_->worker_threads().Set(options.worker_threads);
   metrics_->queue_capacity().Set(options.max_queue);
   metrics_->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
@@ -90,7 +91,10 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
 
 CoveragePlannerService::~CoveragePlannerService() { Shutdown(); }
 
-void CoveragePlannerService::Shutdown() { pool_.Shutdown(); }
+void CoveragePlannerService::Shutdown() {
+  pool_.Shutdown();
+  io_pool_.Shutdown();
+}
 
 CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
                                            const char* method) {
@@ -129,15 +133,22 @@ void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const
   reactor->Finish(ToGrpc(status));
 }
 
-bool CoveragePlannerService::Submit(std::function<void()> work) {
-  const bool accepted = pool_.TrySubmit(std::move(work));
-  UpdateQueueGauges();
-  return accepted;
+bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
+  return io_pool_.TrySubmit(std::move(work));
 }
 
-void CoveragePlannerService::UpdateQueueGauges() {
-  metrics_->queue_depth().Set(pool_.queued());
+bool CoveragePlannerService::TryAdmitSolve() {
+  const int capacity = options_.worker_threads + options_.max_queue;
+  int admitted = admitted_.load();
+  while (admitted < capacity) {
+    if (admitted_.compare_exchange_weak(admitted, admitted + 1)) return true;
+  }
+  return false;
 }
+
+void CoveragePlannerService::ReleaseSolve() { admitted_.fetch_sub(1); }
+
+void CoveragePlannerService::UpdateQueueGauges() { metrics_->queue_depth().Set(pool_.queued()); }
 
 std::string CoveragePlannerService::NewPlanId() {
   return absl::StrFormat("p-%08x-%08x", static_cast<uint32_t>(id_salt_ >> 8),
@@ -173,8 +184,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerCon
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
   }
-  if (!Submit([this, reactor, call, request, response] {
-        UpdateQueueGauges();
+  if (!SubmitIo([this, reactor, call, request, response] {
         const absl::Status status = RunPutMap(*request, response);
         FinishCall(reactor, call, status, response->map_id());
       })) {
@@ -188,12 +198,12 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerCon
                                                          v1::GetMapResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "GetMap");
-  if (!Submit([this, reactor, call, request, response] {
-        UpdateQueueGauges();
+  if (!SubmitIo([this, reactor, call, request, response] {
         absl::StatusOr<v1::GetMapResponse> stored = store_->Get(request->map_id());
         if (stored.ok()) {
           *response->mutable_info() = stored->info();
-          if (request->include_content()) *response->mutable_map() = std::move(*stored->mutable_map());
+          if (request->include_content())
+            *response->mutable_map() = std::move(*stored->mutable_map());
         }
         FinishCall(reactor, call, stored.status(), request->map_id());
       })) {
@@ -219,8 +229,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
                                                             v1::DeleteMapResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "DeleteMap");
-  if (!Submit([this, reactor, call, request, response] {
-        UpdateQueueGauges();
+  if (!SubmitIo([this, reactor, call, request, response] {
         absl::StatusOr<bool> deleted = store_->Delete(request->map_id());
         if (deleted.ok()) {
           response->set_deleted(*deleted);
@@ -237,8 +246,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
 // ---------------------------------------------------------------- plans
 
 absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
-                                             const StopToken& cancel,
-                                             v1::PlanResponse* response) {
+                                             const StopToken& cancel, v1::PlanResponse* response) {
   const absl::Time start = absl::Now();
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
   ASSIGN_OR_RETURN(PlanOptions options, PlanOptionsFromProto(request));
@@ -250,9 +258,9 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   if (call.deadline != absl::InfiniteFuture()) {
     const absl::Time reply_by = call.deadline - options_.deadline_margin;
     if (reply_by <= start) {
-      return absl::DeadlineExceededError(absl::StrFormat(
-          "deadline of %d ms leaves no time to plan",
-          absl::ToInt64Milliseconds(call.deadline - call.start)));
+      return absl::DeadlineExceededError(
+          absl::StrFormat("deadline of %d ms leaves no time to plan",
+                          absl::ToInt64Milliseconds(call.deadline - call.start)));
     }
     stop = cancel.WithEarlierDeadline(reply_by);
     budget_s = std::min(budget_s, absl::ToDoubleSeconds(reply_by - start));
@@ -272,7 +280,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     default:
       return absl::InvalidArgumentError("PlanRequest needs map_id or an inline map");
   }
-  const DecompositionOptions decomposition_options = DecompositionOptionsFor(options, options_.limits);
+  const DecompositionOptions decomposition_options =
+      DecompositionOptionsFor(options, options_.limits);
   RETURN_IF_ERROR(decomposition_options.Validate());
   const std::string key = absl::StrCat(map_id, "/", decomposition_options.CacheKey());
 
@@ -327,23 +336,34 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
   }
-  if (!Submit([this, reactor, call, request, response] {
-        UpdateQueueGauges();
-        metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
-        const absl::Status status = RunPlan(call, *request, reactor->cancel(), response);
-        metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
-        std::string detail;
-        if (status.ok()) {
-          detail = absl::StrFormat("plan=%s ranks=%d cut_short=%d cached=%d",
-                                   response->plan_id(), response->stats().num_ranks(),
-                                   response->stats().tour_cut_short(),
-                                   response->stats().decomposition_cached());
-        }
-        FinishCall(reactor, call, status, detail);
-      })) {
-    FinishCall(reactor, call, absl::ResourceExhaustedError(absl::StrFormat(
-                                  "server busy: %d workers and a queue of %d are full; retry later",
-                                  options_.worker_threads, options_.max_queue)));
+  const auto reject = [&] {
+    FinishCall(reactor, call,
+               absl::ResourceExhaustedError(absl::StrFormat(
+                   "server busy: %d workers and a queue of %d are full; retry later",
+                   options_.worker_threads, options_.max_queue)));
+  };
+  if (!TryAdmitSolve()) {
+    reject();
+    return reactor;
+  }
+  const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
+    UpdateQueueGauges();
+    metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    const absl::Status status = RunPlan(call, *request, reactor->cancel(), response);
+    metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
+    ReleaseSolve();
+    std::string detail;
+    if (status.ok()) {
+      detail = absl::StrFormat("plan=%s ranks=%d cut_short=%d cached=%d", response->plan_id(),
+                               response->stats().num_ranks(), response->stats().tour_cut_short(),
+                               response->stats().decomposition_cached());
+    }
+    FinishCall(reactor, call, status, detail);
+  });
+  UpdateQueueGauges();
+  if (!queued) {
+    ReleaseSolve();
+    reject();
   }
   return reactor;
 }
@@ -356,8 +376,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
   std::shared_ptr<const v1::PlanResponse> plan = plans_.Get(request->plan_id());
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   if (plan == nullptr) {
-    FinishCall(reactor, call, absl::NotFoundError(absl::StrCat(
-                                  "unknown or expired plan_id '", request->plan_id(), "'")));
+    FinishCall(
+        reactor, call,
+        absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", request->plan_id(), "'")));
     return reactor;
   }
   *response = *plan;  // a copy of a retained plan: in-memory, no blocking

@@ -1,8 +1,9 @@
 // The covplan.v1.CoveragePlanner service on gRPC's callback API.
 //
-// Handlers never block gRPC threads: anything that decodes, touches the disk
-// or plans is queued on a bounded WorkerPool and the reply is sent with
-// Finish() from the worker. A full queue answers RESOURCE_EXHAUSTED at once.
+// Handlers never block gRPC threads: solves run on a bounded WorkerPool,
+// map-registry work (decoding, disk) on a small separate one, and the reply
+// is sent with Finish() from the worker. Beyond worker_threads + max_queue
+// admitted solves, Plan answers RESOURCE_EXHAUSTED at once.
 // A Plan's gRPC deadline (minus ServiceOptions::deadline_margin) is its
 // anytime budget; a cancelled call cancels its StopToken so the work stops.
 //
@@ -94,12 +95,18 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // The Plan work proper (runs on a worker).
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                        const StopToken& cancel, v1::PlanResponse* response);
-  // Queues `work` (which must Finish the call) or answers RESOURCE_EXHAUSTED.
-  bool Submit(std::function<void()> work);
   void UpdateQueueGauges();
 
  private:
   CallInfo StartCall(grpc::CallbackServerContext* context, const char* method);
+  // Runs map-registry work (decode, disk) on the I/O pool; false if full.
+  bool SubmitIo(std::function<void()> work);
+  // Admission control for solves: at most worker_threads + max_queue
+  // admitted at once. A solve releases its slot just before it replies, so a
+  // client that sends its next request on receiving a reply finds the slot
+  // free.
+  bool TryAdmitSolve();
+  void ReleaseSolve();
   absl::Status RunPutMap(const v1::PutMapRequest& request, v1::PutMapResponse* response);
   std::string NewPlanId();
 
@@ -111,8 +118,11 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   std::atomic<bool> draining_{false};
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};
+  std::atomic<int> admitted_{0};
   uint64_t id_salt_;
-  WorkerPool pool_;  // last: its threads stop before the rest is destroyed
+  // Last: their threads stop before the rest is destroyed.
+  WorkerPool io_pool_;  // PutMap / GetMap / DeleteMap
+  WorkerPool pool_;     // Plan solves
 };
 
 }  // namespace covplan

@@ -1,5 +1,7 @@
 #include "tests/server/test_maps.h"
 
+#include <random>
+
 #include "absl/strings/str_cat.h"
 
 namespace covplan::testing {
@@ -38,6 +40,23 @@ const std::vector<std::string>& TwoRooms() {
       "############",
   };
   return rows;
+}
+
+std::vector<std::string> PillarField(int cols, int rows, int pillars, unsigned seed) {
+  std::vector<std::string> field(rows, std::string(cols, '.'));
+  for (int c = 0; c < cols; ++c) field[0][c] = field[rows - 1][c] = '#';
+  for (int r = 0; r < rows; ++r) field[r][0] = field[r][cols - 1] = '#';
+  std::mt19937 random(seed);
+  for (int i = 0; i < pillars; ++i) {
+    const int r = 2 + static_cast<int>(random() % (rows - 5));
+    const int c = 2 + static_cast<int>(random() % (cols - 5));
+    const int h = 1 + static_cast<int>(random() % 2);
+    const int w = 1 + static_cast<int>(random() % 2);
+    for (int dr = 0; dr < h; ++dr) {
+      for (int dc = 0; dc < w; ++dc) field[r + dr][c + dc] = '#';
+    }
+  }
+  return field;
 }
 
 v1::PlanRequest PlanRequestFor(const std::string& map_id, double tool_width_m) {

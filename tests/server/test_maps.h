@@ -25,6 +25,10 @@ v1::Map RasterMap(const std::string& image, double resolution);
 // Two rooms joined by a door, with a pillar: 12 x 8 characters.
 const std::vector<std::string>& TwoRooms();
 
+// A walled field of `cols` x `rows` characters with `pillars` random 1-2
+// character obstacles (seeded): hundreds of ranks, a long tour search.
+std::vector<std::string> PillarField(int cols, int rows, int pillars, unsigned seed);
+
 // A PlanRequest for `map_id` with the given tool width.
 v1::PlanRequest PlanRequestFor(const std::string& map_id, double tool_width_m);
 

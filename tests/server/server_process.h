@@ -1,0 +1,57 @@
+// Test-only: runs a real covplan-server process on loopback with a chosen
+// store directory, learns its ports from its start-up log line, and stops it
+// with SIGTERM (SIGKILL if it does not exit in time).
+//
+//   ServerProcess server;
+//   ASSERT_TRUE(server.Start(store_dir, {"--threads=1"}).ok());
+//   auto channel = grpc::CreateChannel(server.target(), grpc::InsecureChannelCredentials());
+//   ASSERT_EQ(server.Stop(), 0);  // exit status
+//
+// Thread-safety: not thread-safe; one test thread owns it.
+#ifndef COVPLAN_TESTS_SERVER_SERVER_PROCESS_H_
+#define COVPLAN_TESTS_SERVER_SERVER_PROCESS_H_
+
+#include <sys/types.h>
+
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/time/time.h"
+
+namespace covplan::testing {
+
+class ServerProcess {
+ public:
+  ServerProcess() = default;
+  ~ServerProcess();  // SIGKILL if still running
+  ServerProcess(const ServerProcess&) = delete;
+  ServerProcess& operator=(const ServerProcess&) = delete;
+
+  // Starts `binary` (default: the covplan-server built with the tests).
+  absl::Status Start(const std::string& store_dir, const std::vector<std::string>& extra_args,
+                     const std::string& binary = "");
+  // SIGTERM, then waits up to `timeout`; returns the exit status, or -1 if
+  // it had to be killed.
+  int Stop(absl::Duration timeout = absl::Seconds(20));
+  // Sends SIGTERM without waiting.
+  void Terminate();
+  // Waits for exit; -1 on timeout.
+  int Wait(absl::Duration timeout);
+
+  int port() const { return port_; }
+  int metrics_port() const { return metrics_port_; }
+  std::string target() const;
+  std::string log() const;  // everything the server wrote to stderr
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+  int metrics_port_ = 0;
+  std::string log_path_;
+};
+
+}  // namespace covplan::testing
+
+#endif  // COVPLAN_TESTS_SERVER_SERVER_PROCESS_H_
