@@ -4,8 +4,9 @@
 // segment or distance removal), re-inserts one vertex per removed set (the
 // best vertex at the best position; cheapest-, farthest- or random-order
 // insertion, optionally with noise), locally re-optimises promising tours
-// (exact vertex re-selection for the set order, plus a neighbour-list or-opt
-// that may also change the vertex) and accepts by a simulated-annealing rule.
+// around the re-inserted sets (LocalSearch: relocate with vertex re-pick,
+// asymmetric 2-opt, exact vertex re-selection for the set order) and accepts
+// by a simulated-annealing rule.
 // Heuristics are drawn with adaptive weights rewarded by success.
 //
 //   LnsTrial trial(problem, params, SeedFor(seed, index));
@@ -71,7 +72,7 @@ class LnsTrial {
   LnsTrial(const Problem& p, const SearchParams& params, uint64_t seed);
 
   // Runs one trial from `start` (nullptr: a random-insertion tour).
-  // `on_best(cost)` is called whenever the trial best improves.
+  // `on_best(tour)` is called whenever the trial best improves.
   TrialOutcome Run(const SearchTour* start, const StopToken& stop,
                    const std::function<void(const SearchTour&)>& on_best);
 
