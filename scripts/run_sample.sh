@@ -11,7 +11,7 @@ shift || true
 OUT_DIR=${OUT_DIR:-.}
 
 bash scripts/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCOVPLAN_BUILD_SERVER=ON >/dev/null
 cmake --build build -j"$(nproc)" --target covplan-server covplan
 
 free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
