@@ -90,9 +90,11 @@ void CovplanServer::Drain(absl::Duration grace) {
     LogLine("info", "gRPC server shut down");
   }
   if (service_ != nullptr) service_->Shutdown();
-  if (server_ != nullptr) server_->Wait();
   exposer_.reset();
-  LogLine("info", "covplan-server stopped");
+  if (server_ != nullptr) {
+    server_->Wait();
+    LogLine("info", "covplan-server stopped");
+  }
 }
 
 CovplanServer::~CovplanServer() {

@@ -26,7 +26,12 @@ inline void LogLine(absl::string_view level, absl::string_view message,
       " level=", level, " msg=\"", message, "\"");
   for (const auto& [key, value] : fields) {
     const bool quote = value.empty() || value.find_first_of(" \"=") != std::string::npos;
-    absl::StrAppend(&line, " ", key, "=", quote ? "\"" : "", value, quote ? "\"" : "");
+    std::string text = value;
+    for (char& c : text) {
+      if (c == '"') c = '\'';  // keep the quoted value parseable
+      if (c == '\n') c = ' ';
+    }
+    absl::StrAppend(&line, " ", key, "=", quote ? "\"" : "", text, quote ? "\"" : "");
   }
   line += '\n';
   std::fwrite(line.data(), 1, line.size(), stderr);
