@@ -1,5 +1,7 @@
 #include "client/args.h"
 
+#include <cstdio>
+
 #include <cmath>
 
 #include "absl/strings/numbers.h"
@@ -74,6 +76,20 @@ absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
     }
   }
   return parsed;
+}
+
+int RunSubcommand(const char* name, const char* usage, const std::vector<std::string>& args,
+                  absl::Status (*run)(const std::vector<std::string>&)) {
+  for (const std::string& arg : args) {
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(usage, stdout);
+      return 0;
+    }
+  }
+  const absl::Status status = run(args);
+  if (status.ok()) return 0;
+  std::fprintf(stderr, "covplan %s: %s\n", name, std::string(status.message()).c_str());
+  return 1;
 }
 
 }  // namespace covplan

@@ -37,6 +37,12 @@ absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
                                      const std::set<std::string>& value_flags,
                                      const std::set<std::string>& bool_flags);
 
+// Shared main of a subcommand: prints `usage` for --help/-h, else runs
+// `run(args)` and maps its status to an exit code (errors on stderr, prefixed
+// with "covplan <name>: ").
+int RunSubcommand(const char* name, const char* usage, const std::vector<std::string>& args,
+                  absl::Status (*run)(const std::vector<std::string>&));
+
 }  // namespace covplan
 
 #endif  // COVPLAN_CLIENT_ARGS_H_

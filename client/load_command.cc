@@ -127,16 +127,7 @@ std::string LoadReport::ToJson() const {
 }
 
 int RunLoadCommand(const std::vector<std::string>& args) {
-  for (const std::string& arg : args) {
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  }
-  const absl::Status status = Run(args);
-  if (status.ok()) return 0;
-  std::fprintf(stderr, "covplan load: %s\n", std::string(status.message()).c_str());
-  return 1;
+  return RunSubcommand("load", kUsage, args, &Run);
 }
 
 }  // namespace covplan

@@ -204,16 +204,7 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
 }
 
 int RunPlanCommand(const std::vector<std::string>& args) {
-  for (const std::string& arg : args) {
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  }
-  const absl::Status status = Run(args);
-  if (status.ok()) return 0;
-  std::fprintf(stderr, "covplan plan: %s\n", std::string(status.message()).c_str());
-  return 1;
+  return RunSubcommand("plan", kUsage, args, &Run);
 }
 
 }  // namespace covplan
