@@ -31,6 +31,7 @@ struct Args {
   int runs = 5;
   int threads = 2;
   bool lp = true;
+  GtspEffort effort = GtspEffort::kDefault;
   std::string svg_dir;  // write <map>.svg of the GTSP plan here
   std::vector<std::string> maps;
 };
@@ -48,7 +49,8 @@ std::string Base(const std::string& p) {
 int Run(const Args& a) {
   std::string partition_table =
       "| map | grid (rows x cols) | free cells | unreachable cells | ranks (min-cut) | ranks (LP) | "
-      "min-cut ms | LP ms | covered free-area ratio |\n|---|---|---|---|---|---|---|---|---|\n";
+      "ranks without thin-wall barriers | min-cut ms | LP ms | covered free-area ratio |\n"
+      "|---|---|---|---|---|---|---|---|---|---|\n";
   std::string plan_table =
       "| map | tour | ranks | turns | coverage m | transition m | duration s | grid ms | partition ms | "
       "transitions ms | tour ms | total ms (median) | gap to long search |\n"
@@ -88,10 +90,15 @@ int Run(const Args& a) {
         lp_ranks = q.ok() ? q->ranks.size() : 0;
       }
     }
-    absl::StrAppendFormat(&partition_table, "| %s | %d x %d | %d | %d | %d | %s | %.2f | %s | %.4f |\n",
+    // Thesis-style grid (no barriers, all components) for comparison.
+    GridOptions plain = dopt.grid;
+    plain.thin_wall_barriers = false;
+    auto plain_grid = BuildGrid(*map, plain);
+    const size_t plain_ranks = MinCutPartitioner().Partition(*plain_grid, StopToken())->ranks.size();
+    absl::StrAppendFormat(&partition_table, "| %s | %d x %d | %d | %d | %d | %s | %d | %.2f | %s | %.4f |\n",
                           Base(path), grid.rows(), grid.cols(), grid.CountFree(),
                           (*d)->unreachable_free_cells, cut_ranks,
-                          a.lp ? absl::StrCat(lp_ranks) : "-", Median(cut_ms),
+                          a.lp ? absl::StrCat(lp_ranks) : "-", plain_ranks, Median(cut_ms),
                           a.lp ? absl::StrFormat("%.1f", Median(lp_ms)) : "-",
                           (*d)->covered_free_area_ratio);
     std::fflush(stdout);
@@ -100,6 +107,7 @@ int Run(const Args& a) {
     if (a.reference_s > 0) {
       PlanOptions ro = po;
       ro.time_limit_s = a.reference_s;
+      ro.tour_effort = GtspEffort::kThorough;
       auto ref = PlanOnDecomposition(**d, ro);
       if (ref.ok()) reference = ref->stats.estimated_duration_s;
     }
@@ -110,6 +118,7 @@ int Run(const Args& a) {
         PlanOptions o = po;
         o.tour_solver = ts;
         o.time_limit_s = a.time_limit;
+        o.tour_effort = a.effort;
         o.seed = 1 + r;
         // Full pipeline from the map, as a fresh request would run it.
         last = PlanCoverage(*map, o);
@@ -160,6 +169,11 @@ int main(int argc, char** argv) {
     else if (k == "--runs") a.runs = std::atoi(next().c_str());
     else if (k == "--threads") a.threads = std::atoi(next().c_str());
     else if (k == "--no-lp") a.lp = false;
+    else if (k == "--effort") {
+      const std::string e = next();
+      a.effort = e == "fast" ? covplan::GtspEffort::kFast
+               : e == "thorough" ? covplan::GtspEffort::kThorough : covplan::GtspEffort::kDefault;
+    }
     else if (k == "--svg-dir") a.svg_dir = next();
     else if (k.rfind("--", 0) == 0) {
       std::fprintf(stderr, "unknown flag %s\n", k.c_str());

@@ -114,6 +114,7 @@ absl::StatusOr<CoveragePlan> PlanOnDecomposition(const Decomposition& d, const P
   oo.time_limit_s = options.time_limit_s;
   oo.seed = options.seed;
   oo.num_threads = options.num_threads;
+  oo.effort = options.tour_effort;
   std::unique_ptr<RankOrderer> orderer;
   if (options.tour_solver == TourSolver::kGreedy) {
     orderer = std::make_unique<GreedyOrderer>();

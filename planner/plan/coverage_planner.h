@@ -23,6 +23,7 @@
 #include "planner/grid/occupancy_map.h"
 #include "planner/partition/partitioner.h"
 #include "planner/plan/coverage_plan.h"
+#include "planner/tour/gtsp/gtsp.h"
 #include "planner/tour/robot_model.h"
 
 namespace covplan {
@@ -61,6 +62,9 @@ struct PlanOptions {
   TourSolver tour_solver = TourSolver::kGtsp;
   double min_free_fraction = 0.5;
   double time_limit_s = 1.0;  // tour search budget (also bounded by `stop`)
+  // kFast/kDefault stop by themselves when the search converges (often well
+  // within the budget); kThorough keeps improving until the budget is spent.
+  GtspEffort tour_effort = GtspEffort::kDefault;
   uint64_t seed = 1;
   int num_threads = 1;
   StopToken stop;             // deadline / cancellation for the whole request

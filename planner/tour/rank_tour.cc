@@ -219,7 +219,7 @@ absl::StatusOr<RankTour> GtspOrderer::Order(const RankTourCost& cost, const Stop
   GtspOptions opt;
   opt.seed = options_.seed;
   opt.num_threads = options_.num_threads;
-  opt.effort = GtspEffort::kFast;
+  opt.effort = options_.effort;
   opt.stop = stop.WithEarlierDeadline(absl::Now() + absl::Seconds(options_.time_limit_s));
   opt.initial_tour.push_back(start);
   for (int v : greedy->vertices) opt.initial_tour.push_back(v);

@@ -24,6 +24,7 @@
 #include "planner/grid/grid.h"
 #include "planner/partition/rank.h"
 #include "planner/plan/coverage_plan.h"
+#include "planner/tour/gtsp/gtsp.h"
 #include "planner/tour/robot_model.h"
 #include "planner/tour/transitions.h"
 
@@ -85,6 +86,7 @@ struct OrdererOptions {
   double time_limit_s = 1.0;
   uint64_t seed = 1;
   int num_threads = 1;
+  GtspEffort effort = GtspEffort::kDefault;
 };
 
 class RankOrderer {
