@@ -10,11 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "client/gtsp_command.h"
 #include "client/load_command.h"
 #include "client/plan_command.h"
-#ifdef COVPLAN_HAVE_GTSP_COMMAND
-#include "client/gtsp_command.h"
-#endif
 
 namespace {
 
@@ -37,14 +35,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 2, argv + argc);
   if (command == "plan") return covplan::RunPlanCommand(args);
   if (command == "load") return covplan::RunLoadCommand(args);
-  if (command == "gtsp") {
-#ifdef COVPLAN_HAVE_GTSP_COMMAND
-    return covplan::RunGtspCommand(args);
-#else
-    std::fputs("covplan: the gtsp command is not part of this build\n", stderr);
-    return 2;
-#endif
-  }
+  if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

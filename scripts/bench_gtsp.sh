@@ -8,8 +8,8 @@
 #   scripts/bench_gtsp.sh [--data DIR] [--limits "1 10"] [--seeds 5]
 #                         [--threads 1] [--bin "CMD"] [--raw FILE] [--only REGEX]
 #
-# The solver command defaults to `build/bin/covplan gtsp` if that binary
-# dispatches `gtsp`, else the first covplan-gtsp found under build*/bin.
+# The solver command defaults to `covplan gtsp` from the first build found
+# is built (build-release/ first, then build/).
 set -euo pipefail
 
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -35,16 +35,12 @@ while [[ $# -gt 0 ]]; do
 done
 
 if [[ -z "$bin" ]]; then
-  if [[ -x "$root/build/bin/covplan" ]] && "$root/build/bin/covplan" gtsp --help >/dev/null 2>&1; then
-    bin="$root/build/bin/covplan gtsp"
-  else
-    for cand in "$root"/build/bin/covplan-gtsp "$root"/build-*/bin/covplan-gtsp; do
-      if [[ -x "$cand" ]]; then bin="$cand"; break; fi
-    done
-  fi
+  for cand in "$root"/build-release/bin/covplan "$root"/build/bin/covplan; do
+    if [[ -x "$cand" ]]; then bin="$cand gtsp"; break; fi
+  done
 fi
 if [[ -z "$bin" ]]; then
-  echo "bench_gtsp.sh: no covplan (with gtsp) or covplan-gtsp binary found; build one first" >&2
+  echo "bench_gtsp.sh: no covplan binary found; run scripts/build.sh first" >&2
   exit 2
 fi
 [[ -f "$data/best_known.csv" ]] || { echo "bench_gtsp.sh: $data/best_known.csv not found" >&2; exit 2; }
