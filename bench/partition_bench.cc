@@ -49,7 +49,7 @@ void BM_MinCut(benchmark::State& state) {
   const Grid grid = BuildingGrid(state.range(0), 42);
   int64_t ranks = 0;
   for (auto _ : state) {
-    auto p = MinCutPartitioner().Partition(grid, StopToken());
+    auto p = MinCutPartitioner(state.range(1) != 0).Partition(grid, StopToken());
     if (!p.ok()) state.SkipWithError(std::string(p.status().message()).c_str());
     ranks = static_cast<int64_t>(p->ranks.size());
   }
@@ -57,7 +57,31 @@ void BM_MinCut(benchmark::State& state) {
   state.counters["free_cells"] = static_cast<double>(grid.CountFree());
   state.counters["ranks"] = static_cast<double>(ranks);
 }
-BENCHMARK(BM_MinCut)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_MinCut)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// An open field (a lawn) of `cells` cells with a scattered 1 % of blocked
+// cells (trees, posts).
+Grid FieldGrid(int64_t cells, uint32_t seed) {
+  const int cols = static_cast<int>(std::sqrt(static_cast<double>(cells)));
+  const int rows = static_cast<int>(cells / cols);
+  std::vector<uint8_t> free(static_cast<size_t>(rows) * cols, 1);
+  std::mt19937 rng(seed);
+  for (auto& f : free) f = rng() % 100 != 0;
+  return Grid(rows, cols, 0.8, {0, 0}, std::move(free));
+}
+
+void BM_MinCutField(benchmark::State& state) {
+  const Grid grid = FieldGrid(state.range(0), 42);
+  int64_t ranks = 0;
+  for (auto _ : state) {
+    auto p = MinCutPartitioner(state.range(1) != 0).Partition(grid, StopToken());
+    if (!p.ok()) state.SkipWithError(std::string(p.status().message()).c_str());
+    ranks = static_cast<int64_t>(p->ranks.size());
+  }
+  state.counters["cells"] = static_cast<double>(grid.size());
+  state.counters["ranks"] = static_cast<double>(ranks);
+}
+BENCHMARK(BM_MinCutField)->Args({1'000'000, 0})->Args({1'000'000, 1})->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_Lp(benchmark::State& state) {
   const Grid grid = BuildingGrid(state.range(0), 42);

@@ -14,8 +14,14 @@ namespace covplan {
 
 class MinCutPartitioner final : public RankPartitioner {
  public:
+  // `greedy_preflow`: push a blocking flow along the monotone paths of the
+  // cut graph (a DAG) before Boykov-Kolmogorov runs on the residual graph.
+  explicit MinCutPartitioner(bool greedy_preflow = true) : greedy_preflow_(greedy_preflow) {}
   std::string_view name() const override { return "mincut"; }
   absl::StatusOr<RankPartition> Partition(const Grid& grid, const StopToken& stop) const override;
+
+ private:
+  bool greedy_preflow_;
 };
 
 }  // namespace covplan

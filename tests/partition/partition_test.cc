@@ -172,6 +172,17 @@ TEST(Partitioners, MinCutEqualsLpOptimumOnRandomGrids) {
   EXPECT_GE(checked, 290);
 }
 
+TEST(MinCutPartitioner, GreedyPreflowDoesNotChangeTheOptimum) {
+  for (uint32_t seed = 0; seed < 60; ++seed) {
+    Grid g = RandomGrid(20 + seed % 30, 25 + seed % 17, 0.9 + 0.001 * (seed % 90), 500 + seed);
+    auto with = MinCutPartitioner(true).Partition(g, StopToken());
+    auto without = MinCutPartitioner(false).Partition(g, StopToken());
+    ASSERT_TRUE(with.ok() && without.ok());
+    EXPECT_EQ(with->ranks.size(), without->ranks.size()) << "seed " << seed;
+    EXPECT_EQ(CheckExactCover(g, with->ranks), "");
+  }
+}
+
 TEST(Partitioners, RanksAreMaximalRuns) {
   Grid g = RandomGrid(30, 40, 0.8, 77);
   auto cut = MinCutPartitioner().Partition(g, StopToken());
