@@ -257,6 +257,12 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   StopToken stop = cancel;
   if (call.deadline != absl::InfiniteFuture()) {
     const absl::Time reply_by = call.deadline - options_.deadline_margin;
+    if (reply_by <= start && call.start + options_.deadline_margin < call.deadline) {
+      // The budget was there on arrival and went into the queue: overload.
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "server busy: the call waited %d ms for a worker and has no time left to plan",
+          absl::ToInt64Milliseconds(start - call.start)));
+    }
     if (reply_by <= start) {
       return absl::DeadlineExceededError(
           absl::StrFormat("deadline of %d ms leaves no time to plan",
@@ -321,7 +327,10 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   PlanToProto(*plan, response);
   response->set_plan_id(NewPlanId());
   response->set_map_id(map_id);
-  metrics_->RecordSolve(absl::ToDoubleSeconds(absl::Now() - start), plan->stats.tour_cut_short);
+  const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
+  metrics_->RecordSolve(solve_us * 1e-6, plan->stats.tour_cut_short);
+  const int64_t mean = mean_solve_us_.load();
+  mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
   plans_.Put(std::make_shared<const v1::PlanResponse>(*response));
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   return absl::OkStatus();
@@ -345,6 +354,26 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   if (!TryAdmitSolve()) {
     reject();
     return reactor;
+  }
+  // Deadline-aware admission: with `ahead` solves admitted before this one
+  // and W workers, it starts after about (ahead - W + 1) / W mean solves. If
+  // that wait already reaches the reply-by time, refusing now is more useful
+  // to the client than a DEADLINE_EXCEEDED after waiting.
+  if (call.deadline != absl::InfiniteFuture()) {
+    const int ahead = admitted_.load() - 1;
+    const int workers = std::max(1, options_.worker_threads);
+    const absl::Duration wait =
+        absl::Microseconds(mean_solve_us_.load()) * std::max(0, ahead - workers + 1) / workers;
+    const absl::Time reply_by = call.deadline - options_.deadline_margin;
+    if (ahead >= workers && absl::Now() + wait >= reply_by) {
+      ReleaseSolve();
+      FinishCall(reactor, call,
+                 absl::ResourceExhaustedError(absl::StrFormat(
+                     "server busy: expected queue wait of %d ms exceeds the call's deadline; "
+                     "retry later",
+                     absl::ToInt64Milliseconds(wait))));
+      return reactor;
+    }
   }
   const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
     UpdateQueueGauges();

@@ -119,6 +119,10 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};
   std::atomic<int> admitted_{0};
+  // Exponentially weighted mean wall time of a solve (microseconds), for the
+  // deadline-aware admission: a call whose expected queue wait would leave no
+  // time to plan before its deadline is refused at once.
+  std::atomic<int64_t> mean_solve_us_{0};
   uint64_t id_salt_;
   // Last: their threads stop before the rest is destroyed.
   WorkerPool io_pool_;  // PutMap / GetMap / DeleteMap

@@ -275,6 +275,33 @@ TEST_F(ServerProcessTest, OverloadIsRefusedQuicklyAndRecovers) {
   EXPECT_TRUE(Plan(Request(map_id, 0.5, 0.2), &after).ok());
 }
 
+TEST_F(ServerProcessTest, QueueWaitBeyondTheDeadlineIsRefusedAtOnce) {
+  StartServer({"--threads=1", "--max_queue=4"});
+  const std::string map_id = PutMap(OfficeMap());
+  // Warm the cache and teach the server that a solve takes ~1 s.
+  v1::PlanResponse warm;
+  ASSERT_TRUE(Plan(Request(map_id, 0.5, 1.0), &warm).ok());
+  ASSERT_TRUE(Plan(Request(map_id, 0.5, 1.0), &warm).ok());
+  // Two 1 s solves hold the worker and the queue...
+  std::vector<std::thread> busy;
+  for (int i = 0; i < 2; ++i) {
+    busy.emplace_back([&] {
+      v1::PlanResponse response;
+      EXPECT_TRUE(Plan(Request(map_id, 0.5, 1.0), &response).ok());
+    });
+  }
+  absl::SleepFor(absl::Milliseconds(150));
+  // ...so a call with a 300 ms deadline would only wait and expire: it is
+  // refused at once instead of answering DEADLINE_EXCEEDED later.
+  v1::PlanResponse response;
+  const absl::Time start = absl::Now();
+  const grpc::Status status = Plan(Request(map_id, 0.5, 1.0), &response, absl::Milliseconds(300));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("queue wait"));
+  EXPECT_LT(absl::Now() - start, absl::Milliseconds(200));
+  for (std::thread& t : busy) t.join();
+}
+
 TEST_F(ServerProcessTest, BadInputIsInvalidArgumentOverTheWire) {
   StartServer();
   const std::string pgm = AsciiToPgm(TwoRooms(), 4);
