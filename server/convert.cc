@@ -33,6 +33,13 @@ absl::Status CheckPositive(double v, absl::string_view field, absl::string_view 
       absl::StrFormat("%s must be a positive, finite number of %s (got %g)", field, unit, v));
 }
 
+absl::Status CheckRange(double v, absl::string_view field, double lo, double hi,
+                        absl::string_view unit) {
+  if (v >= lo && v <= hi) return absl::OkStatus();  // NaN fails
+  return absl::InvalidArgumentError(
+      absl::StrFormat("%s must be between %g and %g %s (got %g)", field, lo, hi, unit, v));
+}
+
 absl::Status CheckFinite(double v, absl::string_view field) {
   if (std::isfinite(v)) return absl::OkStatus();
   return absl::InvalidArgumentError(absl::StrFormat("%s must be finite (got %g)", field, v));
@@ -213,18 +220,23 @@ absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits&
 absl::StatusOr<PlanOptions> PlanOptionsFromProto(const v1::PlanRequest& request) {
   PlanOptions options;
   const v1::RobotModel& robot = request.robot();
-  RETURN_IF_ERROR(CheckPositive(robot.tool_width_m(), "robot.tool_width_m", "metres"));
+  using M = RobotModel;
+  RETURN_IF_ERROR(CheckRange(robot.tool_width_m(), "robot.tool_width_m", M::kMinToolWidth,
+                             M::kMaxToolWidth, "m"));
   options.robot.tool_width_m = robot.tool_width_m();
   if (robot.has_max_speed_mps()) {
-    RETURN_IF_ERROR(CheckPositive(robot.max_speed_mps(), "robot.max_speed_mps", "m/s"));
+    RETURN_IF_ERROR(
+        CheckRange(robot.max_speed_mps(), "robot.max_speed_mps", M::kMinSpeed, M::kMaxSpeed, "m/s"));
     options.robot.max_speed_mps = robot.max_speed_mps();
   }
   if (robot.has_acceleration_mps2()) {
-    RETURN_IF_ERROR(CheckPositive(robot.acceleration_mps2(), "robot.acceleration_mps2", "m/s^2"));
+    RETURN_IF_ERROR(CheckRange(robot.acceleration_mps2(), "robot.acceleration_mps2",
+                               M::kMinAcceleration, M::kMaxAcceleration, "m/s^2"));
     options.robot.acceleration_mps2 = robot.acceleration_mps2();
   }
   if (robot.has_turn_rate_deg_s()) {
-    RETURN_IF_ERROR(CheckPositive(robot.turn_rate_deg_s(), "robot.turn_rate_deg_s", "deg/s"));
+    RETURN_IF_ERROR(CheckRange(robot.turn_rate_deg_s(), "robot.turn_rate_deg_s", M::kMinTurnRate,
+                               M::kMaxTurnRate, "deg/s"));
     options.robot.turn_rate_deg_s = robot.turn_rate_deg_s();
   }
   for (auto [present, pose, name] :

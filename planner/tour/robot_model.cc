@@ -7,10 +7,10 @@
 namespace covplan {
 namespace {
 
-absl::Status CheckPositive(const char* name, double v, const char* unit) {
-  if (!std::isfinite(v) || v <= 0.0) {
+absl::Status CheckRange(const char* name, double v, double lo, double hi, const char* unit) {
+  if (!(v >= lo && v <= hi)) {  // also rejects NaN
     return absl::InvalidArgumentError(
-        absl::StrFormat("%s must be a positive number of %s, got %g", name, unit, v));
+        absl::StrFormat("%s must be between %g and %g %s, got %g", name, lo, hi, unit, v));
   }
   return absl::OkStatus();
 }
@@ -25,11 +25,12 @@ absl::Status CheckPose(const char* name, const std::optional<Pose2>& p) {
 }  // namespace
 
 absl::Status RobotModel::Validate() const {
-  for (absl::Status s : {CheckPositive("tool width", tool_width_m, "metres"),
-                         CheckPositive("max speed", max_speed_mps, "m/s"),
-                         CheckPositive("acceleration", acceleration_mps2, "m/s^2"),
-                         CheckPositive("turn rate", turn_rate_deg_s, "deg/s"),
-                         CheckPose("start", start), CheckPose("end", end)}) {
+  for (absl::Status s :
+       {CheckRange("tool width", tool_width_m, kMinToolWidth, kMaxToolWidth, "m"),
+        CheckRange("max speed", max_speed_mps, kMinSpeed, kMaxSpeed, "m/s"),
+        CheckRange("acceleration", acceleration_mps2, kMinAcceleration, kMaxAcceleration, "m/s^2"),
+        CheckRange("turn rate", turn_rate_deg_s, kMinTurnRate, kMaxTurnRate, "deg/s"),
+        CheckPose("start", start), CheckPose("end", end)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();

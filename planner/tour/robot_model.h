@@ -31,6 +31,16 @@ struct RobotModel {
   // Where the tour must end; default: back at the start.
   std::optional<Pose2> end;
 
+  // Accepted ranges. Wide enough for any ground robot, narrow enough that
+  // every drive time stays a finite, meaningful number (an acceleration of
+  // 1e-300 m/s^2 is "positive" but makes every transition take forever).
+  static constexpr double kMinToolWidth = 1e-3, kMaxToolWidth = 100.0;      // m
+  static constexpr double kMinSpeed = 1e-2, kMaxSpeed = 100.0;              // m/s
+  static constexpr double kMinAcceleration = 1e-3, kMaxAcceleration = 1e3;  // m/s^2
+  static constexpr double kMinTurnRate = 0.1, kMaxTurnRate = 1e5;           // deg/s
+
+  // InvalidArgument naming the field when a value is outside its range or a
+  // pose is not finite.
   absl::Status Validate() const;
 
   // Time to drive a straight segment of `length` metres from rest to rest.

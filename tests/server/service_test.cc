@@ -3,8 +3,13 @@
 // INVALID_ARGUMENT and a useful message, health, reflection and /metrics.
 #include <grpcpp/grpcpp.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
+#include <map>
+#include <random>
 
 #include "absl/strings/str_cat.h"
 #include "gmock/gmock.h"
@@ -251,6 +256,81 @@ TEST_F(ServiceTest, EveryBadInputIsInvalidArgumentWithAMessage) {
   const grpc::Status status = PutMap(RasterMap(pgm.substr(0, 30), 0.1), &put);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("map.raster.image"));
+}
+
+// Random mixes of valid and hostile field values (NaN, infinities, zero,
+// negative, huge, tiny, unknown enum numbers, poses outside the map): every
+// request gets OK with a complete plan or INVALID_ARGUMENT with a message,
+// and the server keeps serving.
+TEST_F(ServiceTest, RandomHostileRequestsAreAnsweredNeverCrash) {
+  const std::string map_id = PutTwoRooms();
+  const std::string pgm = AsciiToPgm(TwoRooms(), 4);
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> hostile = {0.0, -1.0, nan, inf, -inf, 1e300, 1e-300, -0.0,
+                                       std::numeric_limits<double>::denorm_min()};
+  std::mt19937 rng(20261122);
+  auto pick = [&](const std::vector<double>& good) {
+    return rng() % 3 == 0 ? hostile[rng() % hostile.size()] : good[rng() % good.size()];
+  };
+  std::map<int, int> codes;
+  for (int i = 0; i < 150; ++i) {
+    SCOPED_TRACE(i);
+    v1::PlanRequest request = PlanRequestFor(map_id, 0.4);
+    if (rng() % 4 == 0) {
+      *request.mutable_map() = RasterMap(pgm, pick({0.1, 0.05}));
+      if (rng() % 2) request.mutable_map()->mutable_raster()->set_origin_x_m(pick({-3.0, 2.5}));
+      if (rng() % 2) request.mutable_map()->mutable_raster()->set_free_thresh(pick({0.1, 0.3}));
+      if (rng() % 2) request.mutable_map()->mutable_raster()->set_occupied_thresh(pick({0.6, 0.9}));
+    }
+    v1::RobotModel* robot = request.mutable_robot();
+    robot->set_tool_width_m(pick({0.3, 0.4, 0.6}));
+    if (rng() % 2) robot->set_max_speed_mps(pick({0.5, 1.0, 2.0}));
+    if (rng() % 2) robot->set_acceleration_mps2(pick({0.2, 0.5}));
+    if (rng() % 2) robot->set_turn_rate_deg_s(pick({30.0, 90.0}));
+    if (rng() % 3 == 0) {
+      robot->mutable_start()->set_x(pick({0.5, 1.5, 50.0}));
+      robot->mutable_start()->set_y(pick({0.5, 1.0, -20.0}));
+      robot->mutable_start()->set_theta(pick({0.0, 3.0, 100.0}));
+    }
+    if (rng() % 4 == 0) {
+      robot->mutable_end()->set_x(pick({1.0, 2.0}));
+      robot->mutable_end()->set_y(pick({0.5, 1.5}));
+    }
+    request.set_time_limit_s(pick({0.01, 0.05, 0.2}));
+    if (rng() % 3 == 0) request.set_min_free_fraction(pick({0.3, 0.5, 0.9, 1.0, 1.5}));
+    if (rng() % 5 == 0) request.set_partition_solver(static_cast<v1::PartitionSolver>(rng() % 4));
+    if (rng() % 5 == 0) request.set_tour_solver(static_cast<v1::TourSolver>(rng() % 4));
+    request.set_seed(rng());
+
+    v1::PlanResponse response;
+    const grpc::Status status = Plan(request, &response);
+    ++codes[status.error_code()];
+    if (status.ok()) {
+      ASSERT_EQ(response.rank_order_size(), response.ranks_size());
+      std::vector<int> order(response.rank_order().begin(), response.rank_order().end());
+      std::sort(order.begin(), order.end());
+      for (int r = 0; r < static_cast<int>(order.size()); ++r) ASSERT_EQ(order[r], r);
+      for (const v1::Waypoint& w : response.path()) {
+        ASSERT_TRUE(std::isfinite(w.x()) && std::isfinite(w.y()) && std::isfinite(w.theta()));
+      }
+      EXPECT_TRUE(std::isfinite(response.stats().estimated_duration_s()));
+      EXPECT_GT(response.stats().estimated_duration_s(), 0.0);
+    } else {
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+          << status.error_message() << "\nrequest (map bytes omitted): " << [&] {
+               v1::PlanRequest shown = request;
+               if (shown.has_map()) shown.mutable_map()->mutable_raster()->clear_image();
+               return shown.ShortDebugString();
+             }();
+      EXPECT_FALSE(status.error_message().empty());
+    }
+  }
+  // Both outcomes were exercised, and the server still plans.
+  EXPECT_GT(codes[grpc::StatusCode::OK], 10);
+  EXPECT_GT(codes[grpc::StatusCode::INVALID_ARGUMENT], 10);
+  v1::PlanResponse response;
+  EXPECT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &response).ok());
 }
 
 TEST_F(ServiceTest, UnknownMapIdIsNotFound) {

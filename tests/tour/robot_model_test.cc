@@ -51,6 +51,28 @@ TEST(RobotModel, ValidateRejectsBadValues) {
   EXPECT_TRUE(RobotModel().Validate().ok());
 }
 
+// Positive but absurd values would make every drive time infinite or zero.
+TEST(RobotModel, ValidateRejectsValuesOutsideThePhysicalRange) {
+  RobotModel slow;
+  slow.acceleration_mps2 = 1e-300;
+  EXPECT_EQ(slow.Validate().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(slow.Validate().message().find("acceleration"), std::string::npos);
+  RobotModel frozen;
+  frozen.turn_rate_deg_s = 5e-324;
+  EXPECT_NE(frozen.Validate().message().find("turn rate"), std::string::npos);
+  RobotModel rocket;
+  rocket.max_speed_mps = 1e300;
+  EXPECT_NE(rocket.Validate().message().find("max speed"), std::string::npos);
+  // The bounds themselves are accepted and give finite times.
+  RobotModel edge;
+  edge.max_speed_mps = RobotModel::kMinSpeed;
+  edge.acceleration_mps2 = RobotModel::kMinAcceleration;
+  edge.turn_rate_deg_s = RobotModel::kMinTurnRate;
+  ASSERT_TRUE(edge.Validate().ok());
+  EXPECT_TRUE(std::isfinite(edge.StraightTime(1e6)));
+  EXPECT_TRUE(std::isfinite(edge.TurnTime(M_PI)));
+}
+
 TEST(PathTiming, LShapedPathWithTurns) {
   RobotModel robot;
   // Facing +x, drive 10 m east, turn 90 deg, drive 1 m north, then face west.
