@@ -1,6 +1,8 @@
 #include "client/plan_command.h"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <optional>
 #include <random>
@@ -23,8 +25,12 @@ constexpr char kUsage[] =
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
+    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]]\n"
     "FILE is a map_server .yaml (with the image it names) or a bare .pgm/.png (needs\n"
-    "--resolution). Without --local the server defaults to 127.0.0.1:50051.\n";
+    "--resolution). Without --local the server defaults to 127.0.0.1:50051.\n"
+    "Poses are in metres in the map frame, THETA in radians (default 0). Without\n"
+    "--start the robot starts at the first rank; without --end it returns to the start.\n"
+    "A pose in a blocked cell next to a free one (a dock at a wall) joins the grid there.\n";
 
 absl::Status WriteFile(const std::string& path, const std::string& contents) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -32,6 +38,33 @@ absl::Status WriteFile(const std::string& path, const std::string& contents) {
   out << contents;
   out.close();
   if (!out) return absl::InternalError(absl::StrCat("cannot write ", path));
+  return absl::OkStatus();
+}
+
+// "X,Y" or "X,Y,THETA" (finite numbers) into `pose`.
+absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pose* pose) {
+  std::vector<double> v;
+  size_t begin = 0;
+  while (true) {
+    const size_t comma = text.find(',', begin);
+    const std::string part = text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    char* end = nullptr;
+    const double d = std::strtod(part.c_str(), &end);
+    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(d)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--", flag, " must be X,Y or X,Y,THETA (metres, radians), got '", text, "'"));
+    }
+    v.push_back(d);
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
+  if (v.size() < 2 || v.size() > 3) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--", flag, " must be X,Y or X,Y,THETA (metres, radians), got '", text, "'"));
+  }
+  pose->set_x(v[0]);
+  pose->set_y(v[1]);
+  pose->set_theta(v.size() == 3 ? v[2] : 0.0);
   return absl::OkStatus();
 }
 
@@ -57,7 +90,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
       ParseArgs(args,
                 {"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
-                 "occupied-thresh", "min-free-fraction", "deadline-ms"},
+                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end"},
                 {"local", "negate"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -88,6 +121,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   if (accel) robot->set_acceleration_mps2(*accel);
   ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
   if (turn) robot->set_turn_rate_deg_s(*turn);
+  if (auto start = a.Get("start")) RETURN_IF_ERROR(ParsePose("start", *start, robot->mutable_start()));
+  if (auto end = a.Get("end")) RETURN_IF_ERROR(ParsePose("end", *end, robot->mutable_end()));
   ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
   if (limit) r.set_time_limit_s(*limit);
   ASSIGN_OR_RETURN(std::optional<double> fraction, a.GetDouble("min-free-fraction"));
@@ -187,7 +222,7 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
   const v1::PlanStats& s = r.stats();
   return absl::StrFormat(
       "plan       %s (map %s)\n"
-      "grid       %d x %d cells of %.3f m, %d free\n"
+      "grid       %d x %d cells of %.3f m, %d free (%d unreachable, not planned)\n"
       "ranks      %d (partition %s)\n"
       "tour       %s, %d turns%s\n"
       "length     coverage %.1f m, transitions %.1f m\n"
@@ -195,7 +230,7 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
       "duration   %.1f s estimated (turning %.1f s)\n"
       "timings    planning %.1f ms: grid %.1f, partition %.1f, transitions %.1f, tour %.1f ms%s\n",
       r.plan_id(), r.map_id().substr(0, 12), s.grid_rows(), s.grid_cols(),
-      r.grid().cell_size_m(), s.free_cells(), s.num_ranks(), s.partition_solver(),
+      r.grid().cell_size_m(), s.free_cells(), s.unreachable_free_cells(), s.num_ranks(), s.partition_solver(),
       s.tour_solver(), s.num_turns(), s.tour_cut_short() ? " (search cut short by the budget)" : "",
       s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
       s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),

@@ -72,6 +72,7 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_decomposition_cached(s.decomposition_cached);
   o->set_partition_solver(s.partition_solver);
   o->set_tour_solver(s.tour_solver);
+  o->set_unreachable_free_cells(static_cast<int32_t>(s.unreachable_free_cells));
 }
 
 absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
@@ -153,6 +154,7 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   o.decomposition_cached = s.decomposition_cached();
   o.partition_solver = s.partition_solver();
   o.tour_solver = s.tour_solver();
+  o.unreachable_free_cells = s.unreachable_free_cells();
   return plan;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "absl/strings/str_format.h"
 #include "planner/tour/grid_paths.h"
@@ -12,13 +13,29 @@
 namespace covplan {
 namespace {
 
-absl::Status CheckPoseCell(const Grid& grid, const Pose2& p, const char* what) {
+// The free cell where the robot joins the grid: the pose's own cell, or, when
+// that cell is blocked (a dock against a wall stands in a cell that is mostly
+// wall), the adjacent free cell whose centre is nearest. The path then starts
+// with the short move from the pose onto that cell.
+absl::StatusOr<CellIndex> PoseCell(const Grid& grid, const Pose2& p, const char* what) {
   const CellIndex c = grid.CellAt({p.x, p.y});
-  if (!grid.IsFree(c)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "%s pose (%.3f, %.3f) is not inside a reachable free grid cell", what, p.x, p.y));
+  if (grid.IsFree(c)) return c;
+  std::optional<CellIndex> best;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (int dr = -1; dr <= 1; ++dr) {
+    for (int dc = -1; dc <= 1; ++dc) {
+      const CellIndex n{c.row + dr, c.col + dc};
+      if (!grid.IsFree(n)) continue;
+      const Point2 q = grid.CellCenter(n);
+      const double d2 = (q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y);
+      if (d2 < best_d2) best_d2 = d2, best = n;
+    }
   }
-  return absl::OkStatus();
+  if (best) return *best;
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "%s pose (%.3f, %.3f) is neither in nor next to a reachable free grid cell (cells of "
+      "%.3f m; only the largest connected free area is planned)",
+      what, p.x, p.y, grid.cell_size()));
 }
 
 // Points from `pose` to the centre of its cell, then along `cells`.
@@ -58,10 +75,10 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   }
   cost.has_end_ = robot.end.has_value();
   cost.end_ = robot.end.value_or(cost.start_);
-  absl::Status st = CheckPoseCell(grid, cost.start_, "start");
-  if (!st.ok()) return st;
-  st = CheckPoseCell(grid, cost.end_, "end");
-  if (!st.ok()) return st;
+  absl::StatusOr<CellIndex> start_cell = PoseCell(grid, cost.start_, "start");
+  if (!start_cell.ok()) return start_cell.status();
+  absl::StatusOr<CellIndex> end_cell = PoseCell(grid, cost.end_, "end");
+  if (!end_cell.ok()) return end_cell.status();
 
   const int n = cost.num_vertices();
   cost.rank_time_.resize(ranks.size());
@@ -72,7 +89,7 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   AnyAngleSearch search(grid);
   cost.start_paths_.resize(n);
   cost.from_start_.resize(n);
-  if (!search.Run(grid.CellAt({cost.start_.x, cost.start_.y}), stop)) {
+  if (!search.Run(*start_cell, stop)) {
     return absl::DeadlineExceededError("stopped while routing from the start pose");
   }
   for (int v = 0; v < n; ++v) {
@@ -87,7 +104,7 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
                                        cost.Heading(v)).time_s +
                           cost.rank_time_[v / 2];
   }
-  if (cost.has_end_ && !search.Run(grid.CellAt({cost.end_.x, cost.end_.y}), stop)) {
+  if (cost.has_end_ && !search.Run(*end_cell, stop)) {
     return absl::DeadlineExceededError("stopped while routing to the end pose");
   }
   cost.end_paths_.resize(n);

@@ -4,10 +4,13 @@
 #include <grpcpp/grpcpp.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "client/plan_command.h"
 #include "gmock/gmock.h"
+#include "google/protobuf/util/json_util.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
 
@@ -81,6 +84,46 @@ TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
     EXPECT_THAT(json, HasSubstr("\"covered_free_area_ratio\""));
     EXPECT_THAT(json, HasSubstr("\"kind\": \"TRANSITION\""));
   }
+}
+
+TEST(ClientPlanTest, StartAndEndPoseFlagsReachThePlanAndUnreachableCellsAreReported) {
+  const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
+  const std::string out = (std::filesystem::temp_directory_path() /
+                           absl::StrCat("covplan_pose_", ::getpid(), ".json"))
+                              .string();
+  ASSERT_EQ(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--out", out}), 0);
+  auto read = [&]() {
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    v1::PlanResponse r;
+    EXPECT_TRUE(google::protobuf::util::JsonStringToMessage(ss.str(), &r).ok());
+    return r;
+  };
+  const v1::PlanResponse first = read();
+  // The office has a small room behind a door narrower than the 0.8 m tool.
+  EXPECT_GT(first.stats().unreachable_free_cells(), 0);
+  ASSERT_GT(first.path_size(), 10);
+  const v1::Waypoint s = first.path(7), e = first.path(first.path_size() / 2);
+  const std::string start = absl::StrCat(s.x(), ",", s.y(), ",0.5");
+  const std::string end = absl::StrCat(e.x(), ",", e.y());
+  ASSERT_EQ(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--start", start, "--end",
+                            end, "--out", out}),
+            0);
+  const v1::PlanResponse posed = read();
+  EXPECT_NEAR(posed.path(0).x(), s.x(), 1e-9);
+  EXPECT_NEAR(posed.path(0).y(), s.y(), 1e-9);
+  EXPECT_NEAR(posed.path(0).theta(), 0.5, 1e-9);
+  EXPECT_NEAR(posed.path(posed.path_size() - 1).x(), e.x(), 1e-9);
+  EXPECT_NEAR(posed.path(posed.path_size() - 1).y(), e.y(), 1e-9);
+  EXPECT_EQ(posed.stats().num_ranks(), first.stats().num_ranks());
+  std::filesystem::remove(out);
+
+  // Malformed poses and poses off the map are refused with a non-zero exit.
+  for (const char* bad : {"1", "1,x", "1,2,3,4", "nan,2", ""}) {
+    EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--start", bad}), 0) << bad;
+  }
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--start", "-100,-100"}), 0);
 }
 
 }  // namespace

@@ -120,13 +120,44 @@ TEST(RankTour, EndPoseIsHonoured) {
   EXPECT_NEAR(plan.stats.estimated_duration_s, tour->time_s, 1e-6);
 }
 
-TEST(RankTour, StartPoseOnObstacleIsInvalidArgument) {
+TEST(RankTour, StartPoseInBlockedCellJoinsTheNearestAdjacentFreeCell) {
+  // A dock against a wall: the pose lies in the '##' block (rows 6..7, cols
+  // 3..4); the robot first moves onto an adjacent free cell, then the path
+  // stays in free cells and ends back at the pose.
   Fixture f = Make(Grid::FromAscii(kRooms, 1.0));
   RobotModel robot;
-  robot.start = Pose2{3.5, 7.5, 0.0};  // the '##' block at rows 6..7, cols 3..4
+  robot.start = Pose2{3.4, 7.5, 0.0};
   auto cost = RankTourCost::Create(f.grid, f.partition.ranks, *f.table, robot, StopToken());
-  EXPECT_EQ(cost.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(cost.status().message().find("start pose"), std::string::npos);
+  ASSERT_TRUE(cost.ok()) << cost.status();
+  auto tour = GtspOrderer({0.2, 1, 1}).Order(*cost, StopToken());
+  ASSERT_TRUE(tour.ok()) << tour.status();
+  CoveragePlan plan = AsPlan(f, *cost, *tour, robot);
+  ASSERT_GE(plan.path.size(), 3u);
+  EXPECT_NEAR(plan.path[0].x, 3.4, 1e-9);
+  EXPECT_NEAR(plan.path[0].y, 7.5, 1e-9);
+  // Nearest free centre to (3.4, 7.5) is (2.5, 7.5), the cell left of the block.
+  EXPECT_NEAR(plan.path[1].x, 2.5, 1e-9);
+  EXPECT_NEAR(plan.path[1].y, 7.5, 1e-9);
+  const std::vector<Waypoint> inner(plan.path.begin() + 1, plan.path.end() - 1);
+  EXPECT_EQ(testing::CheckPathStaysFree(f.grid, inner), "");
+  EXPECT_NEAR(plan.path.back().x, 3.4, 1e-9);
+  EXPECT_NEAR(plan.stats.estimated_duration_s, tour->time_s, 1e-6);
+}
+
+TEST(RankTour, PoseFarFromFreeCellsIsInvalidArgument) {
+  Fixture f = Make(Grid::FromAscii(kRooms, 1.0));
+  for (Pose2 pose : {Pose2{-5.0, -5.0, 0.0}, Pose2{40.0, 3.0, 0.0}}) {
+    RobotModel robot;
+    robot.start = pose;
+    auto cost = RankTourCost::Create(f.grid, f.partition.ranks, *f.table, robot, StopToken());
+    EXPECT_EQ(cost.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(cost.status().message().find("start pose"), std::string::npos) << cost.status();
+    RobotModel robot2;
+    robot2.end = pose;
+    cost = RankTourCost::Create(f.grid, f.partition.ranks, *f.table, robot2, StopToken());
+    EXPECT_EQ(cost.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(cost.status().message().find("end pose"), std::string::npos) << cost.status();
+  }
 }
 
 }  // namespace
