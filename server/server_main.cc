@@ -13,6 +13,8 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/flags/usage_config.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "server/covplan_server.h"
 #include "server/log.h"
@@ -37,7 +39,14 @@ ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
 int main(int argc, char** argv) {
-  absl::SetProgramUsageMessage("covplan-server: coverage path planning gRPC service");
+  absl::SetProgramUsageMessage("coverage path planning gRPC service");
+  // --help lists this file's flags (absl looks for a file named after the
+  // binary by default and would show none).
+  absl::FlagsUsageConfig usage;
+  usage.contains_help_flags = [](absl::string_view path) {
+    return absl::StrContains(path, "server/server_main.cc");
+  };
+  absl::SetFlagsUsageConfig(usage);
   absl::ParseCommandLine(argc, argv);
 
   // Block the signals in every thread; this one waits for them below.
