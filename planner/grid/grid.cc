@@ -21,13 +21,14 @@ absl::Status GridOptions::Validate() const {
 }
 
 Grid::Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free,
-           std::vector<uint8_t> walls)
+           std::vector<uint8_t> walls, std::shared_ptr<const ObstaclePixels> pixels)
     : rows_(rows),
       cols_(cols),
       cell_size_(cell_size),
       origin_(origin),
       free_(std::move(free)),
-      walls_(std::move(walls)) {}
+      walls_(std::move(walls)),
+      pixels_(std::move(pixels)) {}
 
 int64_t Grid::CountBarriers() const {
   int64_t n = 0;
@@ -231,7 +232,9 @@ absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& optio
       }
     }
   }
-  return Grid(rows, cols, options.cell_size, map.origin(), std::move(free), std::move(walls));
+  auto pixels = std::make_shared<const ObstaclePixels>(map, px_per_cell, rows, cols);
+  return Grid(rows, cols, options.cell_size, map.origin(), std::move(free), std::move(walls),
+              std::move(pixels));
 }
 
 double CoveredFreeAreaRatio(const OccupancyMap& map, const Grid& grid) {

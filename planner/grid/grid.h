@@ -20,11 +20,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "planner/grid/obstacle_pixels.h"
 #include "planner/grid/occupancy_map.h"
 
 namespace covplan {
@@ -54,8 +56,9 @@ class Grid {
 
   // Builds a grid directly from free flags (row-major, row 0 = smallest y)
   // and optional barrier bits (empty = no barriers).
+  // `pixels` (optional) are the map's non-free pixels for segment checks.
   Grid(int rows, int cols, double cell_size, Point2 origin, std::vector<uint8_t> free,
-       std::vector<uint8_t> walls = {});
+       std::vector<uint8_t> walls = {}, std::shared_ptr<const ObstaclePixels> pixels = nullptr);
 
   // Parses ASCII art for tests: one string per row, *first string is the top
   // row* (largest y) so the picture reads naturally; '.' free, '#' blocked,
@@ -103,7 +106,15 @@ class Grid {
   // One string per row (row 0 first) of '1' free / '0' blocked.
   std::vector<std::string> ToRowStrings() const;
 
-  size_t MemoryBytes() const { return sizeof(*this) + free_.capacity() + walls_.capacity(); }
+  // The map's non-free pixels (null for grids not built from a map): straight
+  // moves are checked against them as well as against cells and barriers.
+  const ObstaclePixels* obstacle_pixels() const { return pixels_.get(); }
+  const std::shared_ptr<const ObstaclePixels>& shared_obstacle_pixels() const { return pixels_; }
+
+  size_t MemoryBytes() const {
+    return sizeof(*this) + free_.capacity() + walls_.capacity() +
+           (pixels_ ? pixels_->MemoryBytes() : 0);
+  }
 
  private:
   int rows_ = 0;
@@ -112,6 +123,7 @@ class Grid {
   Point2 origin_;
   std::vector<uint8_t> free_;
   std::vector<uint8_t> walls_;  // empty, or kWall* bits per cell
+  std::shared_ptr<const ObstaclePixels> pixels_;
 };
 
 // Builds the tool-width grid over `map`. InvalidArgument when the cell is

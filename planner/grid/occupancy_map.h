@@ -12,6 +12,7 @@
 #ifndef COVPLAN_PLANNER_GRID_OCCUPANCY_MAP_H_
 #define COVPLAN_PLANNER_GRID_OCCUPANCY_MAP_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

@@ -33,7 +33,7 @@ Grid KeepLargestComponent(const Grid& grid, int64_t* dropped) {
     *dropped += comp[i] >= 0 && comp[i] != keep;
   }
   return Grid(grid.rows(), grid.cols(), grid.cell_size(), grid.origin(), std::move(free),
-              grid.walls());
+              grid.walls(), grid.shared_obstacle_pixels());
 }
 
 }  // namespace

@@ -14,6 +14,14 @@ bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b) {
   const int64_t nx = std::abs(dx), ny = std::abs(dy);
   const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
   if (!grid.IsFree(y, x)) return false;
+  // Inside cells that overlap non-free map pixels, the segment itself must
+  // not touch one (a table inside two free cells blocks the line through it).
+  const ObstaclePixels* px = grid.obstacle_pixels();
+  const Point2 pa{a.col + 0.5, a.row + 0.5}, pb{b.col + 0.5, b.row + 0.5};
+  auto pixels_clear = [&](int r, int c) {
+    return px == nullptr || !px->CellDirty(r, c) || !px->SegmentBlockedInCell(r, c, pa, pb);
+  };
+  if (!pixels_clear(y, x)) return false;
   for (int64_t ix = 0, iy = 0; ix < nx || iy < ny;) {
     // Compare the parameters at which the segment crosses the next vertical
     // ((0.5 + ix) / nx) and horizontal ((0.5 + iy) / ny) grid line.
@@ -25,6 +33,7 @@ bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b) {
           !grid.Passable(y, x, sy, 0) || !grid.Passable(y + sy, x, 0, sx)) {
         return false;
       }
+      if (!pixels_clear(y, x + sx) || !pixels_clear(y + sy, x)) return false;
       x += sx, y += sy, ++ix, ++iy;
     } else if (decision < 0) {
       if (!grid.Passable(y, x, 0, sx)) return false;
@@ -33,6 +42,7 @@ bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b) {
       if (!grid.Passable(y, x, sy, 0)) return false;
       y += sy, ++iy;
     }
+    if (!pixels_clear(y, x)) return false;
   }
   return true;
 }
@@ -77,7 +87,8 @@ float Euclid(const Grid& g, int64_t a, int64_t b) {
 }
 
 // Calls f(neighbour index) for every allowed move from c: 4-neighbours, and
-// diagonals whose two orthogonal cells are free (no corner cutting).
+// diagonals whose two orthogonal cells are free (no corner cutting) and whose
+// segment touches no non-free map pixel.
 template <typename F>
 void ForEachMove(const Grid& g, CellIndex c, F&& f) {
   constexpr int kDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
@@ -90,7 +101,8 @@ void ForEachMove(const Grid& g, CellIndex c, F&& f) {
     }
     // Diagonal: both L-shaped routes around the corner must be open.
     if (g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
-        g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc)) {
+        g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc) &&
+        (g.obstacle_pixels() == nullptr || !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc))) {
       f(g.Index(c.row + dr, c.col + dc));
     }
   }

@@ -3,7 +3,9 @@
 // The robot drives between cell centres. A straight segment is allowed when
 // every cell it touches is free and every cell boundary it crosses is
 // passable (no thin-wall barrier); through an exact grid corner, all four
-// cells and boundaries around it must be open.
+// cells and boundaries around it must be open. For grids built from a map,
+// the segment must also touch no non-free map pixel (ObstaclePixels), so a
+// path's centre line never crosses an obstacle the cell grid cannot show.
 // AnyAngleSearch is a single-source Lazy Theta* (Nash, Koenig & Tovey 2010)
 // without a goal: one search yields any-angle shortest paths, as chains of
 // corner cells, from the source to every reachable cell.
@@ -26,7 +28,7 @@
 namespace covplan {
 
 // True when the straight segment between the centres of a and b touches only
-// free cells.
+// free cells, crosses no barrier and touches no non-free map pixel.
 bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b);
 
 // Connected components of free cells under 4-connectivity through passable

@@ -38,6 +38,23 @@ TEST_P(ShippedMap, LpEqualsMinCutAndPlanConforms) {
   EXPECT_GT(plan->stats.covered_free_area_ratio, 0.5);
 }
 
+TEST_P(ShippedMap, DriveLineNeverCrossesAnObstaclePixel) {
+  // Cells are free when most of their area is: furniture smaller than a cell
+  // hides inside free cells. Coverage and transitions must still miss it.
+  const std::string path = std::string(COVPLAN_SOURCE_DIR) + "/maps/" + GetParam();
+  absl::StatusOr<OccupancyMap> map = LoadMapFile(path, MapLoadOptions());
+  ASSERT_TRUE(map.ok()) << map.status();
+  for (double tool : {0.5, 0.8, 1.2}) {
+    PlanOptions opt;
+    opt.time_limit_s = 0.2;
+    opt.robot.tool_width_m = tool;
+    absl::StatusOr<CoveragePlan> plan = PlanCoverage(*map, opt);
+    ASSERT_TRUE(plan.ok()) << plan.status();
+    EXPECT_EQ(testing::CheckPathAvoidsMapObstacles(*map, plan->path), "")
+        << GetParam() << " tool " << tool;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Maps, ShippedMap,
                          ::testing::Values("sample_office.yaml", "sample_office_furnished.yaml",
                                            "small_rooms.yaml"));

@@ -18,6 +18,42 @@ namespace covplan::testing {
 
 // First point (sampled every 1 % of a cell) of the path outside free cells,
 // or the first move between cells across a thin-wall barrier.
+// "" when no point of the path's centre line (sampled every 1/20 pixel, from
+// waypoint `first` on) lies inside an obstacle of `map`: the cell grid may
+// call a cell with a table in it free, the drive line must still miss it.
+// "Inside" means in the interior of the union of non-free pixels (off-map
+// counts as non-free): a line may touch an obstacle's face or corner, not
+// enter it.
+inline std::string CheckPathAvoidsMapObstacles(const OccupancyMap& map,
+                                               const std::vector<Waypoint>& path,
+                                               size_t first = 0) {
+  const double res = map.resolution();
+  auto blocked = [&](double x, double y) {
+    const int col = static_cast<int>(std::floor(x)), row = static_cast<int>(std::floor(y));
+    return col < 0 || row < 0 || col >= map.width() || row >= map.height() || !map.IsFree(row, col);
+  };
+  constexpr double kNudge = 1e-6;  // pixels
+  for (size_t i = first + 1; i < path.size(); ++i) {
+    const Waypoint& a = path[i - 1];
+    const Waypoint& b = path[i];
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / (res / 20.0))));
+    for (int k = 0; k <= steps; ++k) {
+      const double t = static_cast<double>(k) / steps;
+      const double x = (a.x + t * (b.x - a.x) - map.origin().x) / res;
+      const double y = (a.y + t * (b.y - a.y) - map.origin().y) / res;
+      if (blocked(x - kNudge, y - kNudge) && blocked(x + kNudge, y - kNudge) &&
+          blocked(x - kNudge, y + kNudge) && blocked(x + kNudge, y + kNudge)) {
+        return absl::StrFormat("segment %d (%s) enters an obstacle at pixel (%d, %d), (%.3f, %.3f) m",
+                               i, b.kind == SegmentKind::kCoverage ? "coverage" : "transition",
+                               static_cast<int>(std::floor(y)), static_cast<int>(std::floor(x)),
+                               a.x + t * (b.x - a.x), a.y + t * (b.y - a.y));
+      }
+    }
+  }
+  return "";
+}
+
 inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoint>& path) {
   CellIndex prev{-1, -1};
   for (size_t i = 0; i < path.size(); ++i) {

@@ -32,6 +32,58 @@ TEST(LineOfSight, DiagonalSqueezeBetweenTwoBlocksIsRejected) {
   EXPECT_FALSE(LineOfSight(g, {0, 1}, {1, 0}));
 }
 
+// A 40 x 40 px map at 0.1 m/px, tool 1 m (10 px per cell): free except a
+// 0.3 m table at pixels 21..23 (rows and cols), inside cell (2, 2) and away
+// from every line between 4-adjacent centres, so the cell stays free with no
+// barrier around it.
+OccupancyMap MapWithSmallTable() {
+  OccupancyMap map(40, 40, 0.1, {0.0, 0.0});
+  for (int r = 0; r < 40; ++r) {
+    for (int c = 0; c < 40; ++c) {
+      const bool table = r >= 21 && r <= 23 && c >= 21 && c <= 23;
+      map.set(r, c, table ? CellState::kOccupied : CellState::kFree);
+    }
+  }
+  return map;
+}
+
+TEST(LineOfSight, SmallObstacleInsideAFreeCellBlocksTheLineThroughIt) {
+  GridOptions opt;
+  opt.cell_size = 1.0;
+  absl::StatusOr<Grid> g = BuildGrid(MapWithSmallTable(), opt);
+  ASSERT_TRUE(g.ok()) << g.status();
+  ASSERT_NE(g->obstacle_pixels(), nullptr);
+  EXPECT_TRUE(g->IsFree(2, 2));
+  EXPECT_EQ(g->CountBarriers(), 0);
+  // (1,1) -> (3,3) runs through (2.2, 2.2) m: the table.
+  EXPECT_FALSE(LineOfSight(*g, {1, 1}, {3, 3}));
+  EXPECT_FALSE(LineOfSight(*g, {3, 3}, {1, 1}));
+  // The same free cells without the pixels cannot see the table.
+  const Grid cells_only(g->rows(), g->cols(), g->cell_size(), g->origin(), g->free_flags(),
+                        g->walls());
+  EXPECT_TRUE(LineOfSight(cells_only, {1, 1}, {3, 3}));
+  // Lines that miss it stay open: along row 2 and column 2 (centre lines),
+  // and diagonals elsewhere.
+  EXPECT_TRUE(LineOfSight(*g, {2, 0}, {2, 3}));
+  EXPECT_TRUE(LineOfSight(*g, {0, 2}, {3, 2}));
+  EXPECT_TRUE(LineOfSight(*g, {1, 2}, {2, 3}));
+  EXPECT_TRUE(LineOfSight(*g, {0, 3}, {3, 0}));
+
+  // The any-angle path from (1,1) to (3,3) goes around the table and is
+  // still close to the straight line's length.
+  AnyAngleSearch search(*g);
+  ASSERT_TRUE(search.Run({1, 1}, StopToken()));
+  const std::vector<CellIndex> path = search.PathTo({3, 3});
+  ASSERT_GE(path.size(), 3u);
+  double len = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) {
+    EXPECT_TRUE(LineOfSight(*g, path[i - 1], path[i]));
+    len += std::hypot(path[i].row - path[i - 1].row, path[i].col - path[i - 1].col);
+  }
+  EXPECT_GT(len, 2.0 * std::sqrt(2.0) + 1e-6);
+  EXPECT_LT(len, 3.5);
+}
+
 TEST(AnyAngleSearch, PathAroundWallIsShortAndFree) {
   Grid g = Grid::FromAscii({
       "..........",
