@@ -112,7 +112,7 @@ absl::StatusOr<std::string> ReadFile(const std::string& path, int64_t max_bytes)
 }  // namespace
 
 absl::Status InputLimits::Validate() const {
-  if (max_image_bytes <= 0 || max_map_pixels <= 0 || max_grid_cells <= 0) {
+  if (max_image_bytes <= 0 || max_map_pixels <= 0 || max_grid_cells <= 0 || max_ranks <= 0) {
     return absl::InvalidArgumentError("input limits must be positive");
   }
   return absl::OkStatus();
@@ -297,6 +297,7 @@ DecompositionOptions DecompositionOptionsFor(const PlanOptions& options,
                                              const InputLimits& limits) {
   DecompositionOptions d = options.decomposition();
   d.grid.max_cells = limits.max_grid_cells;
+  d.max_ranks = limits.max_ranks;
   return d;
 }
 

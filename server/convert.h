@@ -36,6 +36,7 @@ struct InputLimits {
   int64_t max_image_bytes = 64ll << 20;   // encoded image size
   int64_t max_map_pixels = 64'000'000;    // decoded width * height
   int64_t max_grid_cells = 4'000'000;     // tool-width cells
+  int64_t max_ranks = 1000;               // coverage ranks (transition table ~ ranks^2)
 
   absl::Status Validate() const;
 };

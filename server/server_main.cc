@@ -34,6 +34,10 @@ ABSL_FLAG(int, max_retained_plans, 256, "Most plans kept for GetPlan");
 ABSL_FLAG(int64_t, max_image_mb, 64, "Largest accepted map image, MiB");
 ABSL_FLAG(int64_t, max_map_pixels, 64'000'000, "Largest accepted map, pixels");
 ABSL_FLAG(int64_t, max_grid_cells, 4'000'000, "Largest accepted tool-width grid, cells");
+ABSL_FLAG(int64_t, max_ranks, 1000,
+          "Most coverage ranks per plan (the transition table grows with ranks^2)");
+ABSL_FLAG(double, max_request_s, 120.0,
+          "Calls without a deadline stop after this long with DEADLINE_EXCEEDED");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");
 ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
@@ -74,6 +78,13 @@ int main(int argc, char** argv) {
   service.limits.max_image_bytes = absl::GetFlag(FLAGS_max_image_mb) << 20;
   service.limits.max_map_pixels = absl::GetFlag(FLAGS_max_map_pixels);
   service.limits.max_grid_cells = absl::GetFlag(FLAGS_max_grid_cells);
+  service.limits.max_ranks = absl::GetFlag(FLAGS_max_ranks);
+  const double max_request_s = absl::GetFlag(FLAGS_max_request_s);
+  if (!(max_request_s > 0)) {
+    std::fprintf(stderr, "covplan-server: --max_request_s must be a positive number of seconds\n");
+    return 1;
+  }
+  service.max_request_time = absl::Seconds(max_request_s);
   // Room for the image plus YAML and the rest of the request.
   config.max_message_bytes =
       static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));

@@ -36,8 +36,14 @@ bool IsStop(const absl::Status& status) {
 // The status for work that stopped early: the client's cancellation wins,
 // otherwise the deadline was too short for even a first plan.
 absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
-                           const CallInfo& call) {
+                           const CallInfo& call, absl::Duration max_request_time) {
   if (cancel.cancelled()) return absl::CancelledError("call cancelled by the client");
+  if (call.deadline == absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
+    return absl::DeadlineExceededError(absl::StrFormat(
+        "no plan within the server's limit of %g s per call without a deadline "
+        "(--max_request_s) (%s); use a wider tool or a smaller map",
+        absl::ToDoubleSeconds(max_request_time), status.message()));
+  }
   if (absl::IsDeadlineExceeded(status) || call.deadline != absl::InfiniteFuture()) {
     return absl::DeadlineExceededError(
         absl::StrFormat("deadline of %d ms too short for a first plan (%s)",
@@ -67,6 +73,9 @@ absl::Status ServiceOptions::Validate() const {
   if (!(default_budget_s > 0)) return absl::InvalidArgumentError("default_budget_s must be > 0");
   if (deadline_margin < absl::ZeroDuration()) {
     return absl::InvalidArgumentError("deadline_margin must be >= 0");
+  }
+  if (max_request_time <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("max_request_time must be > 0");
   }
   return absl::OkStatus();
 }
@@ -270,6 +279,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     }
     stop = cancel.WithEarlierDeadline(reply_by);
     budget_s = std::min(budget_s, absl::ToDoubleSeconds(reply_by - start));
+  } else {
+    stop = cancel.WithEarlierDeadline(start + options_.max_request_time);
   }
   options.time_limit_s = std::max(budget_s, 1e-3);
   options.stop = stop;
@@ -315,13 +326,16 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       },
       &cached);
   if (!decomposition.ok()) {
-    return IsStop(decomposition.status()) ? StoppedStatus(decomposition.status(), cancel, call)
-                                          : decomposition.status();
+    return IsStop(decomposition.status())
+               ? StoppedStatus(decomposition.status(), cancel, call, options_.max_request_time)
+               : decomposition.status();
   }
 
   absl::StatusOr<CoveragePlan> plan = PlanOnDecomposition(**decomposition, options);
   if (!plan.ok()) {
-    return IsStop(plan.status()) ? StoppedStatus(plan.status(), cancel, call) : plan.status();
+    return IsStop(plan.status())
+               ? StoppedStatus(plan.status(), cancel, call, options_.max_request_time)
+               : plan.status();
   }
   plan->stats.decomposition_cached = cached;
   PlanToProto(*plan, response);

@@ -43,6 +43,9 @@ struct ServiceOptions {
   int max_queue = 16;                        // waiting requests beyond the workers
   size_t cache_budget_bytes = 256ull << 20;  // decomposition cache
   double default_budget_s = 2.0;             // tour search budget without a deadline
+  // Without a deadline, the whole call (decomposition included) stops after
+  // this long with DEADLINE_EXCEEDED rather than holding a worker forever.
+  absl::Duration max_request_time = absl::Seconds(120);
   absl::Duration deadline_margin = absl::Milliseconds(25);  // kept for the reply
   absl::Duration plan_ttl = absl::Minutes(10);
   size_t max_retained_plans = 256;

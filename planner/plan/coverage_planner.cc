@@ -76,6 +76,7 @@ DecompositionOptions PlanOptions::decomposition() const {
 absl::StatusOr<std::shared_ptr<const Decomposition>> BuildDecomposition(
     const OccupancyMap& map, const DecompositionOptions& options, const StopToken& stop) {
   RETURN_IF_ERROR(options.Validate());
+  if (options.max_ranks < 1) return absl::InvalidArgumentError("max_ranks must be >= 1");
   auto d = std::make_shared<Decomposition>();
   absl::Time t = absl::Now();
   ASSIGN_OR_RETURN(Grid full_grid, BuildGrid(map, options.grid));
@@ -90,6 +91,14 @@ absl::StatusOr<std::shared_ptr<const Decomposition>> BuildDecomposition(
                    MakePartitioner(options.partition_solver)->Partition(*d->grid, stop));
   d->partition = std::make_shared<const RankPartition>(std::move(partition));
   d->partition_ms = MsSince(t);
+  const int64_t num_ranks = static_cast<int64_t>(d->partition->ranks.size());
+  if (num_ranks > options.max_ranks) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the map needs %d coverage ranks at tool width %g m, above the limit of %d: the "
+        "all-pairs transition table would take about %d MiB; use a wider tool or split the map",
+        num_ranks, options.grid.cell_size, options.max_ranks,
+        TransitionTable::EstimateBytes(static_cast<int>(2 * num_ranks)) >> 20));
+  }
 
   t = absl::Now();
   ASSIGN_OR_RETURN(d->transitions,

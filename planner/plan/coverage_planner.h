@@ -37,6 +37,10 @@ struct DecompositionOptions {
   GridOptions grid;  // grid.cell_size = tool width
   PartitionSolver partition_solver = PartitionSolver::kMinCut;
   int num_threads = 1;  // for the transition table; not part of the key
+  // The all-pairs transition table grows with the square of the rank count
+  // (and its build time with ranks x cells): beyond this many ranks the
+  // decomposition is refused with InvalidArgument. Not part of the key.
+  int64_t max_ranks = 1000;
   absl::Status Validate() const;
   std::string CacheKey() const;  // stable text form of the fields that matter
 };

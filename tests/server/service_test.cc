@@ -48,6 +48,8 @@ class ServiceTest : public ::testing::Test {
     config.service.worker_threads = 2;
     config.service.limits.max_image_bytes = 1 << 20;
     config.service.limits.max_map_pixels = 1'000'000;
+    config.service.limits.max_ranks = max_ranks_;
+    config.service.max_request_time = max_request_time_;
     absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
     ASSERT_TRUE(server.ok()) << server.status();
     server_ = std::move(*server);
@@ -82,6 +84,8 @@ class ServiceTest : public ::testing::Test {
   }
 
   bool with_metrics_ = false;
+  int64_t max_ranks_ = 1000;
+  absl::Duration max_request_time_ = absl::Seconds(120);
   std::string dir_;
   std::unique_ptr<CovplanServer> server_;
   std::shared_ptr<grpc::Channel> channel_;
@@ -375,6 +379,51 @@ TEST_F(MetricsServiceTest, MetricsEndpointExposesTheFamilies) {
         "covplan_maps_stored 1"}) {
     EXPECT_THAT(*body, HasSubstr(family));
   }
+}
+
+// 120 x 100 cells of 0.5 m with 300 pillars: hundreds of ranks, seconds of
+// transition paths.
+v1::Map PillarMap() {
+  return RasterMap(AsciiToPgm(testing::PillarField(120, 100, 300, 5), 5), 0.1);
+}
+
+class RankLimitServiceTest : public ServiceTest {
+ protected:
+  RankLimitServiceTest() { max_ranks_ = 100; }
+};
+
+TEST_F(RankLimitServiceTest, TooManyRanksIsInvalidArgumentBeforeTheTransitionTable) {
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(PillarMap(), &put).ok());
+  v1::PlanResponse plan;
+  const grpc::Status status = Plan(PlanRequestFor(put.map_id(), 0.5), &plan);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("coverage ranks"));
+  EXPECT_THAT(status.error_message(), HasSubstr("limit of 100"));
+  // A map within the limit still plans.
+  ASSERT_TRUE(Plan(PlanRequestFor(PutTwoRooms(), 0.4), &plan).ok());
+}
+
+class RequestTimeLimitServiceTest : public ServiceTest {
+ protected:
+  RequestTimeLimitServiceTest() { max_request_time_ = absl::Milliseconds(150); }
+};
+
+TEST_F(RequestTimeLimitServiceTest, CallWithoutDeadlineStopsAtTheServerLimit) {
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(PillarMap(), &put).ok());
+  v1::PlanRequest request = PlanRequestFor(put.map_id(), 0.5);
+  request.set_time_limit_s(30.0);
+  grpc::ClientContext context;  // no deadline
+  v1::PlanResponse plan;
+  const absl::Time start = absl::Now();
+  const grpc::Status status = stub_->Plan(&context, request, &plan);
+  const absl::Duration took = absl::Now() - start;
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("--max_request_s"));
+  EXPECT_LT(took, absl::Seconds(10));
+  // The worker is free again: a small map plans.
+  ASSERT_TRUE(Plan(PlanRequestFor(PutTwoRooms(), 0.4), &plan).ok());
 }
 
 TEST_F(ServiceTest, DrainingServiceRefusesNewWork) {
