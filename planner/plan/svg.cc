@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -91,15 +92,20 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map) {
                           en.x, en.y, 0.6 * s, 0.15 * s);
   }
   absl::StrAppend(&out, "</g>\n");
-  // Legend above the map (not flipped).
-  const double fs = 0.45 * legend_h;
+  // Legend above the map (not flipped), sized to fit the map's width (sans-serif
+  // glyphs average about 0.56 em).
+  const std::string summary =
+      absl::StrFormat(" · %d ranks, %d turns, %.0f s", static_cast<int>(plan.stats.num_ranks),
+                      static_cast<int>(plan.stats.num_turns), plan.stats.estimated_duration_s);
+  constexpr int kLegendChars = 54;  // "horizontal ranks · vertical ranks · transitions"
+  const double chars = kLegendChars + static_cast<double>(summary.size());
+  const double fs = std::min(0.45 * legend_h, (w - 0.4) / (0.56 * chars));
   absl::StrAppendFormat(&out,
                         "<text x=\"%.4f\" y=\"%.4f\" font-family=\"sans-serif\" font-size=\"%.4f\">"
                         "<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
                         "<tspan fill=\"#8e44ad\">vertical ranks</tspan> · "
-                        "<tspan fill=\"#1f8a5b\">transitions</tspan> · %d ranks, %d turns, %.0f s</text>\n",
-                        o.x + 0.2, -0.35 * legend_h, fs, static_cast<int>(plan.stats.num_ranks),
-                        static_cast<int>(plan.stats.num_turns), plan.stats.estimated_duration_s);
+                        "<tspan fill=\"#1f8a5b\">transitions</tspan>%s</text>\n",
+                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), summary);
   absl::StrAppend(&out, "</svg>\n");
   return out;
 }
