@@ -131,8 +131,12 @@ TEST(GtspLibTest, MalformedFilesAreRejectedWithLineInfo) {
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 4\n", 2), "not terminated by -1");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n1 2 4 -1\n", 2), "set id 1");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 5 -1\n", 2), "outside [1, 4]");
-  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 -1\n", 2), "belongs to no GTSP set");
-  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 3 4 -1\n", 2), "disjoint");
+  // Messages name vertices and sets by the file's 1-based ids.
+  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 -1\n", 2),
+                   "vertex 4 belongs to no set");
+  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 3 4 -1\n", 2),
+                   "line 14: vertex 3 is in set 1 and in set 2; sets must be disjoint");
+  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 2 3 4 -1\n2 -1\n", 2), "set 2 is empty");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n", 2), "ends after 1 of 2 sets");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 4 -1\n3 -1\n", 2), "unexpected data");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, kTwoSets, 3), "GTSP_SET_SECTION ends after 2 of 3");

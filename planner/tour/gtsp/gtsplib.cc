@@ -239,6 +239,7 @@ absl::Status FillSets(const Header& h, GtspInstance& inst) {
   if (h.sets_line == 0) return Error(h.last_line, "missing GTSP_SET_SECTION");
   inst.sets.assign(m, {});
   std::vector<char> seen(m, 0);
+  std::vector<long> owner(inst.num_vertices, 0);  // 1-based set id, 0 = none
   size_t k = 0;
   for (long s = 0; s < m; ++s) {
     if (k >= h.sets.size()) {
@@ -263,11 +264,23 @@ absl::Status FillSets(const Header& h, GtspInstance& inst) {
         return Error(h.sets[k - 1].line,
                      absl::StrCat("set ", id, " lists vertex ", v, ", outside [1, ", inst.num_vertices, "]"));
       }
+      if (owner[v - 1] != 0) {
+        return Error(h.sets[k - 1].line, absl::StrCat("vertex ", v, " is in set ", owner[v - 1],
+                                                      " and in set ", id, "; sets must be disjoint"));
+      }
+      owner[v - 1] = id;
       inst.sets[id - 1].push_back(static_cast<int>(v - 1));
     }
+    if (inst.sets[id - 1].empty()) return Error(set_line, absl::StrCat("set ", id, " is empty"));
   }
   if (k != h.sets.size()) {
     return Error(h.sets[k].line, absl::StrCat("unexpected data after the ", m, " sets of GTSP_SET_SECTION"));
+  }
+  for (long v = 0; v < inst.num_vertices; ++v) {
+    if (owner[v] == 0) {
+      return Error(h.sets_line, absl::StrCat("vertex ", v + 1, " belongs to no set; the sets must "
+                                             "partition the vertices 1..", inst.num_vertices));
+    }
   }
   return absl::OkStatus();
 }
