@@ -91,7 +91,8 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       io_pool_(/*threads=*/2, /*max_queue=*/64),
       // Admission is bounded by TryAdmitSolve; the pool's own bound is slack
       // for solves that have released their slot but not yet returned.
-      pool_(options.worker_threads, 2 * (options.worker_threads + options.max_queue)) {
+      pool_(options.worker_threads, 2 * (options.worker_threads + options.max_queue)),
+      warm_pool_(/*threads=*/1, /*max_queue=*/4) {
   metrics_->worker_threads().Set(options.worker_threads);
   metrics_->queue_capacity().Set(options.max_queue);
   metrics_->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
@@ -101,6 +102,8 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
 CoveragePlannerService::~CoveragePlannerService() { Shutdown(); }
 
 void CoveragePlannerService::Shutdown() {
+  background_stop_.Cancel();
+  warm_pool_.Shutdown();
   pool_.Shutdown();
   io_pool_.Shutdown();
 }
@@ -254,6 +257,55 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
 
 // ---------------------------------------------------------------- plans
 
+absl::StatusOr<std::shared_ptr<const Decomposition>> CoveragePlannerService::BuildFor(
+    const std::string& map_id, const v1::Map* inline_map, const PlanOptions& options,
+    const DecompositionOptions& decomposition_options, const StopToken& stop) {
+  OccupancyMap map;
+  if (inline_map != nullptr) {
+    ASSIGN_OR_RETURN(map, MapFromProto(*inline_map, options_.limits));
+  } else {
+    ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
+    ASSIGN_OR_RETURN(map, MapFromProto(stored.map(), options_.limits));
+  }
+  RETURN_IF_ERROR(ValidatePlanForMap(options, map, options_.limits));
+  ASSIGN_OR_RETURN(std::shared_ptr<const Decomposition> built,
+                   BuildDecomposition(map, decomposition_options, stop));
+  if (built == nullptr || built->grid == nullptr || built->grid->CountFree() == 0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "no grid cell is free at tool width %g m: no %g m square is more than %g%% free",
+        options.robot.tool_width_m, options.robot.tool_width_m, 100 * options.min_free_fraction));
+  }
+  return built;
+}
+
+void CoveragePlannerService::WarmInBackground(const std::string& key, const std::string& map_id,
+                                              std::shared_ptr<const v1::Map> inline_map,
+                                              const PlanOptions& options,
+                                              const DecompositionOptions& decomposition_options) {
+  if (draining()) return;
+  const bool queued = warm_pool_.TrySubmit([this, key, map_id, inline_map, options,
+                                            decomposition_options] {
+    const absl::Time start = absl::Now();
+    bool hit = false;
+    absl::StatusOr<std::shared_ptr<const Decomposition>> built = cache_.GetOrBuild(
+        key, background_stop_.WithEarlierDeadline(start + options_.max_request_time),
+        [&](const StopToken& stop) {
+          return BuildFor(map_id, inline_map.get(), options, decomposition_options, stop);
+        },
+        &hit);
+    LogLine(built.ok() ? "info" : "warn", "background decomposition finished",
+            {{"map", map_id.substr(0, 12)},
+             {"key", key.substr(key.find('/') + 1)},
+             {"ms", absl::StrFormat("%.1f", absl::ToDoubleMilliseconds(absl::Now() - start))},
+             {"result", built.ok() ? (hit ? "already cached" : "cached")
+                                   : std::string(built.status().message())}});
+  });
+  if (!queued) {
+    LogLine("warn", "background decomposition dropped: queue full",
+            {{"map", map_id.substr(0, 12)}});
+  }
+}
+
 absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                                              const StopToken& cancel, v1::PlanResponse* response) {
   const absl::Time start = absl::Now();
@@ -305,27 +357,21 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   bool cached = false;
   absl::StatusOr<std::shared_ptr<const Decomposition>> decomposition = cache_.GetOrBuild(
       key, stop,
-      [&](const StopToken& build_stop) -> absl::StatusOr<std::shared_ptr<const Decomposition>> {
-        OccupancyMap map;
-        if (request.has_map()) {
-          ASSIGN_OR_RETURN(map, MapFromProto(request.map(), options_.limits));
-        } else {
-          ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
-          ASSIGN_OR_RETURN(map, MapFromProto(stored.map(), options_.limits));
-        }
-        RETURN_IF_ERROR(ValidatePlanForMap(options, map, options_.limits));
-        ASSIGN_OR_RETURN(std::shared_ptr<const Decomposition> built,
-                         BuildDecomposition(map, decomposition_options, build_stop));
-        if (built == nullptr || built->grid == nullptr || built->grid->CountFree() == 0) {
-          return absl::InvalidArgumentError(absl::StrFormat(
-              "no grid cell is free at tool width %g m: no %g m square is more than %g%% free",
-              options.robot.tool_width_m, options.robot.tool_width_m,
-              100 * options.min_free_fraction));
-        }
-        return built;
+      [&](const StopToken& build_stop) {
+        return BuildFor(map_id, request.has_map() ? &request.map() : nullptr, options,
+                        decomposition_options, build_stop);
       },
       &cached);
   if (!decomposition.ok()) {
+    if (IsStop(decomposition.status()) && !cancel.cancelled() &&
+        call.deadline != absl::InfiniteFuture()) {
+      // Cut off by this call's deadline: finish it in the background so the
+      // next call finds it cached. (A call without a deadline that hit
+      // --max_request_s already had that long; it is not retried.)
+      WarmInBackground(key, map_id,
+                       request.has_map() ? std::make_shared<const v1::Map>(request.map()) : nullptr,
+                       options, decomposition_options);
+    }
     return IsStop(decomposition.status())
                ? StoppedStatus(decomposition.status(), cancel, call, options_.max_request_time)
                : decomposition.status();

@@ -6,6 +6,9 @@
 // admitted solves, Plan answers RESOURCE_EXHAUSTED at once.
 // A Plan's gRPC deadline (minus ServiceOptions::deadline_margin) is its
 // anytime budget; a cancelled call cancels its StopToken so the work stops.
+// A decomposition (grid, ranks, transition table) that a call's deadline cut
+// off is finished on a background thread, so later calls for the same map
+// find it cached instead of failing the same way forever.
 //
 //   MapStore store = ...; ServerMetrics metrics;
 //   CoveragePlannerService service(ServiceOptions{}, store.get(), &metrics);
@@ -85,7 +88,10 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
                                     const v1::GetPlanRequest* request,
                                     v1::PlanResponse* response) override;
 
-  void StartDraining() { draining_.store(true); }
+  void StartDraining() {
+    draining_.store(true);
+    background_stop_.Cancel();
+  }
   bool draining() const { return draining_.load(); }
   // Runs what is queued (cancelled calls finish quickly) and joins workers.
   void Shutdown();
@@ -111,6 +117,14 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   bool TryAdmitSolve();
   void ReleaseSolve();
   absl::Status RunPutMap(const v1::PutMapRequest& request, v1::PutMapResponse* response);
+  // Loads the map (inline or from the store) and builds its decomposition.
+  absl::StatusOr<std::shared_ptr<const Decomposition>> BuildFor(
+      const std::string& map_id, const v1::Map* inline_map, const PlanOptions& options,
+      const DecompositionOptions& decomposition_options, const StopToken& stop);
+  // Queues a build of `key` on the background pool (dropped when it is full).
+  void WarmInBackground(const std::string& key, const std::string& map_id,
+                        std::shared_ptr<const v1::Map> inline_map, const PlanOptions& options,
+                        const DecompositionOptions& decomposition_options);
   std::string NewPlanId();
 
   const ServiceOptions options_;
@@ -127,9 +141,11 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // time to plan before its deadline is refused at once.
   std::atomic<int64_t> mean_solve_us_{0};
   uint64_t id_salt_;
+  StopToken background_stop_;  // cancelled when draining or shutting down
   // Last: their threads stop before the rest is destroyed.
-  WorkerPool io_pool_;  // PutMap / GetMap / DeleteMap
-  WorkerPool pool_;     // Plan solves
+  WorkerPool io_pool_;    // PutMap / GetMap / DeleteMap
+  WorkerPool pool_;       // Plan solves
+  WorkerPool warm_pool_;  // decompositions cut off by a caller's deadline
 };
 
 }  // namespace covplan

@@ -387,6 +387,38 @@ v1::Map PillarMap() {
   return RasterMap(AsciiToPgm(testing::PillarField(120, 100, 300, 5), 5), 0.1);
 }
 
+TEST_F(ServiceTest, DecompositionCutOffByADeadlineIsFinishedInTheBackground) {
+  // 60 x 50 cells of 0.5 m with 80 pillars: a transition table that takes far
+  // longer than a 60 ms deadline (25 ms of which are kept for the reply).
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(RasterMap(AsciiToPgm(testing::PillarField(60, 50, 80, 3), 5), 0.1), &put).ok());
+  const v1::PlanRequest request = PlanRequestFor(put.map_id(), 0.5);
+  auto plan_within = [&](std::chrono::milliseconds deadline, v1::PlanResponse* response) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + deadline);
+    return stub_->Plan(&context, request, response);
+  };
+  v1::PlanResponse response;
+  grpc::Status status = plan_within(std::chrono::milliseconds(60), &response);
+  ASSERT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+  // Short calls keep failing only until the background build lands in the
+  // cache; then the same short deadline gets a plan from the cached
+  // decomposition.
+  const absl::Time give_up = absl::Now() + absl::Seconds(120);
+  int refused = 0;
+  while (absl::Now() < give_up) {
+    status = plan_within(std::chrono::milliseconds(150), &response);
+    if (status.ok()) break;
+    ASSERT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+    ++refused;
+    absl::SleepFor(absl::Milliseconds(100));
+  }
+  ASSERT_TRUE(status.ok()) << "still " << status.error_message() << " after " << refused << " calls";
+  EXPECT_TRUE(response.stats().decomposition_cached());
+  EXPECT_GT(response.stats().num_ranks(), 0);
+  EXPECT_GE(server_->service().cache().stats().misses, 1);
+}
+
 class RankLimitServiceTest : public ServiceTest {
  protected:
   RankLimitServiceTest() { max_ranks_ = 100; }
