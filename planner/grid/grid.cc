@@ -67,8 +67,14 @@ int64_t Grid::CountFree() const {
 }
 
 CellIndex Grid::CellAt(Point2 p) const {
-  return {static_cast<int>(std::floor((p.y - origin_.y) / cell_size_)),
-          static_cast<int>(std::floor((p.x - origin_.x) / cell_size_))};
+  // Clamped to [-2, n + 1]: far-away (or non-finite) points stay out of
+  // bounds and at least two cells from the grid, and the int cast is defined.
+  auto index = [](double v, int n) {
+    if (!(v >= -2.0)) return -2;  // also NaN
+    if (v > n + 1.0) return n + 1;
+    return static_cast<int>(std::floor(v));
+  };
+  return {index((p.y - origin_.y) / cell_size_, rows_), index((p.x - origin_.x) / cell_size_, cols_)};
 }
 
 std::vector<std::string> Grid::ToRowStrings() const {

@@ -100,7 +100,8 @@ class Grid {
     return {origin_.x + (c + 0.5) * cell_size_, origin_.y + (r + 0.5) * cell_size_};
   }
   Point2 CellCenter(CellIndex c) const { return CellCenter(c.row, c.col); }
-  // Cell containing a map-frame point (may be out of bounds).
+  // Cell containing a map-frame point (may be out of bounds; points more
+  // than a cell outside map to row/col -2 or rows/cols + 1).
   CellIndex CellAt(Point2 p) const;
 
   // One string per row (row 0 first) of '1' free / '0' blocked.

@@ -22,7 +22,9 @@ absl::StatusOr<CellIndex> PoseCell(const Grid& grid, const Pose2& p, const char*
   if (grid.IsFree(c)) return c;
   std::optional<CellIndex> best;
   double best_d2 = std::numeric_limits<double>::infinity();
-  for (int dr = -1; dr <= 1; ++dr) {
+  // Far outside the grid (CellAt clamps to -2 / n + 1): no free neighbour.
+  const bool near_grid = c.row >= -1 && c.col >= -1 && c.row <= grid.rows() && c.col <= grid.cols();
+  for (int dr = -1; near_grid && dr <= 1; ++dr) {
     for (int dc = -1; dc <= 1; ++dc) {
       const CellIndex n{c.row + dr, c.col + dc};
       if (!grid.IsFree(n)) continue;

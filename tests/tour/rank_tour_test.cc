@@ -146,7 +146,8 @@ TEST(RankTour, StartPoseInBlockedCellJoinsTheNearestAdjacentFreeCell) {
 
 TEST(RankTour, PoseFarFromFreeCellsIsInvalidArgument) {
   Fixture f = Make(Grid::FromAscii(kRooms, 1.0));
-  for (Pose2 pose : {Pose2{-5.0, -5.0, 0.0}, Pose2{40.0, 3.0, 0.0}}) {
+  for (Pose2 pose : {Pose2{-5.0, -5.0, 0.0}, Pose2{40.0, 3.0, 0.0}, Pose2{1e300, -1e300, 0.0},
+                     Pose2{-1e300, 1e18, 0.0}}) {
     RobotModel robot;
     robot.start = pose;
     auto cost = RankTourCost::Create(f.grid, f.partition.ranks, *f.table, robot, StopToken());
