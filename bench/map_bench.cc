@@ -15,7 +15,7 @@
 #include "planner/grid/map_io.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
-#include "planner/plan/coverage_planner.h"
+#include "planner/engine/plan_coverage.h"
 #include "planner/plan/svg.h"
 #include <fstream>
 
@@ -67,14 +67,17 @@ int Run(const Args& a) {
     PlanOptions po;
     po.robot.tool_width_m = a.tool_width;
     po.num_threads = a.threads;
-    DecompositionOptions dopt = po.decomposition();
-    dopt.num_threads = a.threads;
-    auto d = BuildDecomposition(*map, dopt, StopToken());
+    // The per-map artifacts once (kept for the reference search below).
+    LocalArtifactCache cache;
+    PlanOptions warm = po;
+    warm.tour_solver = TourSolver::kGreedy;
+    auto d = PlanCoverageWithArea(*map, warm, &cache, path);
     if (!d.ok()) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(d.status().message()).c_str());
       return 1;
     }
-    const Grid& grid = *(*d)->grid;
+    const CoverageArea& area = *d->area;
+    const Grid& grid = *area.cover;
     // Partition timings on the planned grid, median of runs.
     std::vector<double> cut_ms, lp_ms;
     size_t cut_ranks = 0, lp_ranks = 0;
@@ -91,16 +94,18 @@ int Run(const Args& a) {
       }
     }
     // Thesis-style grid (no barriers, all components) for comparison.
-    GridOptions plain = dopt.grid;
+    GridOptions plain;
+    plain.cell_size = po.robot.tool_width_m;
+    plain.min_free_fraction = po.min_free_fraction;
     plain.thin_wall_barriers = false;
     auto plain_grid = BuildGrid(*map, plain);
     const size_t plain_ranks = MinCutPartitioner().Partition(*plain_grid, StopToken())->ranks.size();
     absl::StrAppendFormat(&partition_table, "| %s | %d x %d | %d | %d | %d | %s | %d | %.2f | %s | %.4f |\n",
                           Base(path), grid.rows(), grid.cols(), grid.CountFree(),
-                          (*d)->unreachable_free_cells, cut_ranks,
+                          area.unreachable_cells, cut_ranks,
                           a.lp ? absl::StrCat(lp_ranks) : "-", plain_ranks, Median(cut_ms),
                           a.lp ? absl::StrFormat("%.1f", Median(lp_ms)) : "-",
-                          (*d)->covered_free_area_ratio);
+                          area.covered_free_area_ratio);
     std::fflush(stdout);
     // Long reference search for the tour gap.
     double reference = 0.0;
@@ -108,7 +113,7 @@ int Run(const Args& a) {
       PlanOptions ro = po;
       ro.time_limit_s = a.reference_s;
       ro.tour_effort = GtspEffort::kThorough;
-      auto ref = PlanOnDecomposition(**d, ro);
+      auto ref = PlanCoverage(*map, ro, &cache, path);
       if (ref.ok()) reference = ref->stats.estimated_duration_s;
     }
     for (TourSolver ts : {TourSolver::kGreedy, TourSolver::kGtsp}) {

@@ -39,7 +39,8 @@ absl::StatusOr<std::optional<int64_t>> ParsedArgs::GetInt(const std::string& nam
 
 absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
                                      const std::set<std::string>& value_flags,
-                                     const std::set<std::string>& bool_flags) {
+                                     const std::set<std::string>& bool_flags,
+                                     const std::set<std::string>& repeatable_flags) {
   ParsedArgs parsed;
   std::set<std::string> seen;
   for (size_t i = 0; i < args.size(); ++i) {
@@ -52,6 +53,16 @@ absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
     if (size_t eq = name.find('='); eq != std::string::npos) {
       value = name.substr(eq + 1);
       name = name.substr(0, eq);
+    }
+    if (repeatable_flags.count(name) != 0) {
+      if (!value) {
+        if (i + 1 >= args.size()) {
+          return absl::InvalidArgumentError(absl::StrCat("--", name, " needs a value"));
+        }
+        value = args[++i];
+      }
+      parsed.repeated[name].push_back(*value);
+      continue;
     }
     if (!seen.insert(name).second) {
       return absl::InvalidArgumentError(absl::StrCat("--", name, " given more than once"));

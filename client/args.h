@@ -23,6 +23,7 @@ namespace covplan {
 struct ParsedArgs {
   std::map<std::string, std::string> values;  // flag name (without --) -> value
   std::set<std::string> switches;             // boolean flags that are on
+  std::map<std::string, std::vector<std::string>> repeated;  // repeatable flags, in order
 
   std::optional<std::string> Get(const std::string& name) const;
   bool Has(const std::string& name) const { return switches.count(name) != 0; }
@@ -31,11 +32,12 @@ struct ParsedArgs {
   absl::StatusOr<std::optional<int64_t>> GetInt(const std::string& name) const;
 };
 
-// InvalidArgument on unknown flags, a missing value, a repeated flag or a
-// positional argument.
+// InvalidArgument on unknown flags, a missing value, a repeated flag (other
+// than one of `repeatable_flags`) or a positional argument.
 absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
                                      const std::set<std::string>& value_flags,
-                                     const std::set<std::string>& bool_flags);
+                                     const std::set<std::string>& bool_flags,
+                                     const std::set<std::string>& repeatable_flags = {});
 
 // Shared main of a subcommand: prints `usage` for --help/-h, else runs
 // `run(args)` and maps its status to an exit code (errors on stderr, prefixed

@@ -12,7 +12,7 @@
 #include "client/args.h"
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
-#include "server/convert.h"
+#include "api/convert.h"
 
 namespace covplan {
 namespace {

@@ -3,20 +3,30 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <sstream>
 #include <fstream>
 #include <optional>
 #include <random>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "absl/strings/str_format.h"
 #include "client/args.h"
+#include "api/geojson.h"
 #include "client/remote.h"
+#include "planner/engine/artifact_cache.h"
+#include "planner/engine/engine.h"
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "planner/plan/svg.h"
 
 namespace covplan {
 namespace {
+
+// --local without --time-limit: the same tour budget as the server default.
+constexpr double kLocalDefaultBudgetS = 2.0;
 
 constexpr char kUsage[] =
     "usage: covplan plan --map FILE [--resolution M] [--tool-width M]\n"
@@ -25,9 +35,14 @@ constexpr char kUsage[] =
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
-    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]]\n"
-    "FILE is a map_server .yaml (with the image it names) or a bare .pgm/.png (needs\n"
-    "--resolution). Without --local the server defaults to 127.0.0.1:50051.\n"
+    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp]\n"
+    "                    [--region AREA]... [--no-go AREA]...\n"
+    "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
+    "--resolution) or a .geojson polygon map (Polygon/MultiPolygon in metres; the free\n"
+    "space). Without --local the server defaults to 127.0.0.1:50051.\n"
+    "AREA is a GeoJSON file or a ring \"x,y x,y x,y ...\" in metres (closed for you):\n"
+    "--region covers only the free cells mostly inside the regions (the rest of the\n"
+    "map may still be driven through); --no-go is never entered. Both repeat.\n"
     "Poses are in metres in the map frame, THETA in radians (default 0). Without\n"
     "--start the robot starts at the first rank; without --end it returns to the start.\n"
     "A pose in a blocked cell next to a free one (a dock at a wall) joins the grid there.\n";
@@ -73,6 +88,39 @@ std::string ServerError(const std::string& target, const absl::Status& status) {
                       ": ", status.message());
 }
 
+// --region / --no-go: a GeoJSON file, or "x,y x,y x,y ..." (one ring, closed
+// here if open).
+absl::Status ParseArea(const std::string& flag, const std::string& text,
+                       google::protobuf::RepeatedPtrField<v1::Polygon>* out) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(text, ec)) {
+    std::ifstream in(text, std::ios::binary);
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    if (!in.good() && !in.eof()) return absl::InvalidArgumentError(absl::StrCat("cannot read ", text));
+    ASSIGN_OR_RETURN(std::vector<PolygonInput> polygons, ParseGeoJsonPolygons(buffer.str(), text));
+    PolygonsToProto(polygons, out);
+    return absl::OkStatus();
+  }
+  PolygonInput polygon;
+  for (absl::string_view token : absl::StrSplit(text, ' ', absl::SkipEmpty())) {
+    std::vector<absl::string_view> xy = absl::StrSplit(token, ',');
+    double x = 0, y = 0;
+    if (xy.size() != 2 || !absl::SimpleAtod(xy[0], &x) || !absl::SimpleAtod(xy[1], &y)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--", flag, " must be a GeoJSON file or a ring \"x,y x,y x,y ...\"; '", token,
+          "' is neither a file nor an x,y point"));
+    }
+    polygon.outer.push_back({x, y});
+  }
+  if (!polygon.outer.empty() && (polygon.outer.front().x != polygon.outer.back().x ||
+                                 polygon.outer.front().y != polygon.outer.back().y)) {
+    polygon.outer.push_back(polygon.outer.front());
+  }
+  PolygonsToProto({polygon}, out);
+  return absl::OkStatus();
+}
+
 struct PlanCommand {
   std::string map_path;
   MapFileOverrides overrides;
@@ -90,8 +138,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
       ParseArgs(args,
                 {"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
-                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end"},
-                {"local", "negate"}));
+                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner"},
+                {"local", "negate"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   c.map_path = *a.Get("map");
@@ -131,6 +179,13 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   if (seed) {
     if (*seed < 0 || *seed > UINT32_MAX) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
     r.set_seed(static_cast<uint32_t>(*seed));
+  }
+  if (auto p = a.Get("planner")) r.set_planner(*p);
+  if (auto it = a.repeated.find("region"); it != a.repeated.end()) {
+    for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("region", text, r.mutable_regions()));
+  }
+  if (auto it = a.repeated.find("no-go"); it != a.repeated.end()) {
+    for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("no-go", text, r.mutable_no_go()));
   }
   if (auto p = a.Get("partition")) {
     if (*p == "mincut") r.set_partition_solver(v1::MINCUT);
@@ -176,7 +231,7 @@ absl::Status Run(const std::vector<std::string>& args) {
   const PlanCommand& c = *parsed;
   InputLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(c.map_path, c.overrides, limits));
-  if (map.raster().yaml().empty() && !map.raster().has_resolution()) {
+  if (map.has_raster() && map.raster().yaml().empty() && !map.raster().has_resolution()) {
     return absl::InvalidArgumentError(
         absl::StrCat(c.map_path, " is a bare image: --resolution M (metres per pixel) is required"));
   }
@@ -188,9 +243,12 @@ absl::Status Run(const std::vector<std::string>& args) {
   }
   if (c.svg) {
     // In server mode the map is decoded here too, for the SVG background.
-    ASSIGN_OR_RETURN(OccupancyMap decoded, MapFromProto(map, limits));
+    ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(map, limits));
     ASSIGN_OR_RETURN(CoveragePlan plan, PlanFromProto(response));
-    RETURN_IF_ERROR(WriteFile(*c.svg, RenderPlanSvg(plan, &decoded)));
+    SvgZones zones;
+    zones.regions = PolygonsFromProto(response.regions());
+    zones.no_go = PolygonsFromProto(response.no_go());
+    RETURN_IF_ERROR(WriteFile(*c.svg, RenderPlanSvg(plan, site.raster.get(), zones)));
   }
   return absl::OkStatus();
 }
@@ -200,38 +258,41 @@ absl::Status Run(const std::vector<std::string>& args) {
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
                                              const InputLimits& limits) {
   if (!request.has_map()) return absl::InvalidArgumentError("local planning needs an inline map");
-  ASSIGN_OR_RETURN(OccupancyMap map, MapFromProto(request.map(), limits));
-  ASSIGN_OR_RETURN(PlanOptions options, PlanOptionsFromProto(request));
-  RETURN_IF_ERROR(ValidatePlanForMap(options, map, limits));
-  const DecompositionOptions decomposition_options = DecompositionOptionsFor(options, limits);
-  ASSIGN_OR_RETURN(std::shared_ptr<const Decomposition> decomposition,
-                   BuildDecomposition(map, decomposition_options, options.stop));
-  if (decomposition->grid == nullptr || decomposition->grid->CountFree() == 0) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "no grid cell is free at tool width %g m", options.robot.tool_width_m));
-  }
-  ASSIGN_OR_RETURN(CoveragePlan plan, PlanOnDecomposition(*decomposition, options));
+  ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
+  if (request.time_limit_s() <= 0) plan_request.common.time_limit_s = kLocalDefaultBudgetS;
+  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  LocalArtifactCache cache;
+  const PlanningEngine engine(&registry, &cache, EngineLimitsFor(limits));
+  MapSource source;
+  source.map_id = ComputeMapId(request.map());
+  source.load = [&]() { return SiteFromProto(request.map(), limits); };
+  ASSIGN_OR_RETURN(EngineResult result, engine.Plan(source, plan_request));
+  RetainedPlan retained;
+  retained.plan_id = absl::StrFormat("local-%016x", std::random_device{}() * 0x9e3779b97f4a7c15ull);
+  retained.map_id = source.map_id;
+  retained.plan = std::move(result.plan);
+  retained.request = std::move(plan_request);
   v1::PlanResponse response;
-  PlanToProto(plan, &response);
-  response.set_plan_id(absl::StrFormat("local-%016x", std::random_device{}() * 0x9e3779b97f4a7c15ull));
-  response.set_map_id(ComputeMapId(request.map()));
+  RetainedPlanToProto(retained, &response);
   return response;
 }
 
 std::string FormatPlanSummary(const v1::PlanResponse& r) {
   const v1::PlanStats& s = r.stats();
   return absl::StrFormat(
-      "plan       %s (map %s)\n"
-      "grid       %d x %d cells of %.3f m, %d free (%d unreachable, not planned)\n"
+      "plan       %s (map %s, planner %s)\n"
+      "grid       %d x %d cells of %.3f m, %d to cover, %d swept (%d unreachable, not planned)%s\n"
       "ranks      %d (partition %s)\n"
-      "tour       %s, %d turns%s\n"
+      "tour       %s, %d turns, %s\n"
       "length     coverage %.1f m, transitions %.1f m\n"
       "coverage   %.1f %% of the free area\n"
       "duration   %.1f s estimated (turning %.1f s)\n"
       "timings    planning %.1f ms: grid %.1f, partition %.1f, transitions %.1f, tour %.1f ms%s\n",
-      r.plan_id(), r.map_id().substr(0, 12), s.grid_rows(), s.grid_cols(),
-      r.grid().cell_size_m(), s.free_cells(), s.unreachable_free_cells(), s.num_ranks(), s.partition_solver(),
-      s.tour_solver(), s.num_turns(), s.tour_cut_short() ? " (search cut short by the budget)" : "",
+      r.plan_id(), r.map_id().substr(0, 12), r.planner(), s.grid_rows(), s.grid_cols(),
+      r.grid().cell_size_m(), s.free_cells(), s.covered_cells(), s.unreachable_free_cells(),
+      s.no_go_cells() > 0 ? absl::StrFormat(", %d closed by no-go zones", s.no_go_cells()) : "",
+      s.num_ranks(), s.partition_solver(), s.tour_solver(), s.num_turns(),
+      r.termination().detail().empty() ? "converged" : r.termination().detail(),
       s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
       s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
       s.partition_ms(), s.transitions_ms(), s.tour_ms(),

@@ -14,7 +14,7 @@
 
 #include "absl/status/statusor.h"
 #include "covplan/v1/covplan.pb.h"
-#include "server/convert.h"
+#include "api/convert.h"
 
 namespace covplan {
 

@@ -24,7 +24,7 @@ echo "|---|---|---|---|---|"
 for tw in 0.30 0.32 0.34 0.36 0.38 0.40 0.42 0.45 0.5 0.6 0.7 0.8 1.0 0.31 0.33 0.35 0.37 0.39 0.41 0.43; do
   "$BIN"/covplan plan --map maps/sample_office.yaml --server "127.0.0.1:$PORT" --tool-width "$tw" \
     --time-limit 0.2 --out "$STORE/plan.json" >/dev/null
-  echo "| $tw | $(( $(awk '/VmRSS/ {print $2}' /proc/$SERVER/status) / 1024 )) | $(metric covplan_decomposition_cache_bytes) | $(metric covplan_decomposition_cache_entries) | $(metric covplan_decomposition_cache_evictions_total) |"
+  echo "| $tw | $(( $(awk '/VmRSS/ {print $2}' /proc/$SERVER/status) / 1024 )) | $(metric covplan_artifact_cache_bytes) | $(metric covplan_artifact_cache_entries) | $(metric covplan_artifact_cache_evictions_total) |"
 done
 echo
 echo "budget $((CACHE_MB * 1048576)) bytes; peak RSS (VmHWM) $(( $(awk '/VmHWM/ {print $2}' /proc/$SERVER/status) / 1024 )) MiB"

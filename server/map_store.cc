@@ -13,8 +13,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
-#include "server/convert.h"
-#include "server/digest.h"
+#include "api/convert.h"
+#include "api/digest.h"
 
 namespace covplan {
 namespace {

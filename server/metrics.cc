@@ -40,15 +40,15 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
   in_flight_ = NewGauge(r, "covplan_solves_in_flight", "Requests being worked on now");
   worker_threads_ = NewGauge(r, "covplan_worker_threads", "Size of the worker pool");
   queue_capacity_ = NewGauge(r, "covplan_worker_queue_capacity", "Bound of the worker queue");
-  cache_hits_ = NewCounter(r, "covplan_decomposition_cache_hits_total",
-                           "Decomposition lookups served from the cache or a concurrent build");
-  cache_misses_ = NewCounter(r, "covplan_decomposition_cache_misses_total",
-                             "Decomposition lookups that had to build");
-  cache_evictions_ = NewCounter(r, "covplan_decomposition_cache_evictions_total",
-                                "Decompositions evicted to stay within the byte budget");
-  cache_bytes_ = NewGauge(r, "covplan_decomposition_cache_bytes", "Bytes held by the cache");
-  cache_entries_ = NewGauge(r, "covplan_decomposition_cache_entries", "Entries in the cache");
-  cache_budget_bytes_ = NewGauge(r, "covplan_decomposition_cache_budget_bytes",
+  cache_hits_ = NewCounter(r, "covplan_artifact_cache_hits_total",
+                           "Per-map artifact lookups (grid, area, partition, transitions) served from the cache or a concurrent build");
+  cache_misses_ = NewCounter(r, "covplan_artifact_cache_misses_total",
+                             "Per-map artifact lookups that had to build");
+  cache_evictions_ = NewCounter(r, "covplan_artifact_cache_evictions_total",
+                                "Artifacts evicted to stay within the byte budget");
+  cache_bytes_ = NewGauge(r, "covplan_artifact_cache_bytes", "Bytes held by the cache");
+  cache_entries_ = NewGauge(r, "covplan_artifact_cache_entries", "Entries in the cache");
+  cache_budget_bytes_ = NewGauge(r, "covplan_artifact_cache_budget_bytes",
                                  "Memory budget of the cache");
   maps_stored_ = NewGauge(r, "covplan_maps_stored", "Maps in the registry");
   plans_retained_ = NewGauge(r, "covplan_plans_retained", "Plans addressable by plan_id");

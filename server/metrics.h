@@ -6,8 +6,8 @@
 //   covplan_plans_cut_short_total                     counter
 //   covplan_worker_queue_depth / covplan_solves_in_flight   gauges
 //   covplan_worker_threads / covplan_worker_queue_capacity  gauges
-//   covplan_decomposition_cache_{hits,misses,evictions}_total  counters
-//   covplan_decomposition_cache_{bytes,entries,budget_bytes}   gauges
+//   covplan_artifact_cache_{hits,misses,evictions}_total  counters
+//   covplan_artifact_cache_{bytes,entries,budget_bytes}   gauges
 //   covplan_maps_stored / covplan_plans_retained       gauges
 //
 //   ServerMetrics metrics;
@@ -26,7 +26,7 @@
 #include "prometheus/gauge.h"
 #include "prometheus/histogram.h"
 #include "prometheus/registry.h"
-#include "server/decomposition_cache.h"
+#include "server/artifact_lru.h"
 
 namespace covplan {
 

@@ -4,11 +4,11 @@
 
 namespace covplan {
 
-void PlanRegistry::Put(std::shared_ptr<const v1::PlanResponse> plan, absl::Time now) {
+void PlanRegistry::Put(std::shared_ptr<const RetainedPlan> plan, absl::Time now) {
   if (max_plans_ == 0 || ttl_ <= absl::ZeroDuration()) return;
   absl::MutexLock lock(&mu_);
   Expire(now);
-  const std::string id = plan->plan_id();
+  const std::string id = plan->plan_id;
   if (plans_.count(id) != 0) return;
   order_.push_back(Entry{id, now + ttl_});
   plans_.emplace(id, std::move(plan));
@@ -18,7 +18,7 @@ void PlanRegistry::Put(std::shared_ptr<const v1::PlanResponse> plan, absl::Time 
   }
 }
 
-std::shared_ptr<const v1::PlanResponse> PlanRegistry::Get(const std::string& plan_id,
+std::shared_ptr<const RetainedPlan> PlanRegistry::Get(const std::string& plan_id,
                                                           absl::Time now) {
   absl::MutexLock lock(&mu_);
   Expire(now);

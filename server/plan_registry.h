@@ -1,10 +1,12 @@
-// Keeps recent Plan responses addressable by plan_id for a limited time
-// (GetPlan now; the later Replan builds on it). Bounded both by age (ttl)
-// and by count, oldest dropped first.
+// Keeps recent plans addressable by plan_id for a limited time, as planner
+// types (RetainedPlan: the plan, its request and the coverage area it was
+// planned on), so GetPlan and a later Replan continue from them without
+// re-parsing protos. Bounded both by age (ttl) and by count, oldest dropped
+// first.
 //
 //   PlanRegistry plans(absl::Minutes(10), /*max_plans=*/1000);
-//   plans.Put(response);                       // keyed by response->plan_id()
-//   std::shared_ptr<const v1::PlanResponse> p = plans.Get(id);  // null once expired
+//   plans.Put(retained);                       // keyed by retained->plan_id
+//   std::shared_ptr<const RetainedPlan> p = plans.Get(id);  // null once expired
 //
 // Thread-safety: all methods are thread-safe.
 #ifndef COVPLAN_SERVER_PLAN_REGISTRY_H_
@@ -18,7 +20,7 @@
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
-#include "covplan/v1/covplan.pb.h"
+#include "planner/engine/engine.h"
 
 namespace covplan {
 
@@ -26,8 +28,8 @@ class PlanRegistry {
  public:
   PlanRegistry(absl::Duration ttl, size_t max_plans) : ttl_(ttl), max_plans_(max_plans) {}
 
-  void Put(std::shared_ptr<const v1::PlanResponse> plan, absl::Time now = absl::Now());
-  std::shared_ptr<const v1::PlanResponse> Get(const std::string& plan_id,
+  void Put(std::shared_ptr<const RetainedPlan> plan, absl::Time now = absl::Now());
+  std::shared_ptr<const RetainedPlan> Get(const std::string& plan_id,
                                               absl::Time now = absl::Now());
   size_t size() const;
 
@@ -42,7 +44,7 @@ class PlanRegistry {
   const size_t max_plans_;
   mutable absl::Mutex mu_;
   std::deque<Entry> order_ ABSL_GUARDED_BY(mu_);  // oldest first
-  std::unordered_map<std::string, std::shared_ptr<const v1::PlanResponse>> plans_
+  std::unordered_map<std::string, std::shared_ptr<const RetainedPlan>> plans_
       ABSL_GUARDED_BY(mu_);
 };
 

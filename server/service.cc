@@ -86,6 +86,8 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       store_(store),
       metrics_(metrics),
       cache_(options.cache_budget_bytes, metrics),
+      registry_(PlannerRegistry::WithBuiltins()),
+      engine_(&registry_, &cache_, EngineLimitsFor(options.limits)),
       plans_(options.plan_ttl, options.max_retained_plans),
       id_salt_(std::random_device{}()),
       io_pool_(/*threads=*/2, /*max_queue=*/64),
@@ -171,9 +173,9 @@ std::string CoveragePlannerService::NewPlanId() {
 
 absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
                                                v1::PutMapResponse* response) {
-  ASSIGN_OR_RETURN(OccupancyMap map, MapFromProto(request.map(), options_.limits));
+  ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), options_.limits));
   const std::string map_id = ComputeMapId(request.map());
-  v1::MapInfo info = MapInfoFor(map, map_id);
+  v1::MapInfo info = MapInfoFor(site, map_id);
   info.set_name(request.name());
   ASSIGN_OR_RETURN(bool created, store_->Put(info, request.map()));
   if (!created) {
@@ -257,52 +259,32 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
 
 // ---------------------------------------------------------------- plans
 
-absl::StatusOr<std::shared_ptr<const Decomposition>> CoveragePlannerService::BuildFor(
-    const std::string& map_id, const v1::Map* inline_map, const PlanOptions& options,
-    const DecompositionOptions& decomposition_options, const StopToken& stop) {
-  OccupancyMap map;
-  if (inline_map != nullptr) {
-    ASSIGN_OR_RETURN(map, MapFromProto(*inline_map, options_.limits));
-  } else {
+MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
+                                           std::shared_ptr<const v1::Map> inline_map) {
+  MapSource source;
+  source.map_id = map_id;
+  source.load = [this, map_id, inline_map]() -> absl::StatusOr<SiteMap> {
+    if (inline_map != nullptr) return SiteFromProto(*inline_map, options_.limits);
     ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
-    ASSIGN_OR_RETURN(map, MapFromProto(stored.map(), options_.limits));
-  }
-  RETURN_IF_ERROR(ValidatePlanForMap(options, map, options_.limits));
-  ASSIGN_OR_RETURN(std::shared_ptr<const Decomposition> built,
-                   BuildDecomposition(map, decomposition_options, stop));
-  if (built == nullptr || built->grid == nullptr || built->grid->CountFree() == 0) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "no grid cell is free at tool width %g m: no %g m square is more than %g%% free",
-        options.robot.tool_width_m, options.robot.tool_width_m, 100 * options.min_free_fraction));
-  }
-  return built;
+    return SiteFromProto(stored.map(), options_.limits);
+  };
+  return source;
 }
 
-void CoveragePlannerService::WarmInBackground(const std::string& key, const std::string& map_id,
-                                              std::shared_ptr<const v1::Map> inline_map,
-                                              const PlanOptions& options,
-                                              const DecompositionOptions& decomposition_options) {
+void CoveragePlannerService::WarmInBackground(const MapSource& source, PlanRequest request) {
   if (draining()) return;
-  const bool queued = warm_pool_.TrySubmit([this, key, map_id, inline_map, options,
-                                            decomposition_options] {
+  const bool queued = warm_pool_.TrySubmit([this, source, request]() mutable {
     const absl::Time start = absl::Now();
-    bool hit = false;
-    absl::StatusOr<std::shared_ptr<const Decomposition>> built = cache_.GetOrBuild(
-        key, background_stop_.WithEarlierDeadline(start + options_.max_request_time),
-        [&](const StopToken& stop) {
-          return BuildFor(map_id, inline_map.get(), options, decomposition_options, stop);
-        },
-        &hit);
-    LogLine(built.ok() ? "info" : "warn", "background decomposition finished",
-            {{"map", map_id.substr(0, 12)},
-             {"key", key.substr(key.find('/') + 1)},
+    request.common.stop = background_stop_.WithEarlierDeadline(start + options_.max_request_time);
+    const absl::Status built = engine_.Prepare(source, request);
+    LogLine(built.ok() ? "info" : "warn", "background artifacts finished",
+            {{"map", source.map_id.substr(0, 12)},
+             {"tool_m", absl::StrFormat("%g", request.common.robot.tool_width_m)},
              {"ms", absl::StrFormat("%.1f", absl::ToDoubleMilliseconds(absl::Now() - start))},
-             {"result", built.ok() ? (hit ? "already cached" : "cached")
-                                   : std::string(built.status().message())}});
+             {"result", built.ok() ? "cached" : std::string(built.message())}});
   });
   if (!queued) {
-    LogLine("warn", "background decomposition dropped: queue full",
-            {{"map", map_id.substr(0, 12)}});
+    LogLine("warn", "background artifacts dropped: queue full", {{"map", source.map_id.substr(0, 12)}});
   }
 }
 
@@ -310,7 +292,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
                                              const StopToken& cancel, v1::PlanResponse* response) {
   const absl::Time start = absl::Now();
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
-  ASSIGN_OR_RETURN(PlanOptions options, PlanOptionsFromProto(request));
+  ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
+  CommonOptions& options = plan_request.common;
 
   // The budget: the request's time limit (or the server default), and never
   // past the call's deadline minus the margin kept for sending the reply.
@@ -338,6 +321,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   options.stop = stop;
 
   std::string map_id;
+  std::shared_ptr<const v1::Map> inline_map;
   switch (request.map_ref_case()) {
     case v1::PlanRequest::kMapId:
       RETURN_IF_ERROR(ValidateMapId(request.map_id()));
@@ -345,53 +329,37 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       break;
     case v1::PlanRequest::kMap:
       map_id = ComputeMapId(request.map());
+      inline_map = std::make_shared<const v1::Map>(request.map());
       break;
     default:
       return absl::InvalidArgumentError("PlanRequest needs map_id or an inline map");
   }
-  const DecompositionOptions decomposition_options =
-      DecompositionOptionsFor(options, options_.limits);
-  RETURN_IF_ERROR(decomposition_options.Validate());
-  const std::string key = absl::StrCat(map_id, "/", decomposition_options.CacheKey());
-
-  bool cached = false;
-  absl::StatusOr<std::shared_ptr<const Decomposition>> decomposition = cache_.GetOrBuild(
-      key, stop,
-      [&](const StopToken& build_stop) {
-        return BuildFor(map_id, request.has_map() ? &request.map() : nullptr, options,
-                        decomposition_options, build_stop);
-      },
-      &cached);
-  if (!decomposition.ok()) {
-    if (IsStop(decomposition.status()) && !cancel.cancelled() &&
-        call.deadline != absl::InfiniteFuture()) {
-      // Cut off by this call's deadline: finish it in the background so the
-      // next call finds it cached. (A call without a deadline that hit
-      // --max_request_s already had that long; it is not retried.)
-      WarmInBackground(key, map_id,
-                       request.has_map() ? std::make_shared<const v1::Map>(request.map()) : nullptr,
-                       options, decomposition_options);
+  const MapSource source = SourceFor(map_id, inline_map);
+  absl::StatusOr<EngineResult> result = engine_.Plan(source, plan_request);
+  if (!result.ok()) {
+    if (IsStop(result.status()) && !cancel.cancelled() && call.deadline != absl::InfiniteFuture()) {
+      // Cut off by this call's deadline: finish the artifacts in the
+      // background so the next call finds them cached. (A call without a
+      // deadline that hit --max_request_s already had that long.)
+      WarmInBackground(source, plan_request);
     }
-    return IsStop(decomposition.status())
-               ? StoppedStatus(decomposition.status(), cancel, call, options_.max_request_time)
-               : decomposition.status();
+    return IsStop(result.status())
+               ? StoppedStatus(result.status(), cancel, call, options_.max_request_time)
+               : result.status();
   }
-
-  absl::StatusOr<CoveragePlan> plan = PlanOnDecomposition(**decomposition, options);
-  if (!plan.ok()) {
-    return IsStop(plan.status())
-               ? StoppedStatus(plan.status(), cancel, call, options_.max_request_time)
-               : plan.status();
-  }
-  plan->stats.decomposition_cached = cached;
-  PlanToProto(*plan, response);
-  response->set_plan_id(NewPlanId());
-  response->set_map_id(map_id);
+  auto retained = std::make_shared<RetainedPlan>();
+  retained->plan_id = NewPlanId();
+  retained->map_id = map_id;
+  retained->plan = std::move(result->plan);
+  retained->area = std::move(result->area);
+  retained->request = std::move(plan_request);
+  retained->request.common.stop = StopToken();  // the call's token ends with the call
+  RetainedPlanToProto(*retained, response);
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
-  metrics_->RecordSolve(solve_us * 1e-6, plan->stats.tour_cut_short);
+  metrics_->RecordSolve(solve_us * 1e-6, retained->plan.stats.tour_cut_short);
   const int64_t mean = mean_solve_us_.load();
   mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
-  plans_.Put(std::make_shared<const v1::PlanResponse>(*response));
+  plans_.Put(std::move(retained));
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   return absl::OkStatus();
 }
@@ -443,8 +411,11 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     ReleaseSolve();
     std::string detail;
     if (status.ok()) {
-      detail = absl::StrFormat("plan=%s ranks=%d cut_short=%d cached=%d", response->plan_id(),
-                               response->stats().num_ranks(), response->stats().tour_cut_short(),
+      detail = absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s cached=%d",
+                               response->plan_id(), response->planner(),
+                               response->stats().num_ranks(),
+                               v1::TerminationReason_Name(response->termination().reason()),
+                               v1::TerminationLimit_Name(response->termination().limit()),
                                response->stats().decomposition_cached());
     }
     FinishCall(reactor, call, status, detail);
@@ -462,7 +433,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
                                                           v1::PlanResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "GetPlan");
-  std::shared_ptr<const v1::PlanResponse> plan = plans_.Get(request->plan_id());
+  std::shared_ptr<const RetainedPlan> plan = plans_.Get(request->plan_id());
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   if (plan == nullptr) {
     FinishCall(
@@ -470,7 +441,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
         absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", request->plan_id(), "'")));
     return reactor;
   }
-  *response = *plan;  // a copy of a retained plan: in-memory, no blocking
+  RetainedPlanToProto(*plan, response);  // in memory, no blocking
   FinishCall(reactor, call, absl::OkStatus(), request->plan_id());
   return reactor;
 }

@@ -6,9 +6,12 @@
 // admitted solves, Plan answers RESOURCE_EXHAUSTED at once.
 // A Plan's gRPC deadline (minus ServiceOptions::deadline_margin) is its
 // anytime budget; a cancelled call cancels its StopToken so the work stops.
-// A decomposition (grid, ranks, transition table) that a call's deadline cut
-// off is finished on a background thread, so later calls for the same map
-// find it cached instead of failing the same way forever.
+// Planning itself is the transport-free PlanningEngine (planner/engine): this
+// class converts protos, schedules, and maps statuses. Per-map artifacts
+// (grid, coverage area, partition, transitions) live in one ArtifactLru;
+// artifacts that a call's deadline cut off are finished on a background
+// thread, so later calls for the same map find them cached instead of
+// failing the same way forever.
 //
 //   MapStore store = ...; ServerMetrics metrics;
 //   CoveragePlannerService service(ServiceOptions{}, store.get(), &metrics);
@@ -31,8 +34,9 @@
 #include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "covplan/v1/covplan.grpc.pb.h"
-#include "server/convert.h"
-#include "server/decomposition_cache.h"
+#include "api/convert.h"
+#include "planner/engine/engine.h"
+#include "server/artifact_lru.h"
 #include "server/map_store.h"
 #include "server/metrics.h"
 #include "server/plan_registry.h"
@@ -44,7 +48,7 @@ struct ServiceOptions {
   InputLimits limits;
   int worker_threads = 2;
   int max_queue = 16;                        // waiting requests beyond the workers
-  size_t cache_budget_bytes = 256ull << 20;  // decomposition cache
+  size_t cache_budget_bytes = 256ull << 20;  // per-map artifact cache
   double default_budget_s = 2.0;             // tour search budget without a deadline
   // Without a deadline, the whole call (decomposition included) stops after
   // this long with DEADLINE_EXCEEDED rather than holding a worker forever.
@@ -96,7 +100,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // Runs what is queued (cancelled calls finish quickly) and joins workers.
   void Shutdown();
 
-  const DecompositionCache& cache() const { return cache_; }
+  const ArtifactLru& cache() const { return cache_; }
 
   // Finishes `reactor` with `status`, records metrics and logs one line.
   void FinishCall(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
@@ -117,20 +121,19 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   bool TryAdmitSolve();
   void ReleaseSolve();
   absl::Status RunPutMap(const v1::PutMapRequest& request, v1::PutMapResponse* response);
-  // Loads the map (inline or from the store) and builds its decomposition.
-  absl::StatusOr<std::shared_ptr<const Decomposition>> BuildFor(
-      const std::string& map_id, const v1::Map* inline_map, const PlanOptions& options,
-      const DecompositionOptions& decomposition_options, const StopToken& stop);
-  // Queues a build of `key` on the background pool (dropped when it is full).
-  void WarmInBackground(const std::string& key, const std::string& map_id,
-                        std::shared_ptr<const v1::Map> inline_map, const PlanOptions& options,
-                        const DecompositionOptions& decomposition_options);
+  // The map, inline or from the store, loaded only when an artifact is built.
+  MapSource SourceFor(const std::string& map_id, std::shared_ptr<const v1::Map> inline_map);
+  // Queues the artifacts of `request` on the background pool (dropped when
+  // it is full).
+  void WarmInBackground(const MapSource& source, PlanRequest request);
   std::string NewPlanId();
 
   const ServiceOptions options_;
   MapStore* const store_;
   ServerMetrics* const metrics_;
-  DecompositionCache cache_;
+  ArtifactLru cache_;
+  const PlannerRegistry registry_;
+  const PlanningEngine engine_;
   PlanRegistry plans_;
   std::atomic<bool> draining_{false};
   std::atomic<uint64_t> next_id_{1};

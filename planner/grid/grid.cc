@@ -172,7 +172,7 @@ bool VerticalLineBlocked(const OccupancyMap& map, double x, double y0, double y1
 
 }  // namespace
 
-absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& options) {
+absl::StatusOr<GridFrame> PlanGridFrame(const OccupancyMap& map, const GridOptions& options) {
   absl::Status valid = options.Validate();
   if (!valid.ok()) return valid;
   const double res = map.resolution();
@@ -191,26 +191,47 @@ absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& optio
         "tool width %g m is wider than the map (%g m x %g m)", options.cell_size, width_m,
         height_m));
   }
-  const double px_per_cell = Snap(options.cell_size / res);
-  const int cols = static_cast<int>(std::ceil(Snap(map.width() / px_per_cell)));
-  const int rows = static_cast<int>(std::ceil(Snap(map.height() / px_per_cell)));
-  if (static_cast<int64_t>(rows) * cols > options.max_cells) {
+  GridFrame f;
+  f.px_per_cell = Snap(options.cell_size / res);
+  f.cols = static_cast<int>(std::ceil(Snap(map.width() / f.px_per_cell)));
+  f.rows = static_cast<int>(std::ceil(Snap(map.height() / f.px_per_cell)));
+  f.cell_size = options.cell_size;
+  f.origin = map.origin();
+  if (static_cast<int64_t>(f.rows) * f.cols > options.max_cells) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "grid of %d x %d cells exceeds the limit of %d cells: use a wider tool or a smaller map",
-        rows, cols, options.max_cells));
+        "grid of %d x %d cells is above the limit of %d cells: use a wider tool or a smaller map",
+        f.rows, f.cols, options.max_cells));
   }
+  return f;
+}
+
+std::vector<double> CellFreeFractions(const OccupancyMap& map, const GridFrame& f) {
   FreeAreaIntegrator integrator(map);
-  const double cell_area = px_per_cell * px_per_cell;
+  const double cell_area = f.px_per_cell * f.px_per_cell;
+  std::vector<double> out(static_cast<size_t>(f.rows) * f.cols, 0.0);
+  for (int r = 0; r < f.rows; ++r) {
+    for (int c = 0; c < f.cols; ++c) {
+      const double a = integrator.Area(c * f.px_per_cell, (c + 1) * f.px_per_cell,
+                                       r * f.px_per_cell, (r + 1) * f.px_per_cell);
+      out[static_cast<size_t>(r) * f.cols + c] = a / cell_area;
+    }
+  }
+  return out;
+}
+
+absl::StatusOr<Grid> BuildGridFromFractions(const OccupancyMap& map, const GridOptions& options,
+                                            const GridFrame& f, const std::vector<double>& fractions) {
+  const int rows = f.rows, cols = f.cols;
+  const double px_per_cell = f.px_per_cell;
+  if (fractions.size() != static_cast<size_t>(rows) * cols) {
+    return absl::InternalError("cell fractions do not match the grid");
+  }
   std::vector<uint8_t> free(static_cast<size_t>(rows) * cols, 0);
   int64_t num_free = 0;
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      const double a = integrator.Area(c * px_per_cell, (c + 1) * px_per_cell, r * px_per_cell,
-                                       (r + 1) * px_per_cell);
-      if (a > options.min_free_fraction * cell_area * (1.0 + 1e-12)) {
-        free[static_cast<size_t>(r) * cols + c] = 1;
-        ++num_free;
-      }
+  for (size_t i = 0; i < free.size(); ++i) {
+    if (fractions[i] > options.min_free_fraction * (1.0 + 1e-12)) {
+      free[i] = 1;
+      ++num_free;
     }
   }
   if (num_free == 0) {
@@ -241,6 +262,16 @@ absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& optio
   auto pixels = std::make_shared<const ObstaclePixels>(map, px_per_cell, rows, cols);
   return Grid(rows, cols, options.cell_size, map.origin(), std::move(free), std::move(walls),
               std::move(pixels));
+}
+
+absl::StatusOr<Grid> BuildGrid(const OccupancyMap& map, const GridOptions& options) {
+  absl::StatusOr<GridFrame> frame = PlanGridFrame(map, options);
+  if (!frame.ok()) return frame.status();
+  return BuildGridFromFractions(map, options, *frame, CellFreeFractions(map, *frame));
+}
+
+Grid Grid::WithFreeFlags(std::vector<uint8_t> free) const {
+  return Grid(rows_, cols_, cell_size_, origin_, std::move(free), walls_, pixels_);
 }
 
 double CoveredFreeAreaRatio(const OccupancyMap& map, const Grid& grid) {

@@ -112,6 +112,11 @@ class Grid {
   const ObstaclePixels* obstacle_pixels() const { return pixels_.get(); }
   const std::shared_ptr<const ObstaclePixels>& shared_obstacle_pixels() const { return pixels_; }
 
+  // The same grid (barriers, obstacle pixels) with other free flags, e.g.
+  // with no-go zones closed or only one component kept. `free` must have
+  // size() entries and may only clear cells.
+  Grid WithFreeFlags(std::vector<uint8_t> free) const;
+
   size_t MemoryBytes() const {
     return sizeof(*this) + free_.capacity() + walls_.capacity() +
            (pixels_ ? pixels_->MemoryBytes() : 0);
@@ -126,6 +131,27 @@ class Grid {
   std::vector<uint8_t> walls_;  // empty, or kWall* bits per cell
   std::shared_ptr<const ObstaclePixels> pixels_;
 };
+
+// How a map is cut into cells: validated cell size, pixels per cell, shape.
+struct GridFrame {
+  int rows = 0;
+  int cols = 0;
+  double cell_size = 0.0;
+  double px_per_cell = 1.0;
+  Point2 origin;
+};
+// InvalidArgument when the cell is smaller than a map pixel, larger than the
+// map, or the grid exceeds max_cells.
+absl::StatusOr<GridFrame> PlanGridFrame(const OccupancyMap& map, const GridOptions& options);
+// Exact free share (0..1) of every cell of `frame` over `map`, row-major.
+std::vector<double> CellFreeFractions(const OccupancyMap& map, const GridFrame& frame);
+// The grid whose cells are free when fractions[i] > options.min_free_fraction;
+// barriers and obstacle pixels come from `map` (a polygon map passes its exact
+// polygon fractions and a conservative rasterisation). InvalidArgument when no
+// cell is free.
+absl::StatusOr<Grid> BuildGridFromFractions(const OccupancyMap& map, const GridOptions& options,
+                                            const GridFrame& frame,
+                                            const std::vector<double>& fractions);
 
 // Builds the tool-width grid over `map`. InvalidArgument when the cell is
 // smaller than a map pixel, larger than the map, the grid exceeds max_cells,

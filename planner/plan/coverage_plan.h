@@ -1,7 +1,14 @@
-// The result every coverage planner produces: waypoints with headings, the
-// ranks (for rank-based planners) and statistics.
+// The result every coverage planner produces, whatever its method: the path
+// (waypoints with headings and segment kinds), the cells each coverage
+// segment sweeps (so coverage is proven from the path, not from ranks),
+// statistics every planner fills, how the search ended (Termination), and a
+// planner-specific detail beside them (ranks and their order for OARP).
 //
-// Thread-safety: plain value types.
+//   const CoveragePlan& plan = ...;
+//   for (const CoverageSweep& s : plan.sweeps) { plan.path[s.waypoint] ... s.cells ... }
+//   if (auto* oarp = plan.detail_as<OarpDetail>()) { oarp->ranks ... }
+//
+// Thread-safety: plain value types; `detail` is immutable and shared.
 #ifndef COVPLAN_PLANNER_PLAN_COVERAGE_PLAN_H_
 #define COVPLAN_PLANNER_PLAN_COVERAGE_PLAN_H_
 
@@ -11,14 +18,15 @@
 #include <vector>
 
 #include "planner/grid/grid.h"
-#include "planner/partition/rank.h"
 
 namespace covplan {
 
 enum class SegmentKind : uint8_t {
   kStart = 0,       // first waypoint; no segment ends here
-  kCoverage = 1,    // the straight segment ending here covers a rank
-  kTransition = 2,  // the segment ending here moves between ranks (tool not sweeping new cells)
+  kCoverage = 1,    // the straight segment ending here sweeps new cells
+  kTransition = 2,  // the segment ending here moves without sweeping new cells
+  kToStation = 3,   // drives to a service station (battery-split tours)
+  kFromStation = 4, // drives back from a service station to resume
 };
 
 struct Waypoint {
@@ -26,11 +34,47 @@ struct Waypoint {
   double y = 0.0;
   double theta = 0.0;  // heading while driving the segment that ends here (rad)
   SegmentKind kind = SegmentKind::kStart;
-  int rank = -1;       // rank index for coverage segments, else -1
+  // The planner's own index of what the segment serves (the rank for OARP
+  // coverage segments), else -1.
+  int rank = -1;
 };
 
+// The cells swept by the coverage segment that ends at path[waypoint].
+struct CoverageSweep {
+  int waypoint = 0;
+  std::vector<CellIndex> cells;
+};
+
+// How a search ended (in the spirit of OR-tools math_opt's Termination).
+enum class TerminationReason : uint8_t {
+  kConverged = 0,             // the search stopped by itself
+  kFeasibleLimitReached = 1,  // a limit stopped it; the plan is feasible (best found)
+};
+enum class TerminationLimit : uint8_t {
+  kNone = 0,       // with kConverged
+  kTime = 1,       // the request's own time limit (time_limit_s)
+  kDeadline = 2,   // the caller's deadline
+  kCancelled = 3,  // the caller cancelled
+};
+struct Termination {
+  TerminationReason reason = TerminationReason::kConverged;
+  TerminationLimit limit = TerminationLimit::kNone;
+  std::string detail;
+  bool limit_reached() const { return reason == TerminationReason::kFeasibleLimitReached; }
+  static Termination Converged(std::string detail = "") {
+    return {TerminationReason::kConverged, TerminationLimit::kNone, std::move(detail)};
+  }
+  static Termination LimitReached(TerminationLimit limit, std::string detail = "") {
+    return {TerminationReason::kFeasibleLimitReached, limit, std::move(detail)};
+  }
+};
+const char* TerminationReasonName(TerminationReason r);
+const char* TerminationLimitName(TerminationLimit l);
+
+// Statistics every planner fills (the engine computes the path-derived ones
+// from the waypoints, so they agree with the path by construction).
 struct PlanStats {
-  int64_t num_ranks = 0;
+  int64_t num_ranks = 0;            // OARP: ranks; other planners: coverage segments
   int64_t num_turns = 0;            // heading changes > 1e-6 rad along the path
   double coverage_length_m = 0.0;
   double transition_length_m = 0.0;
@@ -39,8 +83,10 @@ struct PlanStats {
   double turning_time_s = 0.0;
   int64_t grid_rows = 0;
   int64_t grid_cols = 0;
-  int64_t free_cells = 0;
-  int64_t unreachable_free_cells = 0;  // free cells not connected to the planned area
+  int64_t free_cells = 0;              // cells to cover (in the regions, when given)
+  int64_t covered_cells = 0;           // distinct cells swept by the path
+  int64_t unreachable_free_cells = 0;  // cells to cover that the robot cannot reach
+  int64_t no_go_cells = 0;             // free cells closed by no-go zones
   double map_free_area_m2 = 0.0;
   // Timing (wall clock, milliseconds).
   double planning_ms = 0.0;
@@ -48,19 +94,33 @@ struct PlanStats {
   double partition_ms = 0.0;
   double transitions_ms = 0.0;
   double tour_ms = 0.0;
-  bool tour_cut_short = false;   // the deadline stopped the tour search
-  bool decomposition_cached = false;
+  bool tour_cut_short = false;  // kept for old callers: termination.limit_reached()
+  bool decomposition_cached = false;  // every per-map artifact came from the cache
   std::string partition_solver;
   std::string tour_solver;
 };
 
+// Planner-specific detail, beside the planner-neutral result.
+class PlannerDetail {
+ public:
+  virtual ~PlannerDetail() = default;
+  virtual size_t MemoryBytes() const = 0;
+};
+
 struct CoveragePlan {
-  std::shared_ptr<const Grid> grid;
-  std::vector<Rank> ranks;        // all ranks of the partition
-  std::vector<int> rank_order;    // visiting order (indices into ranks)
-  std::vector<bool> rank_reversed;  // per visit in rank_order: traversed last->first
+  std::string planner;              // registered name, e.g. "oarp"
+  std::shared_ptr<const Grid> grid; // the grid the path was planned on (drive grid)
   std::vector<Waypoint> path;
+  std::vector<CoverageSweep> sweeps;  // one per coverage segment, in path order
   PlanStats stats;
+  Termination termination;
+  std::shared_ptr<const PlannerDetail> detail;
+
+  template <typename T>
+  const T* detail_as() const {
+    return dynamic_cast<const T*>(detail.get());
+  }
+  size_t MemoryBytes() const;
 };
 
 }  // namespace covplan

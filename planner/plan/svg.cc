@@ -33,7 +33,27 @@ void AppendRuns(std::string* out, int rows, int cols, double x0, double y0, doub
 
 }  // namespace
 
-std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map) {
+void AppendPolygons(std::string* out, const std::vector<PolygonInput>& polygons, const char* fill,
+                    const char* stroke, double stroke_width) {
+  if (polygons.empty()) return;
+  absl::StrAppendFormat(out, "<g fill=\"%s\" fill-opacity=\"0.35\" fill-rule=\"evenodd\" stroke=\"%s\" "
+                             "stroke-width=\"%.4f\">\n", fill, stroke, stroke_width);
+  for (const PolygonInput& p : polygons) {
+    absl::StrAppend(out, "<path d=\"");
+    auto ring = [&](const std::vector<Point2>& pts) {
+      for (size_t i = 0; i < pts.size(); ++i) {
+        absl::StrAppendFormat(out, "%s%.4f %.4f ", i == 0 ? "M" : "L", pts[i].x, pts[i].y);
+      }
+      absl::StrAppend(out, "Z ");
+    };
+    ring(p.outer);
+    for (const auto& h : p.holes) ring(h);
+    absl::StrAppend(out, "\"/>\n");
+  }
+  absl::StrAppend(out, "</g>\n");
+}
+
+std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, const SvgZones& zones) {
   const Grid& grid = *plan.grid;
   const double s = grid.cell_size();
   const Point2 o = grid.origin();
@@ -64,12 +84,17 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map) {
     AppendRuns(&out, map->height(), map->width(), mo.x, mo.y, res, "#202020",
                [&](int r, int c) { return map->at(r, c) == CellState::kOccupied; });
   }
-  // Ranks, coloured by orientation.
+  AppendPolygons(&out, zones.regions, "#4a90d9", "#1f5fa8", 0.08 * s);
+  AppendPolygons(&out, zones.no_go, "#e03131", "#a61e1e", 0.08 * s);
+  // Coverage segments, coloured by direction (horizontal / vertical sweeps).
   const double stroke = 0.55 * s;
   absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-linecap=\"round\" fill=\"none\">\n", stroke);
-  for (const Rank& r : plan.ranks) {
-    const Point2 a = grid.CellCenter(r.first), b = grid.CellCenter(r.last);
-    const char* color = r.orientation == Orientation::kHorizontal ? "#f08c2e" : "#8e44ad";
+  for (size_t i = 1; i < plan.path.size(); ++i) {
+    const Waypoint& a = plan.path[i - 1];
+    const Waypoint& b = plan.path[i];
+    if (b.kind != SegmentKind::kCoverage) continue;
+    const bool horizontal = std::abs(b.y - a.y) <= std::abs(b.x - a.x);
+    const char* color = horizontal ? "#f08c2e" : "#8e44ad";
     absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\" stroke-opacity=\"0.8\"/>\n",
                           a.x, a.y, b.x, b.y, color);
   }
@@ -97,15 +122,19 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map) {
   const std::string summary =
       absl::StrFormat(" · %d ranks, %d turns, %.0f s", static_cast<int>(plan.stats.num_ranks),
                       static_cast<int>(plan.stats.num_turns), plan.stats.estimated_duration_s);
+  std::string zone_legend;
+  if (!zones.regions.empty()) zone_legend += " · <tspan fill=\"#1f5fa8\">regions</tspan>";
+  if (!zones.no_go.empty()) zone_legend += " · <tspan fill=\"#a61e1e\">no-go zones</tspan>";
   constexpr int kLegendChars = 54;  // "horizontal ranks · vertical ranks · transitions"
-  const double chars = kLegendChars + static_cast<double>(summary.size());
+  const double chars = kLegendChars + static_cast<double>(summary.size()) +
+                       (zones.regions.empty() ? 0 : 10) + (zones.no_go.empty() ? 0 : 14);
   const double fs = std::min(0.45 * legend_h, (w - 0.4) / (0.56 * chars));
   absl::StrAppendFormat(&out,
                         "<text x=\"%.4f\" y=\"%.4f\" font-family=\"sans-serif\" font-size=\"%.4f\">"
                         "<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
                         "<tspan fill=\"#8e44ad\">vertical ranks</tspan> · "
-                        "<tspan fill=\"#1f8a5b\">transitions</tspan>%s</text>\n",
-                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), summary);
+                        "<tspan fill=\"#1f8a5b\">transitions</tspan>%s%s</text>\n",
+                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), summary, zone_legend);
   absl::StrAppend(&out, "</svg>\n");
   return out;
 }

@@ -1,5 +1,5 @@
-// Renders a plan as SVG: the map (if given), blocked grid cells, ranks
-// coloured by orientation, transitions dashed, start/end markers.
+// Renders a plan as SVG: the map (if given), free grid cells, regions and
+// no-go zones, coverage segments coloured by direction, transitions dashed, start/end markers.
 //
 // Thread-safety: stateless.
 #ifndef COVPLAN_PLANNER_PLAN_SVG_H_
@@ -7,13 +7,22 @@
 
 #include <string>
 
+#include <vector>
+
+#include "planner/geometry/area.h"
 #include "planner/grid/occupancy_map.h"
 #include "planner/plan/coverage_plan.h"
 
 namespace covplan {
 
+struct SvgZones {
+  std::vector<PolygonInput> regions;  // drawn blue
+  std::vector<PolygonInput> no_go;    // drawn red
+};
+
 // `map` may be null (only the grid is drawn).
-std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map);
+std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map,
+                          const SvgZones& zones = {});
 
 }  // namespace covplan
 

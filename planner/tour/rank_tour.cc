@@ -58,7 +58,8 @@ double RankTourCost::Heading(int v) const {
 
 absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::vector<Rank>& ranks,
                                                   const TransitionTable& table,
-                                                  const RobotModel& robot, const StopToken& stop) {
+                                                  const RobotModel& robot, const StopToken& stop,
+                                                  std::shared_ptr<const MotionCost> motion) {
   if (ranks.empty()) return absl::InvalidArgumentError("no ranks to order");
   if (table.num_endpoints() != static_cast<int>(ranks.size() * 2)) {
     return absl::InvalidArgumentError("transition table does not match the ranks");
@@ -67,7 +68,8 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   cost.grid_ = &grid;
   cost.ranks_ = &ranks;
   cost.table_ = &table;
-  cost.robot_ = robot;
+  cost.motion_ = motion != nullptr ? std::move(motion) : std::make_shared<const TravelTimeCost>(robot);
+  cost.IndexVertices();
   if (robot.start) {
     cost.start_ = *robot.start;
   } else {
@@ -83,9 +85,9 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   if (!end_cell.ok()) return end_cell.status();
 
   const int n = cost.num_vertices();
-  cost.rank_time_.resize(ranks.size());
+  cost.rank_cost_.resize(ranks.size());
   for (size_t k = 0; k < ranks.size(); ++k) {
-    cost.rank_time_[k] = robot.StraightTime((ranks[k].NumCells() - 1) * grid.cell_size());
+    cost.rank_cost_[k] = cost.motion_->Straight((ranks[k].NumCells() - 1) * grid.cell_size());
   }
   // One search from the start cell and one from the end cell.
   AnyAngleSearch search(grid);
@@ -102,9 +104,9 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
           cost.start_.y));
     }
     cost.start_paths_[v] = PosePath(grid, cost.start_, search.PathTo(entry));
-    cost.from_start_[v] = TimePolyline(robot, cost.start_paths_[v], cost.start_.theta,
-                                       cost.Heading(v)).time_s +
-                          cost.rank_time_[v / 2];
+    cost.from_start_[v] =
+        cost.motion_->Polyline(cost.start_paths_[v], cost.start_.theta, cost.Heading(v)) +
+        cost.rank_cost_[v / 2];
   }
   if (cost.has_end_ && !search.Run(*end_cell, stop)) {
     return absl::DeadlineExceededError("stopped while routing to the end pose");
@@ -116,7 +118,7 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
     std::vector<Point2> pts = PosePath(grid, cost.end_, search.PathTo(table.endpoint(cost.ExitEndpoint(u))));
     std::reverse(pts.begin(), pts.end());
     cost.end_paths_[u] = std::move(pts);
-    cost.to_end_[u] = TimePolyline(robot, cost.end_paths_[u], cost.Heading(u), std::nullopt).time_s;
+    cost.to_end_[u] = cost.motion_->Polyline(cost.end_paths_[u], cost.Heading(u), std::nullopt);
   }
   return cost;
 }
@@ -134,14 +136,7 @@ double RankTourCost::Between(int u, int v) const {
   if (!table_->Reachable(ExitEndpoint(u), EntryEndpoint(v))) return std::numeric_limits<double>::infinity();
   thread_local std::vector<Point2> pts;
   TransitionPoints(u, v, &pts);
-  return TimePolyline(robot_, pts, Heading(u), Heading(v)).time_s + rank_time_[v / 2];
-}
-
-double RankTourCost::TourTime(const std::vector<int>& vertices) const {
-  if (vertices.empty()) return 0.0;
-  double t = FromStart(vertices[0]);
-  for (size_t i = 1; i < vertices.size(); ++i) t += Between(vertices[i - 1], vertices[i]);
-  return t + ToEnd(vertices.back());
+  return motion_->Polyline(pts, Heading(u), Heading(v)) + rank_cost_[v / 2];
 }
 
 std::vector<Waypoint> RankTourCost::BuildPath(const std::vector<int>& vertices) const {
@@ -176,92 +171,6 @@ std::vector<Waypoint> RankTourCost::BuildPath(const std::vector<int>& vertices) 
   }
   if (!vertices.empty()) drive(end_paths_[vertices.back()], SegmentKind::kTransition);
   return path;
-}
-
-absl::StatusOr<RankTour> GreedyOrderer::Order(const RankTourCost& cost, const StopToken& stop) const {
-  const int n = cost.num_vertices();
-  std::vector<bool> used(cost.num_ranks(), false);
-  RankTour tour;
-  int current = -1;
-  for (int step = 0; step < cost.num_ranks(); ++step) {
-    if ((step & 63) == 63 && stop.cancelled()) return absl::CancelledError("greedy ordering cancelled");
-    int best = -1;
-    double best_cost = std::numeric_limits<double>::infinity();
-    for (int v = 0; v < n; ++v) {
-      if (used[v / 2]) continue;
-      const double c = current < 0 ? cost.FromStart(v) : cost.Between(current, v);
-      if (c < best_cost) best_cost = c, best = v;
-    }
-    if (best < 0) return absl::InternalError("greedy ordering found no reachable rank");
-    used[best / 2] = true;
-    tour.vertices.push_back(best);
-    current = best;
-  }
-  tour.time_s = cost.TourTime(tour.vertices);
-  return tour;
-}
-
-absl::StatusOr<RankTour> GtspOrderer::Order(const RankTourCost& cost, const StopToken& stop) const {
-  // Warm start and fallback: the greedy tour.
-  absl::StatusOr<RankTour> greedy = GreedyOrderer().Order(cost, stop);
-  if (!greedy.ok()) return greedy.status();
-  const int n = cost.num_vertices();
-  if (cost.num_ranks() <= 1) return greedy;
-
-  const int start = n, end = cost.has_end() ? n + 1 : -1;
-  GtspInstance inst;
-  inst.num_vertices = n + 1 + (cost.has_end() ? 1 : 0);
-  const double inf = GtspInstance::kInfeasibleCost;
-  inst.costs.assign(static_cast<size_t>(inst.num_vertices) * inst.num_vertices, inf);
-  auto at = [&](int i, int j) -> double& { return inst.costs[static_cast<size_t>(i) * inst.num_vertices + j]; };
-  for (int u = 0; u < n; ++u) {
-    if ((u & 15) == 15 && stop.ShouldStop()) {
-      greedy->cut_short = true;
-      return greedy;
-    }
-    for (int v = 0; v < n; ++v) {
-      const double c = cost.Between(u, v);
-      if (std::isfinite(c)) at(u, v) = c;
-    }
-    at(start, u) = cost.FromStart(u);
-    if (end >= 0) {
-      at(u, end) = cost.ToEnd(u);
-    } else {
-      at(u, start) = cost.ToEnd(u);
-    }
-  }
-  if (end >= 0) at(end, start) = 0.0;
-  for (int k = 0; k < cost.num_ranks(); ++k) inst.sets.push_back({2 * k, 2 * k + 1});
-  inst.sets.push_back({start});
-  if (end >= 0) inst.sets.push_back({end});
-
-  GtspOptions opt;
-  opt.seed = options_.seed;
-  opt.num_threads = options_.num_threads;
-  opt.effort = options_.effort;
-  opt.stop = stop.WithEarlierDeadline(absl::Now() + absl::Seconds(options_.time_limit_s));
-  opt.initial_tour.push_back(start);
-  for (int v : greedy->vertices) opt.initial_tour.push_back(v);
-  if (end >= 0) opt.initial_tour.push_back(end);
-  absl::StatusOr<GtspResult> result = SolveGtsp(inst, opt);
-  if (!result.ok()) return result.status();
-
-  // Rotate the cycle to begin at the start vertex; drop start/end.
-  std::vector<int> cycle = result->tour;
-  auto it = std::find(cycle.begin(), cycle.end(), start);
-  if (it == cycle.end()) return absl::InternalError("GTSP tour misses the start vertex");
-  std::rotate(cycle.begin(), it, cycle.end());
-  RankTour tour;
-  for (int v : cycle) {
-    if (v < n) tour.vertices.push_back(v);
-  }
-  tour.time_s = cost.TourTime(tour.vertices);
-  tour.cut_short = result->stopped_early && stop.ShouldStop();
-  if (greedy->time_s < tour.time_s) {
-    greedy->cut_short = tour.cut_short;
-    return greedy;
-  }
-  return tour;
 }
 
 }  // namespace covplan

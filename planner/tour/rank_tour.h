@@ -1,17 +1,16 @@
-// Ordering ranks into a drivable tour.
+// Ordering ranks into a drivable tour: the rank TourModel.
 //
 // Vertex v = 2k + d stands for rank k driven first->last (d = 0) or
-// last->first (d = 1). RankTourCost prices every move in seconds with the
-// robot model (transition driving + turns + the rank's own traversal), from
-// a start pose and back to it (or to an end pose). A RankOrderer picks the
-// order: greedy nearest-neighbour, or the anytime GTSP of planner/tour/gtsp.
+// last->first (d = 1). RankTourCost prices every move with an injected
+// MotionCost (default: seconds under the robot model: transition driving +
+// turns + the rank's own traversal), from a start pose and back to it (or to
+// an end pose). An orderer of planner/tour/tour_model.h picks the order.
 //
 //   ASSIGN_OR_RETURN(RankTourCost cost, RankTourCost::Create(grid, ranks, *table, robot, stop));
-//   ASSIGN_OR_RETURN(RankTour tour, MakeOrderer(TourSolver::kGtsp, opts)->Order(cost, stop));
-//   std::vector<Waypoint> path = cost.BuildPath(tour);
+//   ASSIGN_OR_RETURN(TourOrder tour, GtspOrderer(opts).Order(cost, stop));
+//   std::vector<Waypoint> path = cost.BuildPath(tour.vertices);
 //
-// Thread-safety: RankTourCost is immutable after Create; orderers are
-// stateless apart from their options.
+// Thread-safety: RankTourCost is immutable after Create.
 #ifndef COVPLAN_PLANNER_TOUR_RANK_TOUR_H_
 #define COVPLAN_PLANNER_TOUR_RANK_TOUR_H_
 
@@ -26,30 +25,36 @@
 #include "planner/plan/coverage_plan.h"
 #include "planner/tour/gtsp/gtsp.h"
 #include "planner/tour/robot_model.h"
+#include "planner/tour/tour_model.h"
 #include "planner/tour/transitions.h"
 
 namespace covplan {
 
-class RankTourCost {
+// The TourModel of OARP: one element per rank, two variants (vertex v = 2k + d
+// is rank k driven first->last for d = 0, last->first for d = 1).
+class RankTourCost final : public TourModel {
  public:
   // InvalidArgument if the start or end pose is outside the reachable free
-  // cells. Runs one any-angle search from the start (and end) cell.
+  // cells. Runs one any-angle search from the start (and end) cell. Moves
+  // are priced by `motion` (default: travel time under `robot`).
   static absl::StatusOr<RankTourCost> Create(const Grid& grid, const std::vector<Rank>& ranks,
                                              const TransitionTable& table,
-                                             const RobotModel& robot, const StopToken& stop);
+                                             const RobotModel& robot, const StopToken& stop,
+                                             std::shared_ptr<const MotionCost> motion = nullptr);
+
+  int num_elements() const override { return num_ranks(); }
+  int num_variants(int) const override { return 2; }
+  TourElementKind kind(int) const override { return TourElementKind::kRank; }
+  bool has_end() const override { return has_end_; }
+  double FromStart(int v) const override { return from_start_[v]; }
+  // Cost to drive from the exit of u to the entry of v and traverse v.
+  double Between(int u, int v) const override;
+  // Cost from the exit of u to the end point (the start if no end pose).
+  double ToEnd(int u) const override { return to_end_[u]; }
 
   int num_ranks() const { return static_cast<int>(ranks_->size()); }
-  int num_vertices() const { return 2 * num_ranks(); }
-  bool has_end() const { return has_end_; }
   const Pose2& start() const { return start_; }
-
-  // Seconds to drive from the exit of u to the entry of v and traverse v.
-  double Between(int u, int v) const;
-  double FromStart(int v) const { return from_start_[v]; }
-  // Seconds from the exit of u to the end point (the start if no end pose).
-  double ToEnd(int u) const { return to_end_[u]; }
-  // Total seconds of a tour given as rank vertices in visiting order.
-  double TourTime(const std::vector<int>& vertices) const;
+  double TourTime(const std::vector<int>& vertices) const { return TourCost(vertices); }
 
   // Waypoints of the whole tour (start, transitions, coverage, return).
   std::vector<Waypoint> BuildPath(const std::vector<int>& vertices) const;
@@ -66,53 +71,14 @@ class RankTourCost {
   const Grid* grid_ = nullptr;
   const std::vector<Rank>* ranks_ = nullptr;
   const TransitionTable* table_ = nullptr;
-  RobotModel robot_;
+  std::shared_ptr<const MotionCost> motion_;
   Pose2 start_;
   Pose2 end_;
   bool has_end_ = false;
-  std::vector<double> rank_time_;
+  std::vector<double> rank_cost_;
   std::vector<double> from_start_, to_end_;
   // Paths start -> entry endpoint and exit endpoint -> end, as points.
   std::vector<std::vector<Point2>> start_paths_, end_paths_;
-};
-
-struct RankTour {
-  std::vector<int> vertices;  // rank vertices in visiting order (one per rank)
-  double time_s = 0.0;        // RankTourCost::TourTime(vertices)
-  bool cut_short = false;     // the search was stopped by the deadline
-};
-
-struct OrdererOptions {
-  double time_limit_s = 1.0;
-  uint64_t seed = 1;
-  int num_threads = 1;
-  GtspEffort effort = GtspEffort::kDefault;
-};
-
-class RankOrderer {
- public:
-  virtual ~RankOrderer() = default;
-  virtual std::string_view name() const = 0;
-  virtual absl::StatusOr<RankTour> Order(const RankTourCost& cost, const StopToken& stop) const = 0;
-};
-
-// Nearest unvisited rank vertex from the current position.
-class GreedyOrderer final : public RankOrderer {
- public:
-  std::string_view name() const override { return "greedy"; }
-  absl::StatusOr<RankTour> Order(const RankTourCost& cost, const StopToken& stop) const override;
-};
-
-// Anytime GTSP: one set per rank, start vertex, optional end vertex with a
-// zero-cost arc end -> start. Warm-started from the greedy tour.
-class GtspOrderer final : public RankOrderer {
- public:
-  explicit GtspOrderer(OrdererOptions options) : options_(options) {}
-  std::string_view name() const override { return "gtsp"; }
-  absl::StatusOr<RankTour> Order(const RankTourCost& cost, const StopToken& stop) const override;
-
- private:
-  OrdererOptions options_;
 };
 
 }  // namespace covplan

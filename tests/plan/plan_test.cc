@@ -1,4 +1,4 @@
-#include "planner/plan/coverage_planner.h"
+#include "planner/engine/plan_coverage.h"
 
 #include <cmath>
 
@@ -67,9 +67,11 @@ TEST(PlanCoverage, OfficeMapConforms) {
     PlanOptions opt;
     opt.tour_solver = tour;
     opt.time_limit_s = 0.3;
-    auto plan = PlanCoverage(OfficeMap(), opt);
-    ASSERT_TRUE(plan.ok()) << plan.status();
-    EXPECT_EQ(testing::CheckRankPlanConformance(*plan, opt.robot), "");
+    auto result = PlanCoverageWithArea(OfficeMap(), opt);
+    ASSERT_TRUE(result.ok()) << result.status();
+    EXPECT_EQ(testing::CheckOarpConformance(*result, opt.robot), "");
+    const CoveragePlan* plan = &result->plan;
+    EXPECT_EQ(plan->planner, "oarp");
     EXPECT_GT(plan->stats.covered_free_area_ratio, 0.8);
     EXPECT_LE(plan->stats.covered_free_area_ratio, 1.0);
     EXPECT_GT(plan->stats.estimated_duration_s, 0.0);
@@ -88,7 +90,7 @@ TEST(PlanCoverage, LpAndMinCutGiveSameRankCount) {
   auto pa = PlanCoverage(OfficeMap(), a);
   auto pb = PlanCoverage(OfficeMap(), b);
   ASSERT_TRUE(pa.ok() && pb.ok());
-  EXPECT_EQ(pa->ranks.size(), pb->ranks.size());
+  EXPECT_EQ(pa->detail_as<OarpDetail>()->ranks.size(), pb->detail_as<OarpDetail>()->ranks.size());
   EXPECT_EQ(pb->stats.partition_solver, "lp");
 }
 
@@ -120,10 +122,10 @@ TEST(PlanCoverage, DisconnectedAreasAreReportedNotPlanned) {
   for (int r = 0; r < 160; ++r) for (int c = 150; c < 182; ++c) m.set(r, c, CellState::kOccupied);
   PlanOptions opt;
   opt.tour_solver = TourSolver::kGreedy;
-  auto plan = PlanCoverage(m, opt);
+  auto plan = PlanCoverageWithArea(m, opt);
   ASSERT_TRUE(plan.ok()) << plan.status();
-  EXPECT_GT(plan->stats.unreachable_free_cells, 0);
-  EXPECT_EQ(testing::CheckRankPlanConformance(*plan, opt.robot), "");
+  EXPECT_GT(plan->plan.stats.unreachable_free_cells, 0);
+  EXPECT_EQ(testing::CheckOarpConformance(*plan, opt.robot), "");
 }
 
 }  // namespace
@@ -153,9 +155,9 @@ TEST(BuildGrid, ThinWallBecomesBarrier) {
 
   PlanOptions po;
   po.tour_solver = TourSolver::kGreedy;
-  auto plan = PlanCoverage(m, po);
+  auto plan = PlanCoverageWithArea(m, po);
   ASSERT_TRUE(plan.ok()) << plan.status();
-  EXPECT_EQ(testing::CheckRankPlanConformance(*plan, po.robot), "");
+  EXPECT_EQ(testing::CheckOarpConformance(*plan, po.robot), "");
 }
 
 }  // namespace

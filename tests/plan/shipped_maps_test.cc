@@ -6,7 +6,7 @@
 #include "planner/grid/map_io.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
-#include "planner/plan/coverage_planner.h"
+#include "planner/engine/plan_coverage.h"
 #include "tests/testing/plan_conformance.h"
 
 namespace covplan {
@@ -32,10 +32,10 @@ TEST_P(ShippedMap, LpEqualsMinCutAndPlanConforms) {
   }
   PlanOptions opt;
   opt.time_limit_s = 0.3;
-  absl::StatusOr<CoveragePlan> plan = PlanCoverage(*map, opt);
+  absl::StatusOr<EngineResult> plan = PlanCoverageWithArea(*map, opt);
   ASSERT_TRUE(plan.ok()) << plan.status();
-  EXPECT_EQ(testing::CheckRankPlanConformance(*plan, opt.robot), "");
-  EXPECT_GT(plan->stats.covered_free_area_ratio, 0.5);
+  EXPECT_EQ(testing::CheckOarpConformance(*plan, opt.robot), "");
+  EXPECT_GT(plan->plan.stats.covered_free_area_ratio, 0.5);
 }
 
 TEST_P(ShippedMap, DriveLineNeverCrossesAnObstaclePixel) {

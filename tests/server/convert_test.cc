@@ -1,13 +1,15 @@
 // The proto <-> planner edge: map decoding and validation, request
 // validation, plan round trips and the JSON shape of plan.json.
-#include "server/convert.h"
+#include "api/convert.h"
 
 #include <cmath>
 #include <limits>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/engine/artifact_cache.h"
 #include "planner/grid/grid.h"
+#include "planner/oarp/oarp_planner.h"
 #include "tests/server/test_maps.h"
 
 namespace covplan {
@@ -116,59 +118,108 @@ TEST(MapFromProtoTest, EnforcesSizeLimits) {
               StatusIs(absl::StatusCode::kInvalidArgument, "too large"));
 }
 
-TEST(PlanOptionsFromProtoTest, ValidatesRobotAndSolvers) {
+TEST(PlanRequestFromProtoTest, ValidatesRobotAndSolvers) {
   const auto kInvalid = absl::StatusCode::kInvalidArgument;
-  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(0)), StatusIs(kInvalid, "tool_width_m"));
-  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(-1)), StatusIs(kInvalid, "tool_width_m"));
-  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(std::nan(""))), StatusIs(kInvalid, "tool_width_m"));
-  EXPECT_THAT(PlanOptionsFromProto(RequestWithTool(std::numeric_limits<double>::infinity())),
+  EXPECT_THAT(PlanRequestFromProto(RequestWithTool(0)), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanRequestFromProto(RequestWithTool(-1)), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanRequestFromProto(RequestWithTool(std::nan(""))), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanRequestFromProto(RequestWithTool(std::numeric_limits<double>::infinity())),
               StatusIs(kInvalid, "tool_width_m"));
   v1::PlanRequest request = RequestWithTool(0.5);
   request.mutable_robot()->set_max_speed_mps(0);
-  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "max_speed_mps"));
+  EXPECT_THAT(PlanRequestFromProto(request), StatusIs(kInvalid, "max_speed_mps"));
   request = RequestWithTool(0.5);
   request.set_time_limit_s(-1);
-  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "time_limit_s"));
+  EXPECT_THAT(PlanRequestFromProto(request), StatusIs(kInvalid, "time_limit_s"));
   request = RequestWithTool(0.5);
   request.set_min_free_fraction(1.5);
-  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "min_free_fraction"));
+  EXPECT_THAT(PlanRequestFromProto(request), StatusIs(kInvalid, "min_free_fraction"));
   request = RequestWithTool(0.5);
   request.set_partition_solver(static_cast<v1::PartitionSolver>(42));
-  EXPECT_THAT(PlanOptionsFromProto(request), StatusIs(kInvalid, "partition_solver"));
+  EXPECT_THAT(PlanRequestFromProto(request), StatusIs(kInvalid, "partition_solver"));
 
   request = RequestWithTool(0.5);
   request.set_partition_solver(v1::LP);
   request.set_tour_solver(v1::GREEDY);
   request.mutable_robot()->set_turn_rate_deg_s(90);
   request.set_seed(11);
-  absl::StatusOr<PlanOptions> options = PlanOptionsFromProto(request);
+  absl::StatusOr<PlanRequest> options = PlanRequestFromProto(request);
   ASSERT_TRUE(options.ok()) << options.status();
-  EXPECT_EQ(options->partition_solver, PartitionSolver::kLp);
-  EXPECT_EQ(options->tour_solver, TourSolver::kGreedy);
-  EXPECT_DOUBLE_EQ(options->robot.turn_rate_deg_s, 90);
-  EXPECT_DOUBLE_EQ(options->robot.tool_width_m, 0.5);
-  EXPECT_EQ(options->seed, 11u);
+  EXPECT_EQ(options->planner, "oarp");
+  const auto* oarp = dynamic_cast<const OarpOptions*>(options->options.get());
+  ASSERT_NE(oarp, nullptr);
+  EXPECT_EQ(oarp->partition_solver, PartitionSolver::kLp);
+  EXPECT_EQ(oarp->tour_solver, TourSolver::kGreedy);
+  EXPECT_DOUBLE_EQ(options->common.robot.turn_rate_deg_s, 90);
+  EXPECT_DOUBLE_EQ(options->common.robot.tool_width_m, 0.5);
+  EXPECT_EQ(options->common.seed, 11u);
+
+  // The oneof wins over the top-level solver fields, and its errors name it.
+  request.mutable_oarp()->set_partition_solver(v1::MINCUT);
+  options = PlanRequestFromProto(request);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(dynamic_cast<const OarpOptions*>(options->options.get())->partition_solver,
+            PartitionSolver::kMinCut);
+  request.mutable_oarp()->set_tour_solver(static_cast<v1::TourSolver>(9));
+  EXPECT_THAT(PlanRequestFromProto(request), StatusIs(kInvalid, "oarp.tour_solver"));
 }
 
-TEST(ValidatePlanForMapTest, ToolMustFitPixelAndMap) {
-  absl::StatusOr<OccupancyMap> map = MapFromProto(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1),
-                                                  InputLimits());  // 4.8 m x 3.2 m
-  ASSERT_TRUE(map.ok());
-  const InputLimits limits;
-  auto check = [&](double tool, const InputLimits& l) {
-    absl::StatusOr<PlanOptions> options = PlanOptionsFromProto(RequestWithTool(tool));
-    EXPECT_TRUE(options.ok());
-    return ValidatePlanForMap(*options, *map, l);
+TEST(PlanRequestFromProtoTest, CarriesPlannerAndZones) {
+  v1::PlanRequest request = RequestWithTool(0.5);
+  request.set_planner("stc");
+  v1::Polygon* zone = request.add_no_go();
+  for (auto [x, y] : {std::pair{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 0.0}}) {
+    v1::Point2* p = zone->mutable_outer()->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+  absl::StatusOr<PlanRequest> r = PlanRequestFromProto(request);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->planner, "stc");
+  EXPECT_EQ(r->options, nullptr);  // not OARP: no OARP options
+  ASSERT_EQ(r->no_go.size(), 1u);
+  EXPECT_EQ(r->no_go[0].outer.size(), 4u);
+  EXPECT_DOUBLE_EQ(r->no_go[0].outer[2].y, 1.0);
+}
+
+// Checks that need the map happen in the engine, reached through the same
+// conversion the server and the CLI use.
+TEST(EngineValidationTest, ToolMustFitPixelAndMapAndZonesTheMap) {
+  const v1::Map map = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);  // 4.8 m x 3.2 m
+  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  auto check = [&](double tool, const InputLimits& limits, v1::PlanRequest request) -> absl::Status {
+    LocalArtifactCache cache;
+    PlanningEngine engine(&registry, &cache, EngineLimitsFor(limits));
+    request.mutable_robot()->set_tool_width_m(tool);
+    request.set_time_limit_s(0.1);
+    absl::StatusOr<PlanRequest> r = PlanRequestFromProto(request);
+    if (!r.ok()) return r.status();
+    MapSource source{ComputeMapId(map), [&] { return SiteFromProto(map, limits); }};
+    return engine.Plan(source, *r).status();
   };
-  EXPECT_TRUE(check(0.4, limits).ok());
-  EXPECT_THAT(absl::StatusOr<int>(check(0.05, limits)),
+  const InputLimits limits;
+  EXPECT_TRUE(check(0.4, limits, {}).ok());
+  EXPECT_THAT(absl::StatusOr<int>(check(0.05, limits, {})),
               StatusIs(absl::StatusCode::kInvalidArgument, "narrower than one map pixel"));
-  EXPECT_THAT(absl::StatusOr<int>(check(3.5, limits)),
+  EXPECT_THAT(absl::StatusOr<int>(check(3.5, limits, {})),
               StatusIs(absl::StatusCode::kInvalidArgument, "wider than the map"));
   InputLimits tight;
   tight.max_grid_cells = 10;
-  EXPECT_THAT(absl::StatusOr<int>(check(0.4, tight)),
+  EXPECT_THAT(absl::StatusOr<int>(check(0.4, tight, {})),
               StatusIs(absl::StatusCode::kInvalidArgument, "above the limit"));
+  v1::PlanRequest far;
+  v1::Ring* ring = far.add_no_go()->mutable_outer();
+  for (auto [x, y] : {std::pair{50.0, 50.0}, {51.0, 50.0}, {51.0, 51.0}, {50.0, 50.0}}) {
+    v1::Point2* p = ring->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+  EXPECT_THAT(absl::StatusOr<int>(check(0.4, limits, far)),
+              StatusIs(absl::StatusCode::kInvalidArgument, "no_go[0] lies outside the map"));
+  v1::PlanRequest unknown;
+  unknown.set_planner("nope");
+  EXPECT_THAT(absl::StatusOr<int>(check(0.4, limits, unknown)),
+              StatusIs(absl::StatusCode::kInvalidArgument, "unknown planner 'nope'; registered: oarp"));
 }
 
 TEST(MapIdTest, ContentDerivedAndWellFormed) {
@@ -185,12 +236,17 @@ TEST(MapIdTest, ContentDerivedAndWellFormed) {
 
 CoveragePlan SmallPlan() {
   CoveragePlan plan;
+  plan.planner = "oarp";
   plan.grid = std::make_shared<const Grid>(Grid::FromAscii({"...", ".#."}, 0.5));
-  plan.ranks = {Rank{Orientation::kHorizontal, {1, 0}, {1, 2}},
-                Rank{Orientation::kVertical, {0, 0}, {0, 0}},
-                Rank{Orientation::kVertical, {0, 2}, {0, 2}}};
-  plan.rank_order = {0, 2, 1};
-  plan.rank_reversed = {false, true, false};
+  auto oarp = std::make_shared<OarpDetail>();
+  oarp->ranks = {Rank{Orientation::kHorizontal, {1, 0}, {1, 2}},
+                 Rank{Orientation::kVertical, {0, 0}, {0, 0}},
+                 Rank{Orientation::kVertical, {0, 2}, {0, 2}}};
+  oarp->rank_order = {0, 2, 1};
+  oarp->rank_reversed = {false, true, false};
+  plan.detail = oarp;
+  plan.sweeps = {CoverageSweep{1, {{1, 0}, {1, 1}, {1, 2}}}};
+  plan.termination = Termination::LimitReached(TerminationLimit::kDeadline, "stopped");
   plan.path = {Waypoint{0.25, 0.75, 0, SegmentKind::kStart, -1},
                Waypoint{1.25, 0.75, 0, SegmentKind::kCoverage, 0},
                Waypoint{1.25, 0.25, -M_PI / 2, SegmentKind::kTransition, -1}};
@@ -218,11 +274,21 @@ TEST(PlanProtoTest, RoundTripsThroughProto) {
   absl::StatusOr<CoveragePlan> back = PlanFromProto(response);
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_EQ(back->grid->free_flags(), plan.grid->free_flags());
-  ASSERT_EQ(back->ranks.size(), 3u);
-  EXPECT_EQ(back->ranks[0].last, (CellIndex{1, 2}));
-  EXPECT_EQ(back->ranks[2].orientation, Orientation::kVertical);
-  EXPECT_EQ(back->rank_order, plan.rank_order);
-  EXPECT_EQ(back->rank_reversed, plan.rank_reversed);
+  const OarpDetail* oarp = back->detail_as<OarpDetail>();
+  ASSERT_NE(oarp, nullptr);
+  ASSERT_EQ(oarp->ranks.size(), 3u);
+  EXPECT_EQ(oarp->ranks[0].last, (CellIndex{1, 2}));
+  EXPECT_EQ(oarp->ranks[2].orientation, Orientation::kVertical);
+  EXPECT_EQ(oarp->rank_order, plan.detail_as<OarpDetail>()->rank_order);
+  EXPECT_EQ(oarp->rank_reversed, plan.detail_as<OarpDetail>()->rank_reversed);
+  ASSERT_EQ(back->sweeps.size(), 1u);
+  EXPECT_EQ(back->sweeps[0].cells[2], (CellIndex{1, 2}));
+  EXPECT_EQ(back->termination.limit, TerminationLimit::kDeadline);
+  EXPECT_EQ(back->termination.reason, TerminationReason::kFeasibleLimitReached);
+  EXPECT_EQ(back->planner, "oarp");
+  // Old callers' top-level fields and the oneof say the same.
+  EXPECT_EQ(response.ranks_size(), response.oarp().ranks_size());
+  EXPECT_EQ(response.sweeps(0).cells(2), 1 * 3 + 2);
   ASSERT_EQ(back->path.size(), 3u);
   EXPECT_EQ(back->path[1].kind, SegmentKind::kCoverage);
   EXPECT_DOUBLE_EQ(back->path[2].theta, -M_PI / 2);
@@ -241,7 +307,7 @@ TEST(PlanProtoTest, RejectsInconsistentResponses) {
   broken.mutable_grid()->set_free_cells(0, "10");
   EXPECT_THAT(PlanFromProto(broken), StatusIs(absl::StatusCode::kInvalidArgument, "row length"));
   broken = response;
-  broken.add_rank_order(7);
+  broken.mutable_oarp()->add_rank_order(7);
   EXPECT_THAT(PlanFromProto(broken), StatusIs(absl::StatusCode::kInvalidArgument, "rank_order"));
 }
 
@@ -261,6 +327,10 @@ TEST(PlanJsonTest, SnakeCaseNamesEnumNamesAndDefaultsPrinted) {
   EXPECT_THAT(*json, HasSubstr("\"transition_length_m\": 0"));  // primitive default printed
   EXPECT_THAT(*json, HasSubstr("\"tour_cut_short\": true"));
   EXPECT_THAT(*json, HasSubstr("\"map_id\": \"\""));
+  EXPECT_THAT(*json, HasSubstr("\"reason\": \"FEASIBLE_LIMIT_REACHED\""));
+  EXPECT_THAT(*json, HasSubstr("\"limit\": \"LIMIT_DEADLINE\""));
+  EXPECT_THAT(*json, HasSubstr("\"planner\": \"oarp\""));
+  EXPECT_THAT(*json, HasSubstr("\"sweeps\": ["));
   EXPECT_THAT(*json, ::testing::Not(HasSubstr("numRanks")));
 }
 

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "gtest/gtest.h"
-#include "server/convert.h"
+#include "api/convert.h"
 #include "tests/server/test_maps.h"
 
 namespace covplan {

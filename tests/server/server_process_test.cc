@@ -16,7 +16,7 @@
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "server/convert.h"
+#include "api/convert.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
 #include "tests/server/test_maps.h"
@@ -340,9 +340,9 @@ TEST_F(ServerProcessTest, MetricsHealthAndDrainOnSigterm) {
   for (const char* family :
        {"covplan_requests_total", "covplan_request_duration_seconds_bucket",
         "covplan_plan_solve_duration_seconds", "covplan_worker_queue_depth",
-        "covplan_solves_in_flight", "covplan_decomposition_cache_hits_total",
-        "covplan_decomposition_cache_misses_total", "covplan_decomposition_cache_evictions_total",
-        "covplan_decomposition_cache_bytes", "covplan_plans_cut_short_total"}) {
+        "covplan_solves_in_flight", "covplan_artifact_cache_hits_total",
+        "covplan_artifact_cache_misses_total", "covplan_artifact_cache_evictions_total",
+        "covplan_artifact_cache_bytes", "covplan_plans_cut_short_total"}) {
     EXPECT_THAT(*metrics, HasSubstr(family));
   }
   absl::StatusOr<int> health = testing::HealthStatus(channel_, "");

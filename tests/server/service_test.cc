@@ -374,8 +374,9 @@ TEST_F(MetricsServiceTest, MetricsEndpointExposesTheFamilies) {
         "covplan_request_duration_seconds_bucket{method=\"Plan\"",
         "covplan_plan_solve_duration_seconds_count 1", "covplan_plans_cut_short_total",
         "covplan_worker_queue_depth", "covplan_solves_in_flight",
-        "covplan_decomposition_cache_misses_total 1", "covplan_decomposition_cache_hits_total",
-        "covplan_decomposition_cache_evictions_total", "covplan_decomposition_cache_bytes",
+        "covplan_artifact_cache_misses_total 4", // grid, area, partition, transitions
+        "covplan_artifact_cache_hits_total",
+        "covplan_artifact_cache_evictions_total", "covplan_artifact_cache_bytes",
         "covplan_maps_stored 1"}) {
     EXPECT_THAT(*body, HasSubstr(family));
   }

@@ -1,7 +1,8 @@
-// The conformance checks every coverage planner must pass: every free cell
-// covered, the path never enters a blocked cell, statistics consistent with
-// the path. Independent of the planner's own geometry code: segments are
-// checked by dense sampling.
+// The conformance checks every coverage planner must pass, proven from the
+// path and its sweeps: every cell to cover swept, the path never enters a
+// blocked cell, a barrier or a no-go polygon, statistics consistent with the
+// path. Independent of the planner's own geometry code: segments are checked
+// by dense sampling and a point-in-polygon test of their own.
 #ifndef COVPLAN_TESTS_TESTING_PLAN_CONFORMANCE_H_
 #define COVPLAN_TESTS_TESTING_PLAN_CONFORMANCE_H_
 
@@ -10,8 +11,12 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include <algorithm>
+
+#include "planner/engine/engine.h"
+#include "planner/engine/plan_coverage.h"
+#include "planner/oarp/oarp_planner.h"
 #include "planner/plan/coverage_plan.h"
-#include "planner/plan/coverage_planner.h"
 #include "tests/testing/grid_fixtures.h"
 
 namespace covplan::testing {
@@ -87,20 +92,143 @@ inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoi
   return "";
 }
 
-// Every rank driven exactly once, end to end, by one coverage segment; ranks
-// cover every free cell exactly once; stats match the path.
-inline std::string CheckRankPlanConformance(const CoveragePlan& plan, const RobotModel& robot) {
+// Strictly inside `ring` (even-odd ray casting; points on the boundary may
+// go either way, so callers keep a margin). Independent of Boost.Geometry.
+inline bool InsideRing(const std::vector<Point2>& ring, double x, double y) {
+  bool in = false;
+  for (size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const Point2& a = ring[i];
+    const Point2& b = ring[j];
+    if ((a.y > y) != (b.y > y) && x < (b.x - a.x) * (y - a.y) / (b.y - a.y) + a.x) in = !in;
+  }
+  return in;
+}
+inline bool InsidePolygon(const PolygonInput& p, double x, double y) {
+  if (!InsideRing(p.outer, x, y)) return false;
+  for (const auto& hole : p.holes) {
+    if (InsideRing(hole, x, y)) return false;
+  }
+  return true;
+}
+// Distance from (x, y) to the polygon's boundary.
+inline double BoundaryDistance(const PolygonInput& p, double x, double y) {
+  double best = 1e300;
+  auto ring = [&](const std::vector<Point2>& r) {
+    for (size_t i = 1; i < r.size(); ++i) {
+      const double dx = r[i].x - r[i - 1].x, dy = r[i].y - r[i - 1].y;
+      const double len2 = dx * dx + dy * dy;
+      double t = len2 > 0 ? ((x - r[i - 1].x) * dx + (y - r[i - 1].y) * dy) / len2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      best = std::min(best, std::hypot(x - (r[i - 1].x + t * dx), y - (r[i - 1].y + t * dy)));
+    }
+  };
+  ring(p.outer);
+  for (const auto& h : p.holes) ring(h);
+  return best;
+}
+
+// "" when no point of the path (sampled every 1 mm) lies inside a no-go
+// polygon by more than 1e-6 m; else the first offending segment.
+inline std::string CheckPathAvoidsZones(const std::vector<Waypoint>& path,
+                                        const std::vector<PolygonInput>& no_go) {
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Waypoint& a = path[i - 1];
+    const Waypoint& b = path[i];
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / 1e-3)));
+    for (int k = 0; k <= steps; ++k) {
+      const double t = static_cast<double>(k) / steps;
+      const double x = a.x + t * (b.x - a.x), y = a.y + t * (b.y - a.y);
+      for (size_t z = 0; z < no_go.size(); ++z) {
+        if (InsidePolygon(no_go[z], x, y) && BoundaryDistance(no_go[z], x, y) > 1e-6) {
+          return absl::StrFormat("segment %d enters no-go zone %d at (%.4f, %.4f)", i, z, x, y);
+        }
+      }
+    }
+  }
+  return "";
+}
+
+// The conformance every registered planner must pass, proven from the path:
+//  - the path never leaves the drive grid's free cells or crosses a barrier;
+//  - every coverage segment has a sweep, and every swept cell is a free
+//    drive cell whose centre the segment passes through;
+//  - every cell to cover is swept;
+//  - the statistics agree with the path;
+//  - no segment enters a no-go polygon (dense sampling, own point test).
+inline std::string CheckPlanConformance(const CoveragePlan& plan, const CoverageArea& area,
+                                        const RobotModel& robot,
+                                        const std::vector<PolygonInput>& no_go = {}) {
+  const Grid& drive = *area.drive;
+  const Grid& cover = *area.cover;
+  if (plan.grid.get() != area.drive.get()) return "plan grid is not the area's drive grid";
+  std::string err = CheckPathStaysFree(drive, plan.path);
+  if (!err.empty()) return err;
+  err = CheckPathAvoidsZones(plan.path, no_go);
+  if (!err.empty()) return err;
+  int coverage_segments = 0;
+  for (size_t i = 1; i < plan.path.size(); ++i) coverage_segments += plan.path[i].kind == SegmentKind::kCoverage;
+  if (static_cast<int>(plan.sweeps.size()) != coverage_segments) {
+    return absl::StrFormat("%d sweeps for %d coverage segments", plan.sweeps.size(), coverage_segments);
+  }
+  std::vector<uint8_t> swept(drive.size(), 0);
+  int last = 0;
+  for (const CoverageSweep& s : plan.sweeps) {
+    if (s.waypoint <= last || s.waypoint >= static_cast<int>(plan.path.size()) ||
+        plan.path[s.waypoint].kind != SegmentKind::kCoverage) {
+      return absl::StrFormat("sweep at waypoint %d is not a coverage segment in path order", s.waypoint);
+    }
+    last = s.waypoint;
+    const Waypoint& a = plan.path[s.waypoint - 1];
+    const Waypoint& b = plan.path[s.waypoint];
+    for (const CellIndex& c : s.cells) {
+      if (!drive.IsFree(c)) {
+        return absl::StrFormat("sweep %d sweeps blocked cell (%d, %d)", s.waypoint, c.row, c.col);
+      }
+      const Point2 m = drive.CellCenter(c);
+      const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+      const double t = len2 > 0 ? std::clamp(((m.x - a.x) * dx + (m.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+      if (std::hypot(m.x - (a.x + t * dx), m.y - (a.y + t * dy)) > 1e-6) {
+        return absl::StrFormat("sweep %d claims cell (%d, %d) that its segment misses", s.waypoint, c.row, c.col);
+      }
+      swept[drive.Index(c.row, c.col)] = 1;
+    }
+  }
+  int64_t covered = 0, to_cover = 0;
+  for (int64_t i = 0; i < drive.size(); ++i) {
+    covered += swept[i];
+    if (!cover.free_flags()[i]) continue;
+    ++to_cover;
+    if (!swept[i]) {
+      const CellIndex c = drive.FromIndex(i);
+      return absl::StrFormat("cell (%d, %d) to cover is never swept", c.row, c.col);
+    }
+  }
+  const PlanStats s = ComputePathStats(plan.path, robot);
+  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b)); };
+  if (s.num_turns != plan.stats.num_turns) return "num_turns inconsistent with the path";
+  if (!close(s.coverage_length_m, plan.stats.coverage_length_m)) return "coverage length inconsistent";
+  if (!close(s.transition_length_m, plan.stats.transition_length_m)) return "transition length inconsistent";
+  if (!close(s.estimated_duration_s, plan.stats.estimated_duration_s)) return "duration inconsistent";
+  if (plan.stats.covered_cells != covered) return "covered_cells inconsistent with the sweeps";
+  if (plan.stats.free_cells != to_cover) return "free_cells is not the number of cells to cover";
+  return "";
+}
+
+// OARP's own invariants on top: the ranks partition the cells to cover
+// exactly, and each rank is driven once, end to end, by one coverage segment.
+inline std::string CheckOarpDetail(const CoveragePlan& plan, const Grid& cover) {
+  const OarpDetail* oarp = plan.detail_as<OarpDetail>();
+  if (oarp == nullptr) return "plan has no OARP detail";
+  std::string err = CheckExactCover(cover, oarp->ranks);
+  if (!err.empty()) return err;
   const Grid& grid = *plan.grid;
-  std::string err = CheckExactCover(grid, plan.ranks);
-  if (!err.empty()) return err;
-  err = CheckPathStaysFree(grid, plan.path);
-  if (!err.empty()) return err;
-  std::vector<int> driven(plan.ranks.size(), 0);
+  std::vector<int> driven(oarp->ranks.size(), 0);
   for (size_t i = 1; i < plan.path.size(); ++i) {
     const Waypoint& w = plan.path[i];
     if (w.kind != SegmentKind::kCoverage) continue;
-    if (w.rank < 0 || w.rank >= static_cast<int>(plan.ranks.size())) return "coverage segment without rank";
-    const Rank& r = plan.ranks[w.rank];
+    if (w.rank < 0 || w.rank >= static_cast<int>(oarp->ranks.size())) return "coverage segment without rank";
+    const Rank& r = oarp->ranks[w.rank];
     const Point2 f = grid.CellCenter(r.first), l = grid.CellCenter(r.last);
     const Waypoint& prev = plan.path[i - 1];
     auto near = [](double x, double y, Point2 p) { return std::hypot(x - p.x, y - p.y) < 1e-6; };
@@ -112,14 +240,16 @@ inline std::string CheckRankPlanConformance(const CoveragePlan& plan, const Robo
   for (size_t k = 0; k < driven.size(); ++k) {
     if (driven[k] != 1) return absl::StrFormat("rank %d driven %d times", k, driven[k]);
   }
-  const PlanStats s = ComputePathStats(plan.path, robot);
-  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b)); };
-  if (s.num_turns != plan.stats.num_turns) return "num_turns inconsistent with the path";
-  if (!close(s.coverage_length_m, plan.stats.coverage_length_m)) return "coverage length inconsistent";
-  if (!close(s.transition_length_m, plan.stats.transition_length_m)) return "transition length inconsistent";
-  if (!close(s.estimated_duration_s, plan.stats.estimated_duration_s)) return "duration inconsistent";
-  if (plan.stats.num_ranks != static_cast<int64_t>(plan.ranks.size())) return "num_ranks inconsistent";
+  if (plan.stats.num_ranks != static_cast<int64_t>(oarp->ranks.size())) return "num_ranks inconsistent";
   return "";
+}
+
+// Both of the above for an engine result.
+inline std::string CheckOarpConformance(const EngineResult& r, const RobotModel& robot,
+                                        const std::vector<PolygonInput>& no_go = {}) {
+  std::string err = CheckPlanConformance(r.plan, *r.area, robot, no_go);
+  if (!err.empty()) return err;
+  return CheckOarpDetail(r.plan, *r.area->cover);
 }
 
 }  // namespace covplan::testing

@@ -4,7 +4,8 @@
 
 #include "gtest/gtest.h"
 #include "planner/partition/mincut_partitioner.h"
-#include "planner/plan/coverage_planner.h"
+#include "planner/engine/engine.h"
+#include "planner/oarp/oarp_planner.h"
 #include "planner/tour/grid_paths.h"
 #include "tests/testing/grid_fixtures.h"
 #include "tests/testing/plan_conformance.h"
@@ -25,14 +26,24 @@ Fixture Make(Grid grid) {
   return f;
 }
 
-CoveragePlan AsPlan(const Fixture& f, const RankTourCost& cost, const RankTour& tour, const RobotModel& robot) {
+CoveragePlan AsPlan(const Fixture& f, const RankTourCost& cost, const TourOrder& tour, const RobotModel& robot) {
   CoveragePlan plan;
   plan.grid = std::make_shared<const Grid>(f.grid);
-  plan.ranks = f.partition.ranks;
+  auto detail = std::make_shared<OarpDetail>();
+  detail->ranks = f.partition.ranks;
+  plan.detail = detail;
   plan.path = cost.BuildPath(tour.vertices);
   plan.stats = ComputePathStats(plan.path, robot);
-  plan.stats.num_ranks = static_cast<int64_t>(plan.ranks.size());
+  plan.stats.num_ranks = static_cast<int64_t>(f.partition.ranks.size());
   return plan;
+}
+
+// The rank tour's own invariants: ranks driven once each, the path in free
+// cells across no barrier.
+std::string CheckRankPlan(const CoveragePlan& plan) {
+  std::string err = testing::CheckOarpDetail(plan, *plan.grid);
+  if (!err.empty()) return err;
+  return testing::CheckPathStaysFree(*plan.grid, plan.path);
 }
 
 const std::vector<std::string> kRooms = {
@@ -74,13 +85,13 @@ TEST(RankTour, TourTimeEqualsPathDuration) {
   auto cost = RankTourCost::Create(f.grid, f.partition.ranks, *f.table, robot, StopToken());
   ASSERT_TRUE(cost.ok()) << cost.status();
   for (bool gtsp : {false, true}) {
-    absl::StatusOr<RankTour> tour = gtsp ? GtspOrderer({0.3, 1, 1}).Order(*cost, StopToken())
+    absl::StatusOr<TourOrder> tour = gtsp ? GtspOrderer({0.3, 1, 1}).Order(*cost, StopToken())
                                          : GreedyOrderer().Order(*cost, StopToken());
     ASSERT_TRUE(tour.ok()) << tour.status();
     ASSERT_EQ(tour->vertices.size(), f.partition.ranks.size());
     CoveragePlan plan = AsPlan(f, *cost, *tour, robot);
-    EXPECT_EQ(testing::CheckRankPlanConformance(plan, robot), "");
-    EXPECT_NEAR(plan.stats.estimated_duration_s, tour->time_s, 1e-6);
+    EXPECT_EQ(CheckRankPlan(plan), "");
+    EXPECT_NEAR(plan.stats.estimated_duration_s, tour->cost, 1e-6);
     // Ends back at the start pose.
     EXPECT_NEAR(plan.path.back().x, 0.5, 1e-9);
     EXPECT_NEAR(plan.path.back().y, 0.3, 1e-9);
@@ -100,8 +111,8 @@ TEST(RankTour, GtspNoWorseThanGreedy) {
     auto greedy = GreedyOrderer().Order(*cost, StopToken());
     auto gtsp = GtspOrderer({0.5, seed, 1}).Order(*cost, StopToken());
     ASSERT_TRUE(greedy.ok() && gtsp.ok());
-    EXPECT_LE(gtsp->time_s, greedy->time_s + 1e-9);
-    EXPECT_EQ(testing::CheckRankPlanConformance(AsPlan(f, *cost, *gtsp, robot), robot), "");
+    EXPECT_LE(gtsp->cost, greedy->cost + 1e-9);
+    EXPECT_EQ(CheckRankPlan(AsPlan(f, *cost, *gtsp, robot)), "");
   }
 }
 
@@ -117,7 +128,7 @@ TEST(RankTour, EndPoseIsHonoured) {
   CoveragePlan plan = AsPlan(f, *cost, *tour, robot);
   EXPECT_NEAR(plan.path.back().x, 19.5, 1e-9);
   EXPECT_NEAR(plan.path.back().y, 9.5, 1e-9);
-  EXPECT_NEAR(plan.stats.estimated_duration_s, tour->time_s, 1e-6);
+  EXPECT_NEAR(plan.stats.estimated_duration_s, tour->cost, 1e-6);
 }
 
 TEST(RankTour, StartPoseInBlockedCellJoinsTheNearestAdjacentFreeCell) {
@@ -141,7 +152,7 @@ TEST(RankTour, StartPoseInBlockedCellJoinsTheNearestAdjacentFreeCell) {
   const std::vector<Waypoint> inner(plan.path.begin() + 1, plan.path.end() - 1);
   EXPECT_EQ(testing::CheckPathStaysFree(f.grid, inner), "");
   EXPECT_NEAR(plan.path.back().x, 3.4, 1e-9);
-  EXPECT_NEAR(plan.stats.estimated_duration_s, tour->time_s, 1e-6);
+  EXPECT_NEAR(plan.stats.estimated_duration_s, tour->cost, 1e-6);
 }
 
 TEST(RankTour, PoseFarFromFreeCellsIsInvalidArgument) {

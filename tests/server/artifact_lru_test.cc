@@ -1,7 +1,7 @@
 // The LRU + single-flight cache: byte budget, eviction order, one build for
 // concurrent callers, failed builds not cached, waiters bounded by their own
 // deadline.
-#include "server/decomposition_cache.h"
+#include "server/artifact_lru.h"
 
 #include <atomic>
 #include <thread>

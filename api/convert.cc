@@ -1,4 +1,4 @@
-#include "server/convert.h"
+#include "api/convert.h"
 
 #include <cctype>
 #include <cmath>
@@ -15,7 +15,9 @@
 #include "planner/grid/grid.h"
 #include "planner/grid/map_io.h"
 #include "planner/partition/rank.h"
-#include "server/digest.h"
+#include "api/digest.h"
+#include "api/geojson.h"
+#include "planner/oarp/oarp_planner.h"
 
 namespace covplan {
 namespace {
@@ -119,6 +121,21 @@ absl::Status InputLimits::Validate() const {
 }
 
 std::string ComputeMapId(const v1::Map& map) {
+  if (map.source_case() == v1::Map::kPolygons) {
+    std::string canonical = "covplan.map.v1.polygons\n";
+    const v1::PolygonMap& pm = map.polygons();
+    AppendField(&canonical, "resolution", absl::StrFormat("%a", pm.resolution()));
+    auto ring = [&](const char* name, const v1::Ring& r) {
+      std::string pts;
+      for (const v1::Point2& p : r.points()) absl::StrAppendFormat(&pts, "%a,%a;", p.x(), p.y());
+      AppendField(&canonical, name, pts);
+    };
+    for (const v1::Polygon& p : pm.polygons()) {
+      ring("outer", p.outer());
+      for (const v1::Ring& h : p.holes()) ring("hole", h);
+    }
+    return Sha256Hex(canonical);
+  }
   std::string canonical = "covplan.map.v1\n";
   const v1::RasterMap& r = map.raster();
   AppendField(&canonical, "image", r.image());
@@ -146,7 +163,9 @@ absl::Status ValidateMapId(absl::string_view map_id) {
 
 absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits& limits) {
   if (map.source_case() != v1::Map::kRaster) {
-    return absl::InvalidArgumentError("map has no source: set map.raster");
+    return absl::InvalidArgumentError(map.source_case() == v1::Map::kPolygons
+                                          ? "map.polygons is a vector map, not a raster"
+                                          : "map has no source: set map.raster or map.polygons");
   }
   const v1::RasterMap& r = map.raster();
   if (r.image().empty()) return absl::InvalidArgumentError("map.raster.image is empty");
@@ -217,8 +236,13 @@ absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits&
   return decoded;
 }
 
-absl::StatusOr<PlanOptions> PlanOptionsFromProto(const v1::PlanRequest& request) {
-  PlanOptions options;
+absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request) {
+  PlanRequest out;
+  out.planner = request.planner().empty() ? std::string(PlannerRegistry::kDefault) : request.planner();
+  if (out.planner.size() > 64) {
+    return absl::InvalidArgumentError("planner: name longer than 64 characters");
+  }
+  CommonOptions& options = out.common;
   const v1::RobotModel& robot = request.robot();
   using M = RobotModel;
   RETURN_IF_ERROR(CheckRange(robot.tool_width_m(), "robot.tool_width_m", M::kMinToolWidth,
@@ -250,29 +274,42 @@ absl::StatusOr<PlanOptions> PlanOptionsFromProto(const v1::PlanRequest& request)
   if (robot.has_start()) options.robot.start = Pose2{robot.start().x(), robot.start().y(), robot.start().theta()};
   if (robot.has_end()) options.robot.end = Pose2{robot.end().x(), robot.end().y(), robot.end().theta()};
 
-  switch (request.partition_solver()) {
-    case v1::PARTITION_SOLVER_UNSPECIFIED:
-    case v1::MINCUT:
-      options.partition_solver = PartitionSolver::kMinCut;
-      break;
-    case v1::LP:
-      options.partition_solver = PartitionSolver::kLp;
-      break;
-    default:
-      return absl::InvalidArgumentError(
-          absl::StrCat("unknown partition_solver ", static_cast<int>(request.partition_solver())));
-  }
-  switch (request.tour_solver()) {
-    case v1::TOUR_SOLVER_UNSPECIFIED:
-    case v1::GTSP:
-      options.tour_solver = TourSolver::kGtsp;
-      break;
-    case v1::GREEDY:
-      options.tour_solver = TourSolver::kGreedy;
-      break;
-    default:
-      return absl::InvalidArgumentError(
-          absl::StrCat("unknown tour_solver ", static_cast<int>(request.tour_solver())));
+  if (request.planner_options_case() == v1::PlanRequest::kOarp || out.planner == "oarp") {
+    if (request.planner_options_case() != v1::PlanRequest::kOarp &&
+        request.planner_options_case() != v1::PlanRequest::PLANNER_OPTIONS_NOT_SET) {
+      return absl::InvalidArgumentError("planner_options: planner 'oarp' takes the oarp options");
+    }
+    const bool nested = request.has_oarp();
+    const char* prefix = nested ? "oarp." : "";
+    const v1::PartitionSolver partition =
+        nested ? request.oarp().partition_solver() : request.partition_solver();
+    const v1::TourSolver tour = nested ? request.oarp().tour_solver() : request.tour_solver();
+    auto oarp = std::make_shared<OarpOptions>();
+    switch (partition) {
+      case v1::PARTITION_SOLVER_UNSPECIFIED:
+      case v1::MINCUT:
+        oarp->partition_solver = PartitionSolver::kMinCut;
+        break;
+      case v1::LP:
+        oarp->partition_solver = PartitionSolver::kLp;
+        break;
+      default:
+        return absl::InvalidArgumentError(
+            absl::StrCat(prefix, "partition_solver: unknown value ", static_cast<int>(partition)));
+    }
+    switch (tour) {
+      case v1::TOUR_SOLVER_UNSPECIFIED:
+      case v1::GTSP:
+        oarp->tour_solver = TourSolver::kGtsp;
+        break;
+      case v1::GREEDY:
+        oarp->tour_solver = TourSolver::kGreedy;
+        break;
+      default:
+        return absl::InvalidArgumentError(
+            absl::StrCat(prefix, "tour_solver: unknown value ", static_cast<int>(tour)));
+    }
+    out.options = std::move(oarp);
   }
   const double limit = request.time_limit_s();
   if (!std::isfinite(limit) || limit < 0.0 || limit > 3600.0) {
@@ -289,40 +326,43 @@ absl::StatusOr<PlanOptions> PlanOptionsFromProto(const v1::PlanRequest& request)
     }
     options.min_free_fraction = fraction;
   }
+  out.regions = PolygonsFromProto(request.regions());
+  out.no_go = PolygonsFromProto(request.no_go());
   RETURN_IF_ERROR(options.Validate());
-  return options;
+  return out;
 }
 
-DecompositionOptions DecompositionOptionsFor(const PlanOptions& options,
-                                             const InputLimits& limits) {
-  DecompositionOptions d = options.decomposition();
-  d.grid.max_cells = limits.max_grid_cells;
-  d.max_ranks = limits.max_ranks;
-  return d;
+EngineLimits EngineLimitsFor(const InputLimits& limits) {
+  EngineLimits e;
+  e.max_grid_cells = limits.max_grid_cells;
+  e.max_ranks = limits.max_ranks;
+  e.max_area_vertices = limits.max_area_vertices;
+  return e;
 }
 
-absl::Status ValidatePlanForMap(const PlanOptions& options, const OccupancyMap& map,
-                                const InputLimits& limits) {
-  const double tool = options.robot.tool_width_m;
-  const double res = map.resolution();
-  if (tool < res) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "robot.tool_width_m (%g m) is narrower than one map pixel (%g m)", tool, res));
+absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const InputLimits& limits) {
+  if (map.source_case() == v1::Map::kPolygons) {
+    const v1::PolygonMap& pm = map.polygons();
+    if (pm.polygons().empty()) {
+      return absl::InvalidArgumentError("map.polygons.polygons is empty: no free space");
+    }
+    AreaLimits area_limits;
+    area_limits.max_vertices = limits.max_area_vertices;
+    ASSIGN_OR_RETURN(Area area, Area::Create(PolygonsFromProto(pm.polygons()), "map.polygons",
+                                             area_limits));
+    double resolution = pm.resolution();
+    if (resolution == 0.0) resolution = 0.05;
+    if (!std::isfinite(resolution) || resolution < 1e-3 || resolution > 10.0) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "map.polygons.resolution must be between 0.001 and 10 m (got %g)", resolution));
+    }
+    return SiteFromPolygons(std::make_shared<const Area>(std::move(area)), resolution,
+                            limits.max_map_pixels);
   }
-  const double width_m = map.width() * res;
-  const double height_m = map.height() * res;
-  if (tool > width_m || tool > height_m) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "robot.tool_width_m (%g m) is wider than the map (%g m x %g m)", tool, width_m, height_m));
-  }
-  const double cells = std::ceil(width_m / tool) * std::ceil(height_m / tool);
-  if (cells > static_cast<double>(limits.max_grid_cells)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "the grid would have %.0f tool-width cells, above the limit of %d; use a wider tool "
-        "or a smaller map",
-        cells, limits.max_grid_cells));
-  }
-  return absl::OkStatus();
+  ASSIGN_OR_RETURN(OccupancyMap raster, MapFromProto(map, limits));
+  SiteMap site;
+  site.raster = std::make_shared<const OccupancyMap>(std::move(raster));
+  return site;
 }
 
 v1::MapInfo MapInfoFor(const OccupancyMap& map, const std::string& map_id) {
@@ -337,13 +377,27 @@ v1::MapInfo MapInfoFor(const OccupancyMap& map, const std::string& map_id) {
   return info;
 }
 
+v1::MapInfo MapInfoFor(const SiteMap& site, const std::string& map_id) {
+  v1::MapInfo info = MapInfoFor(*site.raster, map_id);
+  if (site.polygons != nullptr) info.set_free_area_m2(site.polygons->AreaM2());
+  return info;
+}
+
 absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path,
                                          const MapFileOverrides& overrides,
                                          const InputLimits& limits) {
   v1::Map map;
-  v1::RasterMap* raster = map.mutable_raster();
   std::filesystem::path file(path);
   const std::string ext = absl::AsciiStrToLower(file.extension().string());
+  if (ext == ".geojson" || ext == ".json") {
+    ASSIGN_OR_RETURN(std::string text, ReadFile(path, 16 << 20));
+    ASSIGN_OR_RETURN(std::vector<PolygonInput> polygons, ParseGeoJsonPolygons(text, path));
+    v1::PolygonMap* pm = map.mutable_polygons();
+    PolygonsToProto(polygons, pm->mutable_polygons());
+    if (overrides.resolution) pm->set_resolution(*overrides.resolution);
+    return map;
+  }
+  v1::RasterMap* raster = map.mutable_raster();
   if (ext == ".yaml" || ext == ".yml") {
     ASSIGN_OR_RETURN(std::string yaml, ReadFile(path, 1 << 20));
     absl::StatusOr<MapYaml> parsed = ParseMapYaml(yaml, MapLoadOptions());

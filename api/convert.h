@@ -1,14 +1,16 @@
-// The one edge between the covplan.v1 protos and the planner's types.
+// The one edge between the covplan.v1 protos and the planner's types, linked
+// by the server and the CLI alike (so --local and the server cannot differ).
 //
-// Every request field is validated here, so the server and the CLI's --local
-// mode reject the same inputs with the same messages: bad input is
-// InvalidArgument with a message saying which field is wrong and why.
+// Conversion maps proto fields onto the engine's request; range checks that
+// only need the message happen here with the proto field path in the
+// message, everything that needs the map (tool vs pixel size, zones vs map,
+// regions with no free cell) happens in the engine, whose messages name the
+// same fields. Bad input is InvalidArgument either way.
 //
 //   InputLimits limits;
-//   ASSIGN_OR_RETURN(OccupancyMap map, MapFromProto(request.map(), limits));
-//   ASSIGN_OR_RETURN(PlanOptions options, PlanOptionsFromProto(request));
-//   RETURN_IF_ERROR(ValidatePlanForMap(options, map, limits));
-//   ... plan ...
+//   ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), limits));
+//   ASSIGN_OR_RETURN(PlanRequest req, PlanRequestFromProto(request));
+//   ... engine.Plan(source, req) ...
 //   v1::PlanResponse response;
 //   PlanToProto(plan, &response);
 //
@@ -26,8 +28,10 @@
 #include "absl/strings/string_view.h"
 #include "covplan/v1/covplan.pb.h"
 #include "planner/grid/occupancy_map.h"
+#include "planner/engine/engine.h"
+#include "planner/engine/site.h"
+#include "planner/geometry/area.h"
 #include "planner/plan/coverage_plan.h"
-#include "planner/plan/coverage_planner.h"
 
 namespace covplan {
 
@@ -37,12 +41,14 @@ struct InputLimits {
   int64_t max_map_pixels = 64'000'000;    // decoded width * height
   int64_t max_grid_cells = 4'000'000;     // tool-width cells
   int64_t max_ranks = 1000;               // coverage ranks (transition table ~ ranks^2)
+  int64_t max_area_vertices = 100'000;    // per polygon map, regions or no_go
 
   absl::Status Validate() const;
 };
 
 // Content-derived id: lowercase hex SHA-256 of a canonical encoding of the
-// image bytes, YAML text and explicitly set overrides (64 characters).
+// image bytes, YAML text and explicitly set overrides, or of the polygon
+// coordinates (64 characters).
 std::string ComputeMapId(const v1::Map& map);
 
 // InvalidArgument unless `map_id` looks like an id ComputeMapId produces
@@ -53,21 +59,25 @@ absl::Status ValidateMapId(absl::string_view map_id);
 // size limits, at least one free pixel).
 absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits& limits);
 
-// Validates the robot model, solvers, budget and grid parameters.
-absl::StatusOr<PlanOptions> PlanOptionsFromProto(const v1::PlanRequest& request);
+// A raster or polygon map as the engine's SiteMap (polygons validated with
+// their field path, e.g. "map.polygons[2].outer").
+absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const InputLimits& limits);
 
-// The decomposition options for `options`, with the grid cell limit applied.
-DecompositionOptions DecompositionOptionsFor(const PlanOptions& options,
-                                             const InputLimits& limits);
+// The engine request for a PlanRequest: planner, common options, the
+// planner's own options (oneof), regions and no-go zones.
+absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request);
 
-// Checks that need both the options and the decoded map: the tool must be at
-// least one pixel wide and no wider than the map, and the grid must stay
-// within limits.max_grid_cells.
-absl::Status ValidatePlanForMap(const PlanOptions& options, const OccupancyMap& map,
-                                const InputLimits& limits);
+EngineLimits EngineLimitsFor(const InputLimits& limits);
 
-// Fills everything but plan_id and map_id.
+void PolygonsToProto(const std::vector<PolygonInput>& polygons,
+                     google::protobuf::RepeatedPtrField<v1::Polygon>* out);
+std::vector<PolygonInput> PolygonsFromProto(
+    const google::protobuf::RepeatedPtrField<v1::Polygon>& polygons);
+
+// Fills everything but plan_id, map_id and the zones.
 void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out);
+// Everything, zones included.
+void RetainedPlanToProto(const RetainedPlan& plan, v1::PlanResponse* out);
 
 // The inverse (e.g. to render a server's answer as SVG). InvalidArgument on
 // an inconsistent response.
@@ -78,10 +88,12 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response);
 absl::StatusOr<std::string> PlanToJson(const v1::PlanResponse& response);
 
 v1::MapInfo MapInfoFor(const OccupancyMap& map, const std::string& map_id);
+v1::MapInfo MapInfoFor(const SiteMap& site, const std::string& map_id);
 
 // Builds a Map proto from a file on disk: a map_server YAML (the image it
-// names is read relative to the YAML) or a bare .pgm / .png. Unset overrides
-// leave the YAML's values; a bare image needs `resolution`.
+// names is read relative to the YAML), a bare .pgm / .png, or a .geojson /
+// .json polygon map (metres in a local frame). Unset overrides leave the
+// YAML's values; a bare image needs `resolution`.
 struct MapFileOverrides {
   std::optional<double> resolution;
   std::optional<bool> negate;

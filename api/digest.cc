@@ -1,4 +1,4 @@
-#include "server/digest.h"
+#include "api/digest.h"
 
 #include <openssl/evp.h>
 

@@ -2,22 +2,25 @@
 // single flight: concurrent requests for the same missing key build it once,
 // the others wait for that result (each until its own StopToken fires).
 //
-// The server caches Decompositions (grid + rank partition + transitions)
-// keyed by map_id + DecompositionOptions::CacheKey():
+// ArtifactLru is the server's implementation of the engine's ArtifactCache
+// (planner/engine/artifact_cache.h): every per-map artifact (grid, coverage
+// area, partition, transitions) under its typed key, within one budget.
 //
-//   DecompositionCache cache(256 << 20, &metrics);
-//   bool hit = false;
-//   absl::StatusOr<std::shared_ptr<const Decomposition>> d = cache.GetOrBuild(
-//       key, stop, [&](const StopToken& s) { return BuildDecomposition(map, opt, s); }, &hit);
+//   ArtifactLru cache(256 << 20, &metrics);
+//   PlanningEngine engine(&registry, &cache, limits);
+//   cache.EraseWithPrefix(map_id + "/");   // DeleteMap: drops and fences
 //
-// Failed builds are not cached. If the builder was stopped by its own
+// Failed builds are not cached. EraseWithPrefix also fences the prefix: a
+// build that was already running when the erase happened returns its value
+// to its own caller but does not store it, so a deleted map's artifacts
+// cannot come back from a build that raced the delete. If the builder was stopped by its own
 // request's deadline, a waiter whose token is still live retries the build.
 // An object larger than the whole budget is returned but not kept.
 //
 // Thread-safety: all methods are thread-safe; values are shared immutable
 // objects.
-#ifndef COVPLAN_SERVER_DECOMPOSITION_CACHE_H_
-#define COVPLAN_SERVER_DECOMPOSITION_CACHE_H_
+#ifndef COVPLAN_SERVER_ARTIFACT_LRU_H_
+#define COVPLAN_SERVER_ARTIFACT_LRU_H_
 
 #include <cstddef>
 #include <cstdint>
@@ -31,7 +34,8 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "planner/common/stop_token.h"
-#include "planner/plan/coverage_planner.h"
+#include "planner/engine/artifact_cache.h"
+#include <vector>
 
 namespace covplan {
 
@@ -86,6 +90,7 @@ class SharedLruCache {
           flight = it->second;
         } else {
           flight = std::make_shared<Flight>();
+          flight->epoch = erase_epoch_;
           flights_.emplace(key, flight);
           leader = true;
           ++stats_.misses;
@@ -98,7 +103,7 @@ class SharedLruCache {
         flight->result = result;
         flight->done = true;
         flights_.erase(key);
-        if (result.ok() && *result != nullptr) Insert(key, *result);
+        if (result.ok() && *result != nullptr && !Fenced(key, flight->epoch)) Insert(key, *result);
         return result;
       }
       absl::StatusOr<Value> shared = Wait(*flight, stop);
@@ -120,6 +125,9 @@ class SharedLruCache {
   // Drops every entry whose key starts with `prefix` (e.g. a deleted map).
   void EraseWithPrefix(const std::string& prefix) {
     absl::MutexLock lock(&mu_);
+    ++erase_epoch_;
+    erases_.push_back({prefix, erase_epoch_});
+    if (erases_.size() > kMaxFences) erases_.erase(erases_.begin());
     for (auto it = entries_.begin(); it != entries_.end();) {
       if (it->first.compare(0, prefix.size(), prefix) == 0) {
         stats_.bytes -= it->second.bytes;
@@ -142,6 +150,7 @@ class SharedLruCache {
  private:
   struct Flight {
     bool done = false;
+    uint64_t epoch = 0;  // erase_epoch_ when the build started
     absl::StatusOr<Value> result = absl::UnknownError("not built");
   };
   struct Entry {
@@ -184,6 +193,17 @@ class SharedLruCache {
     if (observer_ != nullptr) observer_->OnCacheSize(stats_.bytes, stats_.entries);
   }
 
+  // True when an erase of a prefix of `key` happened after `epoch` (or so
+  // long ago that it was forgotten: then refuse, to be safe).
+  bool Fenced(const std::string& key, uint64_t epoch) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+    if (epoch == erase_epoch_) return false;
+    if (erases_.empty() || erases_.front().epoch > epoch + 1) return true;
+    for (const Erase& e : erases_) {
+      if (e.epoch > epoch && key.compare(0, e.prefix.size(), e.prefix) == 0) return true;
+    }
+    return false;
+  }
+
   void Notify(void (CacheObserver::*event)()) {
     if (observer_ != nullptr) (observer_->*event)();
   }
@@ -196,15 +216,34 @@ class SharedLruCache {
   std::unordered_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
   std::unordered_map<std::string, std::shared_ptr<Flight>> flights_ ABSL_GUARDED_BY(mu_);
   Stats stats_ ABSL_GUARDED_BY(mu_);
+  struct Erase {
+    std::string prefix;
+    uint64_t epoch;
+  };
+  static constexpr size_t kMaxFences = 256;
+  uint64_t erase_epoch_ ABSL_GUARDED_BY(mu_) = 0;
+  std::vector<Erase> erases_ ABSL_GUARDED_BY(mu_);
 };
 
-class DecompositionCache : public SharedLruCache<Decomposition> {
+// The server's ArtifactCache: one byte budget over all artifacts.
+// Thread-safety: thread-safe.
+class ArtifactLru final : public ArtifactCache {
  public:
-  DecompositionCache(size_t budget_bytes, CacheObserver* observer = nullptr)
-      : SharedLruCache(budget_bytes, [](const Decomposition& d) { return d.MemoryBytes(); },
-                       observer) {}
+  explicit ArtifactLru(size_t budget_bytes, CacheObserver* observer = nullptr)
+      : lru_(budget_bytes, [](const Artifact& a) { return a.MemoryBytes(); }, observer) {}
+
+  absl::StatusOr<Value> GetOrBuild(const std::string& key, const StopToken& stop,
+                                   const Builder& build, bool* hit) override {
+    return lru_.GetOrBuild(key, stop, build, hit);
+  }
+  void EraseWithPrefix(const std::string& prefix) { lru_.EraseWithPrefix(prefix); }
+  SharedLruCache<Artifact>::Stats stats() const { return lru_.stats(); }
+  size_t budget_bytes() const { return lru_.budget_bytes(); }
+
+ private:
+  SharedLruCache<Artifact> lru_;
 };
 
 }  // namespace covplan
 
-#endif  // COVPLAN_SERVER_DECOMPOSITION_CACHE_H_
+#endif  // COVPLAN_SERVER_ARTIFACT_LRU_H_

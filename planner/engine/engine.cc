@@ -1,0 +1,236 @@
+#include "planner/engine/engine.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/time/clock.h"
+#include "planner/common/status_macros.h"
+#include "planner/tour/path_timing.h"
+
+namespace covplan {
+namespace {
+
+double MsSince(absl::Time t) { return absl::ToDoubleMilliseconds(absl::Now() - t); }
+
+// InvalidArgument when a zone polygon's outer ring misses the map entirely.
+absl::Status CheckInsideMap(const std::vector<PolygonInput>& polygons, const char* field,
+                            Point2 lo, Point2 hi) {
+  for (size_t i = 0; i < polygons.size(); ++i) {
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (const Point2& p : polygons[i].outer) {
+      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+    }
+    if (x1 <= lo.x || y1 <= lo.y || x0 >= hi.x || y0 >= hi.y) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "%s[%d] lies outside the map: its bounds (%.3f, %.3f)..(%.3f, %.3f) miss the map's "
+          "(%.3f, %.3f)..(%.3f, %.3f)",
+          field, i, x0, y0, x1, y1, lo.x, lo.y, hi.x, hi.y));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status CommonOptions::Validate() const {
+  RETURN_IF_ERROR(robot.Validate());
+  if (!std::isfinite(time_limit_s) || time_limit_s < 0.0) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "time_limit_s must be a non-negative number of seconds, got %g", time_limit_s));
+  }
+  if (num_threads < 1 || num_threads > 256) {
+    return absl::InvalidArgumentError(absl::StrFormat("threads must be in [1, 256], got %d", num_threads));
+  }
+  if (!std::isfinite(min_free_fraction) || min_free_fraction < 0.0 || min_free_fraction >= 1.0) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("min_free_fraction must be in [0, 1), got %g", min_free_fraction));
+  }
+  return absl::OkStatus();
+}
+
+void PlannerRegistry::Register(std::unique_ptr<Planner> planner) {
+  std::string name(planner->name());
+  planners_[name] = std::shared_ptr<const Planner>(std::move(planner));
+}
+
+const Planner* PlannerRegistry::Find(std::string_view name) const {
+  auto it = planners_.find(name);
+  return it == planners_.end() ? nullptr : it->second.get();
+}
+
+std::vector<std::string> PlannerRegistry::Names() const {
+  std::vector<std::string> names;
+  for (const auto& [name, planner] : planners_) names.push_back(name);
+  return names;
+}
+
+absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanRequest& request) const {
+  Resolved r;
+  r.planner = registry_->Find(request.planner);
+  if (r.planner == nullptr) {
+    return absl::InvalidArgumentError(absl::StrFormat("planner: unknown planner '%s'; registered: %s",
+                                                      request.planner,
+                                                      absl::StrJoin(registry_->Names(), ", ")));
+  }
+  RETURN_IF_ERROR(request.common.Validate());
+  r.options = request.options != nullptr ? request.options : r.planner->DefaultOptions();
+  RETURN_IF_ERROR(r.planner->CheckOptions(*r.options));
+  AreaLimits area_limits;
+  area_limits.max_vertices = limits_.max_area_vertices;
+  if (!request.regions.empty()) {
+    ASSIGN_OR_RETURN(Area regions, Area::Create(request.regions, "regions", area_limits));
+    r.zones.regions = std::make_shared<const Area>(std::move(regions));
+  }
+  if (!request.no_go.empty()) {
+    ASSIGN_OR_RETURN(Area no_go, Area::Create(request.no_go, "no_go", area_limits));
+    r.zones.no_go = std::make_shared<const Area>(std::move(no_go));
+    for (auto [pose, name] : {std::pair{&request.common.robot.start, "robot.start"},
+                              std::pair{&request.common.robot.end, "robot.end"}}) {
+      if (pose->has_value() && r.zones.no_go->Contains({(*pose)->x, (*pose)->y})) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s (%.3f, %.3f) lies in a no-go zone", name, (*pose)->x, (*pose)->y));
+      }
+    }
+  }
+  return r;
+}
+
+absl::Status PlanningEngine::Setup(const MapSource& source, const PlanRequest& request,
+                                   const Resolved& resolved, PlanContext* ctx, bool* all_cached) const {
+  const CommonOptions& common = request.common;
+  GridOptions grid_options;
+  grid_options.cell_size = common.robot.tool_width_m;
+  grid_options.min_free_fraction = common.min_free_fraction;
+  grid_options.max_cells = limits_.max_grid_cells;
+  const auto grid_key = ArtifactKey<GridArtifact>::Root(
+      source.map_id, "grid",
+      absl::StrFormat("cell=%.9g;minfree=%.9g", grid_options.cell_size, grid_options.min_free_fraction));
+  bool hit = false;
+  ASSIGN_OR_RETURN(std::shared_ptr<const GridArtifact> grid,
+                   GetOrBuild(*cache_, grid_key, common.stop,
+                              [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const GridArtifact>> {
+                                if (!source.load) return absl::InternalError("map source without loader");
+                                ASSIGN_OR_RETURN(SiteMap site, source.load());
+                                return BuildGridArtifact(site, grid_options);
+                              },
+                              &hit));
+  *all_cached = *all_cached && hit;
+  const Grid& g = *grid->grid;
+  const Point2 lo = g.origin();
+  const Point2 hi{lo.x + g.cols() * g.cell_size(), lo.y + g.rows() * g.cell_size()};
+  RETURN_IF_ERROR(CheckInsideMap(request.regions, "regions", lo, hi));
+  RETURN_IF_ERROR(CheckInsideMap(request.no_go, "no_go", lo, hi));
+  const auto area_key = grid_key.Derive<CoverageArea>("area", resolved.zones.CacheText());
+  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area,
+                   GetOrBuild(*cache_, area_key, common.stop,
+                              [&](const StopToken&) {
+                                return BuildCoverageArea(*grid, resolved.zones, common.min_free_fraction);
+                              },
+                              &hit));
+  *all_cached = *all_cached && hit;
+  ctx->common = &request.common;
+  ctx->options = resolved.options.get();
+  ctx->area = std::move(area);
+  ctx->area_key = area_key;
+  ctx->cache = cache_;
+  ctx->limits = limits_;
+  ctx->all_cached = all_cached;
+  return absl::OkStatus();
+}
+
+absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest& request) const {
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
+  PlanContext ctx;
+  bool all_cached = true;
+  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  return resolved.planner->Prepare(ctx);
+}
+
+absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
+                                                  const PlanRequest& request) const {
+  const absl::Time start = absl::Now();
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
+  PlanContext ctx;
+  bool all_cached = true;
+  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  ASSIGN_OR_RETURN(CoveragePlan plan, resolved.planner->Plan(ctx));
+  const CoverageArea& area = *ctx.area;
+
+  // The engine's own check: no segment may enter a no-go zone's interior.
+  if (resolved.zones.has_no_go()) {
+    for (size_t i = 1; i < plan.path.size(); ++i) {
+      const Waypoint& a = plan.path[i - 1];
+      const Waypoint& b = plan.path[i];
+      if (resolved.zones.no_go->SegmentLengthInInterior({a.x, a.y}, {b.x, b.y}) <= 1e-9) continue;
+      const bool from_start = i <= 2 && request.common.robot.start.has_value();
+      const bool to_end = i + 2 >= plan.path.size() && request.common.robot.end.has_value();
+      if (from_start || to_end) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "%s: the move between (%.3f, %.3f) and the grid at (%.3f, %.3f) would cross a no-go zone",
+            from_start ? "robot.start" : "robot.end", a.x, a.y, b.x, b.y));
+      }
+      return absl::InternalError(absl::StrFormat(
+          "planner '%s' produced a segment through a no-go zone at (%.3f, %.3f)-(%.3f, %.3f)",
+          resolved.planner->name(), a.x, a.y, b.x, b.y));
+    }
+  }
+
+  plan.planner = std::string(resolved.planner->name());
+  PlanStats& s = plan.stats;
+  const PlanStats path_stats = ComputePathStats(plan.path, request.common.robot);
+  s.num_turns = path_stats.num_turns;
+  s.coverage_length_m = path_stats.coverage_length_m;
+  s.transition_length_m = path_stats.transition_length_m;
+  s.estimated_duration_s = path_stats.estimated_duration_s;
+  s.turning_time_s = path_stats.turning_time_s;
+  s.grid_rows = area.drive->rows();
+  s.grid_cols = area.drive->cols();
+  s.free_cells = area.cover_cells;
+  std::vector<uint8_t> swept(static_cast<size_t>(area.drive->size()), 0);
+  s.covered_cells = 0;
+  for (const CoverageSweep& sweep : plan.sweeps) {
+    for (const CellIndex& c : sweep.cells) {
+      if (!area.drive->InBounds(c.row, c.col)) continue;
+      uint8_t& bit = swept[area.drive->Index(c.row, c.col)];
+      s.covered_cells += bit == 0;
+      bit = 1;
+    }
+  }
+  s.unreachable_free_cells = area.unreachable_cells;
+  s.no_go_cells = area.no_go_cells;
+  s.map_free_area_m2 = area.map_free_area_m2;
+  s.covered_free_area_ratio = area.covered_free_area_ratio;
+  s.grid_ms = area.grid_ms;
+  s.planning_ms = s.grid_ms + s.partition_ms + s.transitions_ms + s.tour_ms;
+  s.decomposition_cached = all_cached;
+  const TerminationLimit limit = plan.termination.limit;
+  s.tour_cut_short = limit == TerminationLimit::kDeadline || limit == TerminationLimit::kCancelled;
+  (void)start;
+  return EngineResult{std::move(plan), ctx.area};
+}
+
+PlanStats ComputePathStats(const std::vector<Waypoint>& path, const RobotModel& robot) {
+  PlanStats s;
+  if (path.empty()) return s;
+  double heading = path[0].theta;
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Waypoint& a = path[i - 1];
+    const Waypoint& b = path[i];
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    const double change = HeadingChange(heading, b.theta);
+    if (change > kTurnEpsilonRad) {
+      ++s.num_turns;
+      s.turning_time_s += robot.TurnTime(change);
+    }
+    heading = b.theta;
+    s.estimated_duration_s += robot.StraightTime(len);
+    (b.kind == SegmentKind::kCoverage ? s.coverage_length_m : s.transition_length_m) += len;
+  }
+  s.estimated_duration_s += s.turning_time_s;
+  return s;
+}
+
+}  // namespace covplan

@@ -1,0 +1,114 @@
+// The one transport-free planning engine: covplan-server and `covplan plan
+// --local` both call it, so the two paths cannot drift apart. It validates
+// the request (common options, the planner's options, regions and no-go
+// zones against the map), builds or finds the per-map artifacts (grid,
+// coverage area; the planner adds its own), runs the selected planner and
+// fills the statistics that follow from the path. It also checks the
+// result: no path segment may enter a no-go zone.
+//
+//   PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+//   LocalArtifactCache cache;
+//   PlanningEngine engine(&registry, &cache, EngineLimits{});
+//   MapSource source{map_id, [&] { return LoadSite(...); }};
+//   PlanRequest request; request.common.robot.tool_width_m = 0.8;
+//   absl::StatusOr<CoveragePlan> plan = engine.Plan(source, request);
+//
+// Thread-safety: thread-safe when the cache is (the registry is read-only).
+#ifndef COVPLAN_PLANNER_ENGINE_ENGINE_H_
+#define COVPLAN_PLANNER_ENGINE_ENGINE_H_
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "planner/engine/artifact_cache.h"
+#include "planner/engine/planner.h"
+#include "planner/engine/site.h"
+#include "planner/geometry/area.h"
+#include "planner/plan/coverage_plan.h"
+
+namespace covplan {
+
+// Planners by name.
+class PlannerRegistry {
+ public:
+  // Every planner this build ships (see registry.cc).
+  static PlannerRegistry WithBuiltins();
+  void Register(std::unique_ptr<Planner> planner);
+  const Planner* Find(std::string_view name) const;
+  std::vector<std::string> Names() const;
+  static constexpr const char* kDefault = "oarp";
+
+ private:
+  std::map<std::string, std::shared_ptr<const Planner>, std::less<>> planners_;
+};
+
+// Where a map comes from: its content id (all cache keys derive from it) and
+// a loader that is called only when an artifact must be built.
+struct MapSource {
+  std::string map_id;
+  std::function<absl::StatusOr<SiteMap>()> load;
+};
+
+struct PlanRequest {
+  std::string planner = PlannerRegistry::kDefault;
+  CommonOptions common;
+  std::shared_ptr<const PlannerOptions> options;  // null: the planner's defaults
+  std::vector<PolygonInput> regions;
+  std::vector<PolygonInput> no_go;
+};
+
+// A plan kept for GetPlan and later continuation: the plan, the request it
+// answered and the coverage area (grid with barriers and obstacle pixels,
+// zones) it was planned on.
+struct RetainedPlan {
+  std::string plan_id;
+  std::string map_id;
+  CoveragePlan plan;
+  PlanRequest request;
+  std::shared_ptr<const CoverageArea> area;
+  size_t MemoryBytes() const { return sizeof(*this) + plan.MemoryBytes(); }
+};
+
+struct EngineResult {
+  CoveragePlan plan;
+  std::shared_ptr<const CoverageArea> area;
+};
+
+class PlanningEngine {
+ public:
+  PlanningEngine(const PlannerRegistry* registry, ArtifactCache* cache, EngineLimits limits)
+      : registry_(registry), cache_(cache), limits_(limits) {}
+
+  absl::StatusOr<EngineResult> Plan(const MapSource& source, const PlanRequest& request) const;
+  // Builds every per-map artifact `request` needs, without planning.
+  absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
+
+  const PlannerRegistry& registry() const { return *registry_; }
+  const EngineLimits& limits() const { return limits_; }
+
+ private:
+  struct Resolved {
+    const Planner* planner = nullptr;
+    std::shared_ptr<const PlannerOptions> options;
+    AreaZones zones;
+  };
+  absl::StatusOr<Resolved> Resolve(const PlanRequest& request) const;
+  absl::Status Setup(const MapSource& source, const PlanRequest& request, const Resolved& resolved,
+                     PlanContext* ctx, bool* all_cached) const;
+
+  const PlannerRegistry* registry_;
+  ArtifactCache* cache_;
+  EngineLimits limits_;
+};
+
+// Path length, turns and duration recomputed from waypoints alone (the
+// robot turns in place to each waypoint's heading, then drives straight).
+PlanStats ComputePathStats(const std::vector<Waypoint>& path, const RobotModel& robot);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_PLANNER_ENGINE_ENGINE_H_

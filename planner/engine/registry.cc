@@ -1,0 +1,14 @@
+// The planners this build ships. Adding a planner: its folder under
+// planner/, one Register line here, its options message in the proto.
+#include "planner/engine/engine.h"
+#include "planner/oarp/oarp_planner.h"
+
+namespace covplan {
+
+PlannerRegistry PlannerRegistry::WithBuiltins() {
+  PlannerRegistry registry;
+  registry.Register(std::make_unique<OarpPlanner>());
+  return registry;
+}
+
+}  // namespace covplan

@@ -1,0 +1,172 @@
+// CellOverlapFractions and RasterizeArea (declared in area.h).
+#include <algorithm>
+#include <climits>
+#include <cmath>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_format.h"
+#include "planner/geometry/area.h"
+#include "planner/geometry/area_data.h"
+#include "planner/geometry/grid_scan.h"
+
+namespace covplan {
+namespace {
+
+using geometry_internal::AreaData;
+using geometry_internal::BBox;
+using geometry_internal::BMultiPolygon;
+using geometry_internal::BoxIndex;
+using geometry_internal::BoxPolygon;
+using geometry_internal::BPoint;
+using geometry_internal::BSegment;
+using geometry_internal::GridFrame;
+using geometry_internal::GridScanner;
+using geometry_internal::ToBoost;
+namespace bg = geometry_internal::bg;
+namespace bgi = geometry_internal::bgi;
+
+bool Finite(Point2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+
+// Inside/outside of the cells between boundary cells: one parity test per run.
+class RunClassifier {
+ public:
+  explicit RunClassifier(const GridScanner& scan) : scan_(scan) {}
+  void StartRow() { valid_ = false; }
+  bool Inside(int c, double centre_x) {
+    if (!valid_ || c != next_) inside_ = scan_.InsideAtCentreLine(centre_x);
+    valid_ = true;
+    next_ = c + 1;
+    return inside_;
+  }
+
+ private:
+  const GridScanner& scan_;
+  bool valid_ = false;
+  bool inside_ = false;
+  int next_ = 0;
+};
+
+// Pixel centre in the closed area. Parity is exact away from edges; near one, ask Boost.
+bool CentreFree(const AreaData& d, const GridScanner& scan, Point2 p, double tol) {
+  std::vector<BoxIndex> hits;
+  d.edge_tree.query(bgi::intersects(BBox(BPoint(p.x - tol, p.y - tol), BPoint(p.x + tol, p.y + tol))),
+                    std::back_inserter(hits));
+  for (const BoxIndex& hit : hits) {
+    const auto& e = d.edges[hit.second];
+    if (bg::comparable_distance(ToBoost(p), BSegment(ToBoost(e.a), ToBoost(e.b))) <= tol * tol) {
+      return bg::covered_by(ToBoost(p), d.shape);
+    }
+  }
+  return scan.InsideAtCentreLine(p.x);
+}
+
+// The closed square lies in the closed area: no edge enters the (slightly shrunk) square and
+// its centre is inside.
+bool SquareFree(const AreaData& d, const GridScanner& scan, double x0, double y0, double side) {
+  const double shrink = 1e-9 * side;
+  const BBox inner(BPoint(x0 + shrink, y0 + shrink), BPoint(x0 + side - shrink, y0 + side - shrink));
+  std::vector<BoxIndex> hits;
+  d.edge_tree.query(bgi::intersects(inner), std::back_inserter(hits));
+  for (const BoxIndex& hit : hits) {
+    const auto& e = d.edges[hit.second];
+    if (bg::intersects(BSegment(ToBoost(e.a), ToBoost(e.b)), inner)) return false;
+  }
+  return scan.InsideAtCentreLine(x0 + 0.5 * side);
+}
+
+}  // namespace
+
+std::vector<float> CellOverlapFractions(const Area& area, int rows, int cols, double cell,
+                                        Point2 origin) {
+  if (rows <= 0 || cols <= 0) return {};
+  std::vector<float> out(static_cast<size_t>(rows) * cols, 0.0f);
+  if (area.empty() || !(cell > 0) || !std::isfinite(cell) || !Finite(origin)) return out;
+  const AreaData& d = *area.data_;
+  const GridFrame frame{rows, cols, cell, origin};
+  GridScanner scan(d, frame);
+  RunClassifier runs(scan);
+  const double cell_area = cell * cell;
+  for (int r = scan.row_begin(); r < scan.row_end(); ++r) {
+    scan.LoadRow(r);
+    runs.StartRow();
+    float* row = out.data() + static_cast<size_t>(r) * cols;
+    // Clipping each boundary cell against the row's strip of the area keeps every clip small
+    // however many vertices the whole area has.
+    BMultiPolygon strip;
+    if (scan.RowHasBoundary()) {
+      bg::intersection(BoxPolygon(frame.X(scan.col_begin()), frame.Y(r), frame.X(scan.col_end()),
+                                  frame.Y(r + 1)),
+                       d.shape, strip);
+    }
+    const BBox strip_box = strip.empty() ? BBox() : bg::return_envelope<BBox>(strip);
+    for (int c = scan.col_begin(); c < scan.col_end(); ++c) {
+      if (!scan.boundary(c)) {
+        row[c] = runs.Inside(c, origin.x + (c + 0.5) * cell) ? 1.0f : 0.0f;
+        continue;
+      }
+      if (strip.empty() || frame.X(c + 1) <= strip_box.min_corner().x() ||
+          frame.X(c) >= strip_box.max_corner().x()) {
+        continue;
+      }
+      BMultiPolygon piece;
+      bg::intersection(BoxPolygon(frame.X(c), frame.Y(r), frame.X(c + 1), frame.Y(r + 1)), strip,
+                       piece);
+      row[c] = static_cast<float>(std::clamp(bg::area(piece) / cell_area, 0.0, 1.0));
+    }
+  }
+  return out;
+}
+
+absl::StatusOr<OccupancyMap> RasterizeArea(const Area& area, double resolution, RasterRule rule,
+                                           int64_t max_pixels) {
+  if (area.empty()) return absl::InvalidArgumentError("cannot rasterize an empty area");
+  if (!(resolution > 0) || !std::isfinite(resolution)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("raster resolution must be a positive number, got %g", resolution));
+  }
+  const AreaData& d = *area.data_;
+  const double col0 = std::floor(d.min_corner.x / resolution);
+  const double row0 = std::floor(d.min_corner.y / resolution);
+  const Point2 origin{col0 * resolution, row0 * resolution};
+  double width = std::max(1.0, std::ceil(d.max_corner.x / resolution) - col0);
+  double height = std::max(1.0, std::ceil(d.max_corner.y / resolution) - row0);
+  if (origin.x + width * resolution < d.max_corner.x) width += 1;
+  if (origin.y + height * resolution < d.max_corner.y) height += 1;
+  if (!(width * height <= static_cast<double>(max_pixels)) || width > INT_MAX ||
+      height > INT_MAX) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "a %.0f x %.0f image at %g m/px exceeds the limit of %d pixels", width, height,
+        resolution, max_pixels));
+  }
+  OccupancyMap map(static_cast<int>(width), static_cast<int>(height), resolution, origin);
+  const GridFrame frame{map.height(), map.width(), resolution, origin};
+  GridScanner scan(d, frame);
+  RunClassifier runs(scan);
+  const double tol = 1e-9 * resolution +
+                     1e-12 * std::max({std::abs(d.min_corner.x), std::abs(d.min_corner.y),
+                                       std::abs(d.max_corner.x), std::abs(d.max_corner.y)});
+  for (int r = 0; r < map.height(); ++r) {
+    const bool scanned = r >= scan.row_begin() && r < scan.row_end();
+    if (scanned) {
+      scan.LoadRow(r);
+      runs.StartRow();
+    }
+    for (int c = 0; c < map.width(); ++c) {
+      bool free = false;
+      if (scanned && c >= scan.col_begin() && c < scan.col_end()) {
+        const double cx = origin.x + (c + 0.5) * resolution;
+        if (!scan.boundary(c)) {
+          free = runs.Inside(c, cx);
+        } else if (rule == RasterRule::kCentre) {
+          free = CentreFree(d, scan, Point2{cx, scan.row_centre_y()}, tol);
+        } else {
+          free = SquareFree(d, scan, frame.X(c), frame.Y(r), resolution);
+        }
+      }
+      map.set(r, c, free ? CellState::kFree : CellState::kOccupied);
+    }
+  }
+  return map;
+}
+
+}  // namespace covplan
