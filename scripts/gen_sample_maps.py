@@ -12,6 +12,7 @@ With --preview, also writes 8-bit PNG copies of the PGMs for viewing.
 """
 
 import argparse
+import math
 import os
 import random
 import struct
@@ -240,6 +241,40 @@ def write_png(path, c, rgba=False):
         f.write(png_chunk(b"IEND", b""))
 
 
+# ---------------------------------------------------------------- yard (polygons)
+
+def yard_polygons():
+    """A garden for a mowing robot, as polygons in metres: a back lawn with a
+    house, a round flower bed and a pond cut out, joined by a 1.4 m path to
+    a front lawn with a tree ring. Returns (free-space polygons, no-go zones)."""
+    def circle(cx, cy, r, n=24):
+        pts = [(round(cx + r * math.cos(2 * math.pi * k / n), 3),
+                round(cy + r * math.sin(2 * math.pi * k / n), 3)) for k in range(n)]
+        return pts + [pts[0]]
+    back = [(0.0, 0.0), (24.0, 0.0), (24.0, 14.0), (13.0, 14.0), (13.0, 15.5),
+            (11.6, 15.5), (11.6, 14.0), (0.0, 14.0), (0.0, 0.0)]
+    house = [(2.0, 9.0), (9.5, 9.0), (9.5, 12.8), (2.0, 12.8), (2.0, 9.0)]
+    bed = circle(16.0, 9.0, 1.6)
+    pond = [(4.0, 2.0), (7.5, 1.6), (8.6, 3.4), (6.9, 5.1), (4.6, 4.6), (4.0, 2.0)]
+    front = [(6.0, 15.5), (20.0, 15.5), (20.0, 23.0), (6.0, 23.0), (6.0, 15.5)]
+    tree = circle(15.5, 19.5, 0.9, n=16)
+    veg_patch = [(19.0, 2.0), (22.6, 2.0), (22.6, 5.0), (19.0, 5.0), (19.0, 2.0)]
+    free = [[back, house, bed, pond], [front, tree]]
+    return free, [[veg_patch]]
+
+
+def write_geojson(path, polygons):
+    import json
+    doc = {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {},
+         "geometry": {"type": "MultiPolygon",
+                      "coordinates": [[[list(p) for p in ring] for ring in poly]
+                                      for poly in polygons]}}]}
+    with open(path, "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+
+
 def write_yaml(path, image, origin):
     with open(path, "w") as f:
         f.write("image: %s\nresolution: %g\norigin: [%g, %g, 0.0]\nnegate: 0\n"
@@ -265,6 +300,9 @@ def main():
         write_yaml(os.path.join(args.out, name + ".yaml"), name + ".pgm", (-1.0, -0.5))
     write_png(os.path.join(args.out, "small_rooms.png"), flat, rgba=True)
     write_yaml(os.path.join(args.out, "small_rooms.yaml"), "small_rooms.png", (0.0, 0.0))
+    yard, zones = yard_polygons()
+    write_geojson(os.path.join(args.out, "sample_yard.geojson"), yard)
+    write_geojson(os.path.join(args.out, "sample_yard_no_go.geojson"), zones)
     if args.preview:
         os.makedirs(args.preview, exist_ok=True)
         for name, canvas in outputs:

@@ -11,6 +11,7 @@
 #include "absl/strings/str_format.h"
 #include "planner/common/status_macros.h"
 #include "planner/geometry/area_data.h"
+#include "planner/geometry/edge_queries.h"
 #include "planner/geometry/polygon_validation.h"
 
 namespace covplan {
@@ -219,9 +220,10 @@ double Area::BoxOverlapM2(double x0, double y0, double x1, double y1) const {
   const Point2 lo = data_->min_corner, hi = data_->max_corner;
   if (x1 <= lo.x || x0 >= hi.x || y1 <= lo.y || y0 >= hi.y) return 0.0;
   if (x0 <= lo.x && y0 <= lo.y && x1 >= hi.x && y1 >= hi.y) return data_->area_m2;
-  BMultiPolygon out;
-  bg::intersection(geometry_internal::BoxPolygon(x0, y0, x1, y1), data_->shape, out);
-  return bg::area(out);
+  const geometry_internal::AreaData& d = *data_;
+  return geometry_internal::ClipBoxM2(d, d.shape, x0, y0, x1, y1, [&d](Point2 p) {
+    return bg::within(ToBoost(p), d.shape);
+  });
 }
 
 std::string Area::CanonicalText() const {

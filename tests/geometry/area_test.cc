@@ -303,6 +303,37 @@ TEST(CellOverlapFractionsTest, GridAlignedEdgesAndOutsideGrid) {
   EXPECT_TRUE(CellOverlapFractions(a, 0, 5, 1.0, {0, 0}).empty());
 }
 
+// Found by fuzz/geojson_fuzzer: edge (6,0)-(3,3) passes through cell corners, where Boost
+// 1.74's overlay returned whole cells.
+TEST(CellOverlapFractionsTest, EdgeThroughCellCorners) {
+  Area a = MustCreate({{{{0, 0}, {2, 0}, {3, 2}, {0, 2}, {0, 0}}, {}},
+                       {{{1, 1}, {6, 0}, {3, 3}, {0, 3}, {1, 1}}, {}}});
+  const double cell = 6.0 / 14;
+  const std::vector<float> f = CellOverlapFractions(a, 16, 16, cell, {-cell, -cell});
+  double total = 0.0;
+  for (float v : f) total += v * cell * cell;
+  EXPECT_NEAR(total, a.AreaM2(), 1e-5);
+  EXPECT_EQ(f[4 * 16 + 12], 0.0f);
+  EXPECT_EQ(f[5 * 16 + 11], 0.0f);
+}
+
+// Areas with many edges are clipped in blocks of columns; compare a band of cells.
+TEST(CellOverlapFractionsTest, ManyEdgesMatchReference) {
+  std::mt19937 rng(11);
+  const Area a = MustCreate({{RandomStar(rng, {0, 0}, 5, 10, 600), {}}});
+  const double cell = 0.45;
+  const Point2 origin{-10.1, -10.2};
+  const int rows = 46, cols = 46;
+  const std::vector<float> f = CellOverlapFractions(a, rows, cols, cell, origin);
+  for (int r = 20; r < 26; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const double x0 = origin.x + c * cell, y0 = origin.y + r * cell;
+      const double ref = ReferenceBoxArea(a, x0, y0, x0 + cell, y0 + cell) / (cell * cell);
+      ASSERT_NEAR(f[r * cols + c], ref, 2e-5) << r << "," << c;
+    }
+  }
+}
+
 TEST(CellOverlapFractionsTest, MillionCellsSumToArea) {
   std::mt19937 rng(7);
   Ring star = RandomStar(rng, {50, 50}, 20, 49, 100);

@@ -31,16 +31,42 @@ void Normalise(v1::PlanResponse* r) {
   s->clear_decomposition_cached();
 }
 
+void AddBox(google::protobuf::RepeatedPtrField<v1::Polygon>* out, double x0, double y0, double x1,
+            double y1) {
+  v1::Ring* ring = out->Add()->mutable_outer();
+  for (auto [x, y] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}, {x0, y0}}) {
+    v1::Point2* p = ring->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+}
+
+// The same request gives the same plan through --local and through the
+// server: identical ranks, visiting order and path for the same seed when the
+// search converges. Only ids and timings may differ.
 TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
-  for (const char* name : {"maps/small_rooms.yaml", "maps/sample_office.yaml"}) {
-    SCOPED_TRACE(name);
-    const std::string path = absl::StrCat(COVPLAN_SOURCE_DIR, "/", name);
+  struct Case {
+    const char* map;
+    v1::TourSolver tour;
+    bool zones;
+  };
+  for (const Case& c : {Case{"maps/small_rooms.yaml", v1::GREEDY, false},
+                        Case{"maps/sample_office.yaml", v1::GTSP, false},
+                        Case{"maps/sample_office.yaml", v1::GTSP, true},
+                        Case{"maps/sample_yard.geojson", v1::GTSP, true}}) {
+    SCOPED_TRACE(absl::StrCat(c.map, c.zones ? " with zones" : ""));
+    const std::string path = absl::StrCat(COVPLAN_SOURCE_DIR, "/", c.map);
     absl::StatusOr<v1::Map> map = MapProtoFromFile(path, MapFileOverrides(), InputLimits());
     ASSERT_TRUE(map.ok()) << map.status();
     v1::PlanRequest request;
     request.mutable_robot()->set_tool_width_m(0.8);
-    request.set_tour_solver(v1::GREEDY);  // deterministic and fast
+    request.set_tour_solver(c.tour);
     request.set_seed(3);
+    request.set_time_limit_s(30);  // the default effort converges long before
+    if (c.zones) {
+      AddBox(request.mutable_no_go(), 3.3, 3.3, 5.1, 5.05);
+      AddBox(request.mutable_regions(), -0.5, 0.2, 21.0, 9.0);
+    }
     *request.mutable_map() = *map;
     absl::StatusOr<v1::PlanResponse> local = PlanLocally(request, InputLimits());
     ASSERT_TRUE(local.ok()) << local.status();
@@ -76,6 +102,10 @@ TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
     std::filesystem::remove_all(store);
 
     EXPECT_EQ(remote.map_id(), local->map_id());
+    EXPECT_EQ(local->termination().reason(), v1::CONVERGED);
+    EXPECT_EQ(remote.termination().reason(), v1::CONVERGED);
+    EXPECT_GT(remote.path_size(), 10);
+    EXPECT_EQ(remote.no_go_size(), c.zones ? 1 : 0);
     v1::PlanResponse a = *local, b = remote;
     Normalise(&a);
     Normalise(&b);
@@ -124,6 +154,41 @@ TEST(ClientPlanTest, StartAndEndPoseFlagsReachThePlanAndUnreachableCellsAreRepor
     EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--start", bad}), 0) << bad;
   }
   EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--start", "-100,-100"}), 0);
+}
+
+TEST(ClientPlanTest, RegionAndNoGoFlagsTakeRingsAndGeoJsonFiles) {
+  const std::string yard = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_yard.geojson");
+  const std::string zones = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_yard_no_go.geojson");
+  const std::string dir = (std::filesystem::temp_directory_path() /
+                           absl::StrCat("covplan_zones_", ::getpid()))
+                              .string();
+  std::filesystem::create_directories(dir);
+  const std::string out = dir + "/plan.json", svg = dir + "/plan.svg";
+  ASSERT_EQ(RunPlanCommand({"--map", yard, "--local", "--tool-width", "0.6", "--tour", "greedy",
+                            "--no-go", zones, "--no-go", "10,5 12,5 12,6.5", "--region",
+                            "0,0 24,0 24,14 0,14", "--out", out, "--svg", svg}),
+            0);
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  v1::PlanResponse r;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(ss.str(), &r).ok());
+  EXPECT_EQ(r.no_go_size(), 2);
+  EXPECT_EQ(r.regions_size(), 1);
+  // The open ring given on the command line was closed for the user.
+  EXPECT_EQ(r.no_go(1).outer().points_size(), 4);
+  EXPECT_GT(r.stats().no_go_cells(), 0);
+  EXPECT_EQ(r.stats().covered_cells(), r.stats().free_cells());
+  std::ifstream svg_in(svg);
+  std::stringstream svg_text;
+  svg_text << svg_in.rdbuf();
+  EXPECT_THAT(svg_text.str(), HasSubstr("no-go zones"));
+  EXPECT_THAT(svg_text.str(), HasSubstr("regions"));
+  // Bad areas: a non-point token, a self-intersecting ring, a missing file.
+  EXPECT_NE(RunPlanCommand({"--map", yard, "--local", "--no-go", "1,1 2,x 3,3"}), 0);
+  EXPECT_NE(RunPlanCommand({"--map", yard, "--local", "--no-go", "1,1 3,1 1,3 3,3"}), 0);
+  EXPECT_NE(RunPlanCommand({"--map", yard, "--local", "--region", "/no/such/zones.geojson"}), 0);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
