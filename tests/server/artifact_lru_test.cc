@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "absl/synchronization/notification.h"
 #include "gtest/gtest.h"
 
@@ -114,6 +115,64 @@ TEST(SharedLruCacheTest, FailuresAreNotCachedAndWaitersRespectTheirDeadline) {
   EXPECT_LT(absl::Now() - start, absl::Milliseconds(500));
   release.Notify();
   leader.join();
+}
+
+// DeleteMap's erase fences builds that were already running: their value
+// reaches their own caller but is not stored, so a deleted map's artifacts
+// cannot come back from a build that raced the delete.
+TEST(SharedLruCacheTest, EraseFencesABuildAlreadyRunning) {
+  BlobCache cache(1000, [](const Blob& b) { return b.bytes; });
+  absl::Notification started, release;
+  std::thread builder([&] {
+    bool hit = false;
+    absl::StatusOr<std::shared_ptr<const Blob>> v = cache.GetOrBuild(
+        "map1/grid", StopToken(),
+        [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const Blob>> {
+          started.Notify();
+          release.WaitForNotification();
+          return std::make_shared<const Blob>(Blob{10, 1});
+        },
+        &hit);
+    EXPECT_TRUE(v.ok());
+  });
+  started.WaitForNotification();
+  cache.EraseWithPrefix("map1/");
+  release.Notify();
+  builder.join();
+  bool hit = true;
+  ASSERT_TRUE(cache.GetOrBuild("map1/grid", StopToken(), Make(10, 2), &hit).ok());
+  EXPECT_FALSE(hit);  // the raced build was not kept
+  // Other maps are not fenced, and builds after the erase are kept again.
+  ASSERT_TRUE(cache.GetOrBuild("map2/grid", StopToken(), Make(10, 3), &hit).ok());
+  ASSERT_TRUE(cache.GetOrBuild("map2/grid", StopToken(), Make(10, 4), &hit).ok());
+  EXPECT_TRUE(hit);
+  ASSERT_TRUE(cache.GetOrBuild("map1/grid", StopToken(), Make(10, 5), &hit).ok());
+  EXPECT_TRUE(hit);
+}
+
+// A build that started before more erases than the fence window remembers
+// is refused (conservatively), not kept.
+TEST(SharedLruCacheTest, FenceWindowOverflowRefusesOldBuilds) {
+  BlobCache cache(1000, [](const Blob& b) { return b.bytes; });
+  absl::Notification started, release;
+  std::thread builder([&] {
+    bool hit = false;
+    cache.GetOrBuild(
+        "keep/grid", StopToken(),
+        [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const Blob>> {
+          started.Notify();
+          release.WaitForNotification();
+          return std::make_shared<const Blob>(Blob{10, 1});
+        },
+        &hit).IgnoreError();
+  });
+  started.WaitForNotification();
+  for (int i = 0; i < 300; ++i) cache.EraseWithPrefix(absl::StrCat("other", i, "/"));
+  release.Notify();
+  builder.join();
+  bool hit = true;
+  ASSERT_TRUE(cache.GetOrBuild("keep/grid", StopToken(), Make(10, 2), &hit).ok());
+  EXPECT_FALSE(hit);
 }
 
 }  // namespace

@@ -140,6 +140,72 @@ TEST_F(ServiceTest, PutMapThenPlanCoversEveryFreeCell) {
   EXPECT_EQ(retained.SerializeAsString(), plan.SerializeAsString());
 }
 
+void AddRing(v1::Ring* ring, std::vector<std::pair<double, double>> pts) {
+  for (auto [x, y] : pts) {
+    v1::Point2* p = ring->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+}
+
+TEST_F(ServiceTest, PolygonMapsRegionsAndNoGoZonesOverGrpc) {
+  v1::Map map;
+  v1::Polygon* site = map.mutable_polygons()->add_polygons();
+  AddRing(site->mutable_outer(), {{0, 0}, {12, 0}, {12, 8}, {0, 8}, {0, 0}});
+  AddRing(site->add_holes(), {{5, 3}, {7, 3}, {7, 5}, {5, 5}, {5, 3}});
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(map, &put).ok());
+  EXPECT_NEAR(put.info().free_area_m2(), 96 - 4, 1e-9);
+  v1::PlanRequest request = PlanRequestFor(put.map_id(), 0.5);
+  AddRing(request.add_no_go()->mutable_outer(), {{1, 1}, {2.3, 1}, {2.3, 2.2}, {1, 1}});
+  AddRing(request.add_regions()->mutable_outer(), {{0, 0}, {9, 0}, {9, 8}, {0, 8}, {0, 0}});
+  v1::PlanResponse plan;
+  const grpc::Status status = Plan(request, &plan);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(plan.planner(), "oarp");
+  EXPECT_GT(plan.stats().no_go_cells(), 0);
+  EXPECT_EQ(plan.stats().covered_cells(), plan.stats().free_cells());
+  EXPECT_EQ(plan.no_go_size(), 1);
+  EXPECT_EQ(plan.regions_size(), 1);
+  EXPECT_EQ(plan.termination().reason(), v1::CONVERGED);
+  int coverage = 0;
+  for (const v1::Waypoint& w : plan.path()) coverage += w.kind() == v1::COVERAGE;
+  EXPECT_EQ(plan.sweeps_size(), coverage);
+  // Nothing east of the region (x > 9) is swept.
+  for (const v1::CoverageSweep& s : plan.sweeps()) {
+    for (int32_t cell : s.cells()) {
+      const int col = cell % plan.grid().cols();
+      EXPECT_LT(plan.grid().origin_x_m() + (col + 0.5) * 0.5, 9.0);
+    }
+  }
+  // GetPlan returns the retained plan, zones included.
+  grpc::ClientContext context;
+  v1::GetPlanRequest get;
+  get.set_plan_id(plan.plan_id());
+  v1::PlanResponse retained;
+  ASSERT_TRUE(stub_->GetPlan(&context, get, &retained).ok());
+  EXPECT_EQ(retained.SerializeAsString(), plan.SerializeAsString());
+
+  // Bad geometry: INVALID_ARGUMENT naming the ring.
+  v1::Map bow_tie;
+  AddRing(bow_tie.mutable_polygons()->add_polygons()->mutable_outer(),
+          {{0, 0}, {4, 0}, {0, 4}, {4, 4}, {0, 0}});
+  v1::PutMapResponse bad_put;
+  grpc::Status bad = PutMap(bow_tie, &bad_put);
+  EXPECT_EQ(bad.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(bad.error_message(), HasSubstr("map.polygons[0].outer"));
+  v1::PlanRequest open_zone = PlanRequestFor(put.map_id(), 0.5);
+  AddRing(open_zone.add_no_go()->mutable_outer(), {{1, 1}, {2, 1}, {2, 2}});
+  bad = Plan(open_zone, &plan);
+  EXPECT_EQ(bad.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(bad.error_message(), HasSubstr("no_go[0].outer: ring is not closed"));
+  v1::PlanRequest unknown = PlanRequestFor(put.map_id(), 0.5);
+  unknown.set_planner("stc-not-yet");
+  bad = Plan(unknown, &plan);
+  EXPECT_EQ(bad.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(bad.error_message(), HasSubstr("unknown planner"));
+}
+
 TEST_F(ServiceTest, InlineMapPlansWithoutPutMap) {
   v1::PlanRequest request = PlanRequestFor("", 0.4);
   *request.mutable_map() = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);
