@@ -35,13 +35,6 @@ absl::Status CheckPositive(double v, absl::string_view field, absl::string_view 
       absl::StrFormat("%s must be a positive, finite number of %s (got %g)", field, unit, v));
 }
 
-absl::Status CheckRange(double v, absl::string_view field, double lo, double hi,
-                        absl::string_view unit) {
-  if (v >= lo && v <= hi) return absl::OkStatus();  // NaN fails
-  return absl::InvalidArgumentError(
-      absl::StrFormat("%s must be between %g and %g %s (got %g)", field, lo, hi, unit, v));
-}
-
 absl::Status CheckFinite(double v, absl::string_view field) {
   if (std::isfinite(v)) return absl::OkStatus();
   return absl::InvalidArgumentError(absl::StrFormat("%s must be finite (got %g)", field, v));
@@ -243,34 +236,13 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
     return absl::InvalidArgumentError("planner: name longer than 64 characters");
   }
   CommonOptions& options = out.common;
+  // Field values are copied as given; CommonOptions::Validate (and the
+  // planner's options) check them and name the proto field in the message.
   const v1::RobotModel& robot = request.robot();
-  using M = RobotModel;
-  RETURN_IF_ERROR(CheckRange(robot.tool_width_m(), "robot.tool_width_m", M::kMinToolWidth,
-                             M::kMaxToolWidth, "m"));
   options.robot.tool_width_m = robot.tool_width_m();
-  if (robot.has_max_speed_mps()) {
-    RETURN_IF_ERROR(
-        CheckRange(robot.max_speed_mps(), "robot.max_speed_mps", M::kMinSpeed, M::kMaxSpeed, "m/s"));
-    options.robot.max_speed_mps = robot.max_speed_mps();
-  }
-  if (robot.has_acceleration_mps2()) {
-    RETURN_IF_ERROR(CheckRange(robot.acceleration_mps2(), "robot.acceleration_mps2",
-                               M::kMinAcceleration, M::kMaxAcceleration, "m/s^2"));
-    options.robot.acceleration_mps2 = robot.acceleration_mps2();
-  }
-  if (robot.has_turn_rate_deg_s()) {
-    RETURN_IF_ERROR(CheckRange(robot.turn_rate_deg_s(), "robot.turn_rate_deg_s", M::kMinTurnRate,
-                               M::kMaxTurnRate, "deg/s"));
-    options.robot.turn_rate_deg_s = robot.turn_rate_deg_s();
-  }
-  for (auto [present, pose, name] :
-       {std::tuple{robot.has_start(), &robot.start(), "robot.start"},
-        std::tuple{robot.has_end(), &robot.end(), "robot.end"}}) {
-    if (!present) continue;
-    if (!std::isfinite(pose->x()) || !std::isfinite(pose->y()) || !std::isfinite(pose->theta())) {
-      return absl::InvalidArgumentError(absl::StrCat(name, " must have finite x, y and theta"));
-    }
-  }
+  if (robot.has_max_speed_mps()) options.robot.max_speed_mps = robot.max_speed_mps();
+  if (robot.has_acceleration_mps2()) options.robot.acceleration_mps2 = robot.acceleration_mps2();
+  if (robot.has_turn_rate_deg_s()) options.robot.turn_rate_deg_s = robot.turn_rate_deg_s();
   if (robot.has_start()) options.robot.start = Pose2{robot.start().x(), robot.start().y(), robot.start().theta()};
   if (robot.has_end()) options.robot.end = Pose2{robot.end().x(), robot.end().y(), robot.end().theta()};
 
@@ -311,21 +283,10 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
     }
     out.options = std::move(oarp);
   }
-  const double limit = request.time_limit_s();
-  if (!std::isfinite(limit) || limit < 0.0 || limit > 3600.0) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("time_limit_s must be in [0, 3600] seconds (got %g)", limit));
-  }
-  if (limit > 0.0) options.time_limit_s = limit;
+  // 0 means "default" for both (proto3 scalars have no presence).
+  if (request.time_limit_s() != 0.0) options.time_limit_s = request.time_limit_s();
   options.seed = request.seed();
-  const double fraction = request.min_free_fraction();
-  if (fraction != 0.0) {
-    if (!std::isfinite(fraction) || fraction < 0.0 || fraction >= 1.0) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("min_free_fraction must be in (0, 1) (got %g)", fraction));
-    }
-    options.min_free_fraction = fraction;
-  }
+  if (request.min_free_fraction() != 0.0) options.min_free_fraction = request.min_free_fraction();
   out.regions = PolygonsFromProto(request.regions());
   out.no_go = PolygonsFromProto(request.no_go());
   RETURN_IF_ERROR(options.Validate());

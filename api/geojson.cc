@@ -1,10 +1,10 @@
 #include "api/geojson.h"
 
-#include <string>
-#include <utility>
-
 #include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
+
+#include <string>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -71,7 +71,8 @@ class GeoJsonReader {
                            std::string_view what, const ListValue*& out) const {
     const Value* v = Find(s, name);
     if (v == nullptr) return Error(path, absl::StrFormat("missing member \"%s\"", name));
-    if (!v->has_list_value()) return Error(Member(path, name), absl::StrCat("expected ", std::string(what)));
+    if (!v->has_list_value())
+      return Error(Member(path, name), absl::StrCat("expected ", std::string(what)));
     out = &v->list_value();
     return absl::OkStatus();
   }
@@ -157,8 +158,8 @@ class GeoJsonReader {
         ok = p.list_value().values(k).has_number_value();
       }
       if (!ok) return Error(Index(path, i), "expected a position [x, y] of numbers");
-      ring.push_back(Point2{p.list_value().values(0).number_value(),
-                            p.list_value().values(1).number_value()});
+      ring.push_back(
+          Point2{p.list_value().values(0).number_value(), p.list_value().values(1).number_value()});
     }
     return absl::OkStatus();
   }
@@ -193,7 +194,8 @@ absl::StatusOr<std::vector<PolygonInput>> ParseGeoJsonPolygons(std::string_view 
   RETURN_IF_ERROR(reader.ReadDocument(root));
   std::vector<PolygonInput> polygons = reader.TakePolygons();
   if (polygons.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(std::string(source), ": no Polygon or MultiPolygon found"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(std::string(source), ": no Polygon or MultiPolygon found"));
   }
   return polygons;
 }

@@ -13,8 +13,6 @@
 namespace covplan {
 namespace {
 
-double MsSince(absl::Time t) { return absl::ToDoubleMilliseconds(absl::Now() - t); }
-
 // InvalidArgument when a zone polygon's outer ring misses the map entirely.
 absl::Status CheckInsideMap(const std::vector<PolygonInput>& polygons, const char* field,
                             Point2 lo, Point2 hi) {
@@ -37,12 +35,13 @@ absl::Status CheckInsideMap(const std::vector<PolygonInput>& polygons, const cha
 
 absl::Status CommonOptions::Validate() const {
   RETURN_IF_ERROR(robot.Validate());
-  if (!std::isfinite(time_limit_s) || time_limit_s < 0.0) {
+  if (!std::isfinite(time_limit_s) || time_limit_s < 0.0 || time_limit_s > kMaxTimeLimitS) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "time_limit_s must be a non-negative number of seconds, got %g", time_limit_s));
+        "time_limit_s must be in [0, %g] seconds, got %g", kMaxTimeLimitS, time_limit_s));
   }
   if (num_threads < 1 || num_threads > 256) {
-    return absl::InvalidArgumentError(absl::StrFormat("threads must be in [1, 256], got %d", num_threads));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("num_threads must be in [1, 256], got %d", num_threads));
   }
   if (!std::isfinite(min_free_fraction) || min_free_fraction < 0.0 || min_free_fraction >= 1.0) {
     return absl::InvalidArgumentError(
@@ -151,7 +150,6 @@ absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest&
 
 absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
                                                   const PlanRequest& request) const {
-  const absl::Time start = absl::Now();
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
   PlanContext ctx;
   bool all_cached = true;
@@ -208,7 +206,6 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   s.decomposition_cached = all_cached;
   const TerminationLimit limit = plan.termination.limit;
   s.tour_cut_short = limit == TerminationLimit::kDeadline || limit == TerminationLimit::kCancelled;
-  (void)start;
   return EngineResult{std::move(plan), ctx.area};
 }
 

@@ -45,6 +45,8 @@ struct CommonOptions {
   int num_threads = 1;
   StopToken stop;  // deadline / cancellation of the whole request
 
+  static constexpr double kMaxTimeLimitS = 3600.0;
+  // The one place these are validated; the API edge passes the messages on.
   absl::Status Validate() const;
 };
 

@@ -17,7 +17,7 @@ absl::Status CheckRange(const char* name, double v, double lo, double hi, const 
 
 absl::Status CheckPose(const char* name, const std::optional<Pose2>& p) {
   if (p && (!std::isfinite(p->x) || !std::isfinite(p->y) || !std::isfinite(p->theta))) {
-    return absl::InvalidArgumentError(absl::StrFormat("%s pose must be finite", name));
+    return absl::InvalidArgumentError(absl::StrFormat("%s must have finite x, y and theta", name));
   }
   return absl::OkStatus();
 }
@@ -26,11 +26,12 @@ absl::Status CheckPose(const char* name, const std::optional<Pose2>& p) {
 
 absl::Status RobotModel::Validate() const {
   for (absl::Status s :
-       {CheckRange("tool width", tool_width_m, kMinToolWidth, kMaxToolWidth, "m"),
-        CheckRange("max speed", max_speed_mps, kMinSpeed, kMaxSpeed, "m/s"),
-        CheckRange("acceleration", acceleration_mps2, kMinAcceleration, kMaxAcceleration, "m/s^2"),
-        CheckRange("turn rate", turn_rate_deg_s, kMinTurnRate, kMaxTurnRate, "deg/s"),
-        CheckPose("start", start), CheckPose("end", end)}) {
+       {CheckRange("robot.tool_width_m", tool_width_m, kMinToolWidth, kMaxToolWidth, "m"),
+        CheckRange("robot.max_speed_mps", max_speed_mps, kMinSpeed, kMaxSpeed, "m/s"),
+        CheckRange("robot.acceleration_mps2", acceleration_mps2, kMinAcceleration, kMaxAcceleration,
+                   "m/s^2"),
+        CheckRange("robot.turn_rate_deg_s", turn_rate_deg_s, kMinTurnRate, kMaxTurnRate, "deg/s"),
+        CheckPose("robot.start", start), CheckPose("robot.end", end)}) {
     if (!s.ok()) return s;
   }
   return absl::OkStatus();

@@ -39,8 +39,8 @@ struct RobotModel {
   static constexpr double kMinAcceleration = 1e-3, kMaxAcceleration = 1e3;  // m/s^2
   static constexpr double kMinTurnRate = 0.1, kMaxTurnRate = 1e5;           // deg/s
 
-  // InvalidArgument naming the field when a value is outside its range or a
-  // pose is not finite.
+  // InvalidArgument naming the field as the API does ("robot.tool_width_m")
+  // when a value is outside its range or a pose is not finite.
   absl::Status Validate() const;
 
   // Time to drive a straight segment of `length` metres from rest to rest.

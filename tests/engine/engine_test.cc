@@ -46,7 +46,7 @@ class EveryPlanner : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(EveryPlanner, ConformsOnShippedMapsWithAndWithoutZones) {
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  for (const std::string& map_name : {"small_rooms.yaml", "sample_office_furnished.yaml"}) {
+  for (const std::string map_name : {"small_rooms.yaml", "sample_office_furnished.yaml"}) {
     const OccupancyMap map = Load(map_name);
     for (double tool : {0.5, 0.9}) {
       for (bool zones : {false, true}) {

@@ -85,7 +85,9 @@ TEST(PolygonMap, MatchesItsRasterisedTwinUpToRasterisationCells) {
       for (int c = 0; c < g.cols(); ++c) {
         const double x0 = g.origin().x + c * tool, y0 = g.origin().y + r * tool;
         const double exact = area.BoxOverlapM2(x0, y0, x0 + tool, y0 + tool) / (tool * tool);
-        if (std::abs(exact - 0.5) > 1e-6) ASSERT_EQ(g.IsFree(r, c), exact > 0.5) << r << "," << c;
+        if (std::abs(exact - 0.5) > 1e-6) {
+          ASSERT_EQ(g.IsFree(r, c), exact > 0.5) << r << "," << c;
+        }
       }
     }
     // The rank count on the polygon grid is the optimum (LP = min-cut).

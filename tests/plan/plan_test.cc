@@ -99,7 +99,7 @@ TEST(PlanCoverage, BadInputIsInvalidArgument) {
     double tool;
     const char* message;
   };
-  for (const Case& c : {Case{NAN, "tool width"}, Case{0.0, "tool width"}, Case{-0.8, "tool width"},
+  for (const Case& c : {Case{NAN, "robot.tool_width_m"}, Case{0.0, "robot.tool_width_m"}, Case{-0.8, "robot.tool_width_m"},
                         Case{0.01, "narrower than one map pixel"}, Case{20.0, "wider than the map"}}) {
     PlanOptions opt;
     opt.robot.tool_width_m = c.tool;

@@ -43,7 +43,7 @@ TEST(RobotModel, ValidateRejectsBadValues) {
     RobotModel w;
     w.tool_width_m = bad;
     EXPECT_EQ(w.Validate().code(), absl::StatusCode::kInvalidArgument) << bad;
-    EXPECT_NE(w.Validate().message().find("tool width"), std::string::npos);
+    EXPECT_NE(w.Validate().message().find("robot.tool_width_m"), std::string::npos);
   }
   RobotModel p;
   p.start = Pose2{NAN, 0, 0};
@@ -59,10 +59,10 @@ TEST(RobotModel, ValidateRejectsValuesOutsideThePhysicalRange) {
   EXPECT_NE(slow.Validate().message().find("acceleration"), std::string::npos);
   RobotModel frozen;
   frozen.turn_rate_deg_s = 5e-324;
-  EXPECT_NE(frozen.Validate().message().find("turn rate"), std::string::npos);
+  EXPECT_NE(frozen.Validate().message().find("robot.turn_rate_deg_s"), std::string::npos);
   RobotModel rocket;
   rocket.max_speed_mps = 1e300;
-  EXPECT_NE(rocket.Validate().message().find("max speed"), std::string::npos);
+  EXPECT_NE(rocket.Validate().message().find("robot.max_speed_mps"), std::string::npos);
   // The bounds themselves are accepted and give finite times.
   RobotModel edge;
   edge.max_speed_mps = RobotModel::kMinSpeed;
