@@ -119,7 +119,7 @@ class SharedLruCache {
       if (!leader_stopped || stop.ShouldStop()) return shared.status();
       // The leader gave up on its own deadline; try again (maybe as leader).
     }
-    return absl::UnavailableError("decomposition build kept being abandoned; retry");
+    return absl::UnavailableError("artifact build kept being abandoned; retry");
   }
 
   // Drops every entry whose key starts with `prefix` (e.g. a deleted map).
@@ -165,7 +165,7 @@ class SharedLruCache {
       if (stop.ShouldStop()) {
         return stop.cancelled() ? absl::CancelledError("request cancelled")
                                 : absl::DeadlineExceededError(
-                                      "deadline reached while waiting for the decomposition");
+                                      "deadline reached while waiting for a per-map artifact (grid, partition or transitions) that another call is building");
       }
       absl::Duration wait = absl::Milliseconds(20);
       if (stop.has_deadline()) wait = std::max(absl::ZeroDuration(), std::min(wait, stop.remaining()));

@@ -26,7 +26,7 @@ ABSL_FLAG(int, metrics_port, 9464, "Prometheus /metrics port (0 picks, -1 disabl
 ABSL_FLAG(std::string, store_dir, "./covplan-data/maps", "Directory of the map registry");
 ABSL_FLAG(int, threads, 2, "Worker threads for planning");
 ABSL_FLAG(int, max_queue, 16, "Requests that may wait for a worker; beyond: RESOURCE_EXHAUSTED");
-ABSL_FLAG(int64_t, cache_mb, 256, "Decomposition cache budget in MiB");
+ABSL_FLAG(int64_t, cache_mb, 256, "Per-map artifact cache budget in MiB (grids, coverage areas, partitions, transitions)");
 ABSL_FLAG(double, default_budget_s, 2.0, "Tour search budget for calls without a deadline");
 ABSL_FLAG(int, deadline_margin_ms, 25, "Part of a call's deadline kept for sending the reply");
 ABSL_FLAG(int, plan_ttl_s, 600, "How long plans stay addressable by plan_id");

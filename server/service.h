@@ -50,7 +50,7 @@ struct ServiceOptions {
   int max_queue = 16;                        // waiting requests beyond the workers
   size_t cache_budget_bytes = 256ull << 20;  // per-map artifact cache
   double default_budget_s = 2.0;             // tour search budget without a deadline
-  // Without a deadline, the whole call (decomposition included) stops after
+  // Without a deadline, the whole call (artifacts included) stops after
   // this long with DEADLINE_EXCEEDED rather than holding a worker forever.
   absl::Duration max_request_time = absl::Seconds(120);
   absl::Duration deadline_margin = absl::Milliseconds(25);  // kept for the reply
@@ -148,7 +148,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // Last: their threads stop before the rest is destroyed.
   WorkerPool io_pool_;    // PutMap / GetMap / DeleteMap
   WorkerPool pool_;       // Plan solves
-  WorkerPool warm_pool_;  // decompositions cut off by a caller's deadline
+  WorkerPool warm_pool_;  // artifacts cut off by a caller's deadline
 };
 
 }  // namespace covplan
