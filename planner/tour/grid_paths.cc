@@ -1,10 +1,14 @@
 #include "planner/tour/grid_paths.h"
 
 #include <algorithm>
+#include <limits>
+#include <optional>
 #include <cmath>
 #include <cstdlib>
 #include <queue>
 #include <utility>
+
+#include "absl/strings/str_format.h"
 
 namespace covplan {
 
@@ -168,6 +172,29 @@ std::vector<CellIndex> AnyAngleSearch::PathTo(CellIndex target) const {
   }
   std::reverse(path.begin(), path.end());
   return path;
+}
+
+absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& p, const char* what) {
+  const CellIndex c = grid.CellAt({p.x, p.y});
+  if (grid.IsFree(c)) return c;
+  std::optional<CellIndex> best;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  // Far outside the grid (CellAt clamps to -2 / n + 1): no free neighbour.
+  const bool near_grid = c.row >= -1 && c.col >= -1 && c.row <= grid.rows() && c.col <= grid.cols();
+  for (int dr = -1; near_grid && dr <= 1; ++dr) {
+    for (int dc = -1; dc <= 1; ++dc) {
+      const CellIndex n{c.row + dr, c.col + dc};
+      if (!grid.IsFree(n)) continue;
+      const Point2 q = grid.CellCenter(n);
+      const double d2 = (q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y);
+      if (d2 < best_d2) best_d2 = d2, best = n;
+    }
+  }
+  if (best) return *best;
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "%s pose (%.3f, %.3f) is neither in nor next to a reachable free grid cell (cells of "
+      "%.3f m; only the largest connected free area is planned)",
+      what, p.x, p.y, grid.cell_size()));
 }
 
 }  // namespace covplan

@@ -22,8 +22,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "planner/common/stop_token.h"
 #include "planner/grid/grid.h"
+#include "planner/tour/robot_model.h"
 
 namespace covplan {
 
@@ -34,6 +36,12 @@ bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b);
 // Connected components of free cells under 4-connectivity through passable
 // boundaries (the moves the line-of-sight rule allows). Returns per-cell component id, -1 for blocked.
 std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components);
+
+// The free cell where a robot at `pose` joins the grid: its own cell, or,
+// when that cell is blocked (a dock against a wall stands in a cell that is
+// mostly wall), the adjacent free cell whose centre is nearest. `what` names
+// the pose in the InvalidArgument error ("start", "end").
+absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& pose, const char* what);
 
 class AnyAngleSearch {
  public:

@@ -13,33 +13,6 @@
 namespace covplan {
 namespace {
 
-// The free cell where the robot joins the grid: the pose's own cell, or, when
-// that cell is blocked (a dock against a wall stands in a cell that is mostly
-// wall), the adjacent free cell whose centre is nearest. The path then starts
-// with the short move from the pose onto that cell.
-absl::StatusOr<CellIndex> PoseCell(const Grid& grid, const Pose2& p, const char* what) {
-  const CellIndex c = grid.CellAt({p.x, p.y});
-  if (grid.IsFree(c)) return c;
-  std::optional<CellIndex> best;
-  double best_d2 = std::numeric_limits<double>::infinity();
-  // Far outside the grid (CellAt clamps to -2 / n + 1): no free neighbour.
-  const bool near_grid = c.row >= -1 && c.col >= -1 && c.row <= grid.rows() && c.col <= grid.cols();
-  for (int dr = -1; near_grid && dr <= 1; ++dr) {
-    for (int dc = -1; dc <= 1; ++dc) {
-      const CellIndex n{c.row + dr, c.col + dc};
-      if (!grid.IsFree(n)) continue;
-      const Point2 q = grid.CellCenter(n);
-      const double d2 = (q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y);
-      if (d2 < best_d2) best_d2 = d2, best = n;
-    }
-  }
-  if (best) return *best;
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "%s pose (%.3f, %.3f) is neither in nor next to a reachable free grid cell (cells of "
-      "%.3f m; only the largest connected free area is planned)",
-      what, p.x, p.y, grid.cell_size()));
-}
-
 // Points from `pose` to the centre of its cell, then along `cells`.
 std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose, const std::vector<CellIndex>& cells) {
   std::vector<Point2> pts = {{pose.x, pose.y}};
@@ -79,9 +52,9 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   }
   cost.has_end_ = robot.end.has_value();
   cost.end_ = robot.end.value_or(cost.start_);
-  absl::StatusOr<CellIndex> start_cell = PoseCell(grid, cost.start_, "start");
+  absl::StatusOr<CellIndex> start_cell = JoinCell(grid, cost.start_, "start");
   if (!start_cell.ok()) return start_cell.status();
-  absl::StatusOr<CellIndex> end_cell = PoseCell(grid, cost.end_, "end");
+  absl::StatusOr<CellIndex> end_cell = JoinCell(grid, cost.end_, "end");
   if (!end_cell.ok()) return end_cell.status();
 
   const int n = cost.num_vertices();

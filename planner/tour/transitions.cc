@@ -11,17 +11,24 @@ namespace covplan {
 
 absl::StatusOr<std::shared_ptr<const TransitionTable>> TransitionTable::Build(
     const Grid& grid, const std::vector<Rank>& ranks, const StopToken& stop, int num_threads) {
-  auto table = std::make_shared<TransitionTable>();
-  const int e_count = static_cast<int>(ranks.size() * 2);
-  table->num_endpoints_ = e_count;
-  table->endpoints_.reserve(e_count);
+  std::vector<CellIndex> endpoints;
+  endpoints.reserve(ranks.size() * 2);
   for (const Rank& r : ranks) {
-    if (!grid.IsFree(r.first) || !grid.IsFree(r.last)) {
-      return absl::InvalidArgumentError("rank endpoint lies on a blocked cell");
-    }
-    table->endpoints_.push_back(r.first);
-    table->endpoints_.push_back(r.last);
+    endpoints.push_back(r.first);
+    endpoints.push_back(r.last);
   }
+  return BuildForEndpoints(grid, std::move(endpoints), stop, num_threads);
+}
+
+absl::StatusOr<std::shared_ptr<const TransitionTable>> TransitionTable::BuildForEndpoints(
+    const Grid& grid, std::vector<CellIndex> endpoints, const StopToken& stop, int num_threads) {
+  auto table = std::make_shared<TransitionTable>();
+  const int e_count = static_cast<int>(endpoints.size());
+  table->num_endpoints_ = e_count;
+  for (const CellIndex& c : endpoints) {
+    if (!grid.IsFree(c)) return absl::InvalidArgumentError("transition endpoint lies on a blocked cell");
+  }
+  table->endpoints_ = std::move(endpoints);
   table->pairs_.assign(static_cast<size_t>(e_count) * e_count, PairInfo{});
   table->corners_.assign(e_count, {});
 

@@ -29,6 +29,9 @@ class TransitionTable {
  public:
   static absl::StatusOr<std::shared_ptr<const TransitionTable>> Build(
       const Grid& grid, const std::vector<Rank>& ranks, const StopToken& stop, int num_threads);
+  // The same over arbitrary endpoint cells (tour elements other than ranks).
+  static absl::StatusOr<std::shared_ptr<const TransitionTable>> BuildForEndpoints(
+      const Grid& grid, std::vector<CellIndex> endpoints, const StopToken& stop, int num_threads);
 
   int num_endpoints() const { return num_endpoints_; }
   CellIndex endpoint(int e) const { return endpoints_[e]; }

@@ -1,0 +1,68 @@
+// The geometry of replanning (internal to planner/replan): where the robot is
+// on its plan, which cells the new obstacles block, the remainder of the old
+// path as legs, and the greedy walk that drives that remainder with a detour
+// around every blocked stretch (finishing interrupted ranks after it).
+//
+// Thread-safety: plain functions over immutable inputs.
+#ifndef COVPLAN_PLANNER_REPLAN_REPLAN_WALK_H_
+#define COVPLAN_PLANNER_REPLAN_REPLAN_WALK_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "planner/engine/site.h"
+#include "planner/plan/coverage_plan.h"
+#include "planner/replan/replanner.h"
+
+namespace covplan::replan_internal {
+
+// One straight segment of the remaining path.
+struct Leg {
+  Point2 a, b;
+  SegmentKind kind = SegmentKind::kTransition;
+  int old_segment = -1;          // index of the old path's waypoint this leg ends at
+  int tag = -1;                  // the old waypoint's rank tag
+  bool whole = true;             // the leg is a whole old segment (not cut by the robot)
+  std::vector<CellIndex> cells;  // coverage: cells swept, ordered from a to b
+};
+
+struct Located {
+  int segment = 1;   // the old segment path[segment - 1] -> path[segment]
+  double t = 0.0;    // position on it, 0..1
+  Point2 at;
+  double heading = 0.0;
+};
+
+absl::StatusOr<Located> Locate(const CoveragePlan& plan, const RobotProgress& progress);
+
+// Per drive-grid cell: 1 when a new obstacle blocks a free cell. The robot's
+// own cell is never blocked (it stands there).
+absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Observations& obs,
+                                                  CellIndex robot_cell);
+
+// The old path from the robot on, as legs; `covered` gets 1 for every cell
+// swept before the robot's position.
+std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
+                               std::vector<uint8_t>* covered);
+
+// The greedy walk over `legs` on `drive` (cells not free there are
+// obstacles). With stop_at_encounter = k >= 0 it stops where the walk would
+// enter its k-th blocked stretch (0-based) and reports that point; otherwise
+// it detours around every stretch and drives to the end.
+struct Walk {
+  std::vector<Waypoint> path;        // from the robot
+  std::vector<CoverageSweep> sweeps;
+  std::vector<uint8_t> swept;        // per cell
+  int encounters = 0;                // blocked stretches met (up to the stop)
+  bool stopped = false;              // reached the requested encounter
+  Point2 end;
+  double end_heading = 0.0;
+  int end_leg = -1;                  // leg where the walk stopped
+};
+Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, double heading,
+                int stop_at_encounter);
+
+}  // namespace covplan::replan_internal
+
+#endif  // COVPLAN_PLANNER_REPLAN_REPLAN_WALK_H_

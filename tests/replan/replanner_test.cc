@@ -1,0 +1,296 @@
+// OARP-Replan end to end on the shipped office: the robot drives the plan of
+// the plain map and meets the furnished map's extra obstacles. Every method
+// passes the conformance suite on the remainder (every remaining reachable
+// cell swept, nothing through a known or new obstacle), plans start at the
+// robot and end where the old plan ended; bad progress and bad obstacles are
+// InvalidArgument; an expired deadline still gets the greedy detour.
+#include "planner/replan/replanner.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "planner/engine/plan_coverage.h"
+#include "planner/grid/map_io.h"
+#include "tests/testing/plan_conformance.h"
+
+namespace covplan {
+namespace {
+
+using ::testing::HasSubstr;
+
+OccupancyMap Load(const std::string& name) {
+  absl::StatusOr<OccupancyMap> map =
+      LoadMapFile(std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name, MapLoadOptions());
+  EXPECT_TRUE(map.ok()) << map.status();
+  return *map;
+}
+
+struct Mission {
+  RetainedPlan plan;
+  Observations furniture;  // the furnished map's extra obstacles, as cells
+};
+
+// Plans the plain office; the new obstacles are the cells that are free on
+// the plain grid but blocked on the furnished one.
+Mission Office(double tool = 0.8) {
+  const OccupancyMap known = Load("sample_office.yaml");
+  const OccupancyMap truth = Load("sample_office_furnished.yaml");
+  PlanOptions o;
+  o.robot.tool_width_m = tool;
+  o.time_limit_s = 0.5;
+  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(known, o);
+  EXPECT_TRUE(r.ok()) << r.status();
+  Mission m;
+  m.plan.plan_id = "p-test";
+  m.plan.map_id = "office";
+  m.plan.plan = r->plan;
+  m.plan.area = r->area;
+  m.plan.request = o.ToRequest();
+  GridOptions go;
+  go.cell_size = tool;
+  absl::StatusOr<Grid> true_grid = BuildGrid(truth, go);
+  EXPECT_TRUE(true_grid.ok());
+  const Grid& drive = *r->area->drive;
+  for (int64_t i = 0; i < drive.size(); ++i) {
+    const CellIndex c = drive.FromIndex(i);
+    if (drive.IsFree(c) && !true_grid->IsFree(c)) m.furniture.cells.push_back(c);
+  }
+  EXPECT_GT(m.furniture.cells.size(), 5u);
+  return m;
+}
+
+RobotProgress Early(const CoveragePlan& plan) {
+  RobotProgress p;
+  p.waypoint = static_cast<int>(plan.path.size()) / 6;
+  const Waypoint& a = plan.path[p.waypoint - 1];
+  const Waypoint& b = plan.path[p.waypoint];
+  p.position = Point2{(a.x + b.x) / 2, (a.y + b.y) / 2};
+  return p;
+}
+
+void ExpectGoodReplan(const ReplanResult& r, const RetainedPlan& old, const RobotProgress& at,
+                      const Observations& seen) {
+  EXPECT_EQ(testing::CheckPlanConformance(r.plan, *r.area, old.request.common.robot), "");
+  // Starts at the robot, ends where the old plan ended.
+  ASSERT_GE(r.plan.path.size(), 2u);
+  if (at.position) {
+    EXPECT_NEAR(r.plan.path.front().x, at.position->x, 0.81);
+    EXPECT_NEAR(r.plan.path.front().y, at.position->y, 0.81);
+  }
+  EXPECT_NEAR(r.plan.path.back().x, old.plan.path.back().x, 1e-9);
+  EXPECT_NEAR(r.plan.path.back().y, old.plan.path.back().y, 1e-9);
+  // No new obstacle is entered (the drive grid has them blocked; check the cells directly too).
+  for (const CellIndex& c : seen.cells) EXPECT_FALSE(r.area->drive->IsFree(c));
+  EXPECT_EQ(testing::CheckPathStaysFree(*r.area->drive, r.plan.path), "");
+  // Honest accounting: swept + remaining + unreachable add up.
+  EXPECT_EQ(r.plan.stats.covered_cells, r.stats.remaining_cells);
+  EXPECT_EQ(static_cast<int64_t>(r.unreachable.size()), r.stats.newly_unreachable_cells);
+}
+
+class EveryMethod : public ::testing::TestWithParam<ReplanMethod> {};
+
+TEST_P(EveryMethod, FurnitureOfTheFurnishedOfficeIsReplannedAroundAndEverythingLeftIsSwept) {
+  const Mission m = Office();
+  const RobotProgress at = Early(m.plan.plan);
+  ReplanEstimator estimator;
+  ReplanOptions options;
+  options.method = GetParam();
+  absl::StatusOr<ReplanResult> r = Replan(m.plan, at, m.furniture, options, &estimator);
+  ASSERT_TRUE(r.ok()) << r.status();
+  std::printf("method %s: encounters %d, detours %zu, replanned at %d (tau %.1f s), budget %lld, "
+              "new %lld, kept %lld, pieces %lld; rank %.1f ms, transitions %.1f ms, tour %.1f ms, "
+              "total %.1f ms\n",
+              r->stats.method.c_str(), r->stats.num_encounters, r->stats.greedy_detours.size(),
+              r->stats.replanned_encounter, r->stats.time_to_encounter_s,
+              static_cast<long long>(r->stats.rank_budget), static_cast<long long>(r->stats.new_ranks),
+              static_cast<long long>(r->stats.kept_ranks), static_cast<long long>(r->stats.kept_path_pieces),
+              r->stats.rank_replan_ms, r->stats.transitions_ms, r->stats.tour_ms, r->stats.total_ms);
+  ExpectGoodReplan(*r, m.plan, at, m.furniture);
+  EXPECT_GT(r->stats.num_encounters, 0);
+  EXPECT_GT(r->stats.newly_blocked_cells, 0);
+  if (GetParam() == ReplanMethod::kGreedyDetour) {
+    EXPECT_EQ(static_cast<int>(r->stats.greedy_detours.size()), r->stats.num_encounters);
+  }
+  if (GetParam() == ReplanMethod::kIlp1 || GetParam() == ReplanMethod::kIlp2 ||
+      GetParam() == ReplanMethod::kAuto) {
+    // The robot is far from the first obstacle: Algorithm 1 replans at it.
+    EXPECT_GE(r->stats.replanned_encounter, 0) << r->stats.method;
+    EXPECT_GT(r->stats.kept_ranks, 0);
+    EXPECT_LE(r->stats.new_ranks, std::max<int64_t>(r->stats.rank_budget, 0));
+    EXPECT_LT(r->stats.total_ms, 1000 * r->stats.time_to_encounter_s);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, EveryMethod,
+                         ::testing::Values(ReplanMethod::kGreedyDetour, ReplanMethod::kIlp1,
+                                           ReplanMethod::kIlp2, ReplanMethod::kAuto,
+                                           ReplanMethod::kFull),
+                         [](const ::testing::TestParamInfo<ReplanMethod>& info) {
+                           return std::string(ReplanMethodName(info.param));
+                         });
+
+TEST(Replan, AReplannedPlanCanBeReplannedAgain) {
+  const Mission m = Office();
+  RobotProgress at = Early(m.plan.plan);
+  ReplanEstimator estimator;
+  Observations first, second;
+  first.cells.assign(m.furniture.cells.begin(), m.furniture.cells.begin() + m.furniture.cells.size() / 2);
+  second.cells.assign(m.furniture.cells.begin() + m.furniture.cells.size() / 2, m.furniture.cells.end());
+  absl::StatusOr<ReplanResult> r1 = Replan(m.plan, at, first, ReplanOptions(), &estimator);
+  ASSERT_TRUE(r1.ok()) << r1.status();
+  RetainedPlan next = m.plan;
+  next.plan = r1->plan;
+  next.area = r1->area;
+  RobotProgress later;
+  later.waypoint = static_cast<int>(next.plan.path.size()) / 4;
+  const Waypoint& a = next.plan.path[later.waypoint - 1];
+  later.position = Point2{a.x, a.y};
+  absl::StatusOr<ReplanResult> r2 = Replan(next, later, second, ReplanOptions(), &estimator);
+  ASSERT_TRUE(r2.ok()) << r2.status();
+  ExpectGoodReplan(*r2, next, later, second);
+}
+
+TEST(Replan, ObstaclesBehindTheRobotChangeNothing) {
+  const Mission m = Office();
+  RobotProgress at;
+  at.waypoint = static_cast<int>(m.plan.plan.path.size()) - 2;  // near the end
+  const Waypoint& w = m.plan.plan.path[at.waypoint - 1];
+  at.position = Point2{w.x, w.y};
+  // A cell swept early in the plan, well away from what is left to drive.
+  const Grid& g = *m.plan.area->drive;
+  Observations seen;
+  for (const CoverageSweep& s : m.plan.plan.sweeps) {
+    if (!seen.cells.empty() || s.waypoint > static_cast<int>(m.plan.plan.path.size()) / 3) break;
+    for (const CellIndex& c : s.cells) {
+      const Point2 p = g.CellCenter(c);
+      double nearest = 1e9;
+      for (size_t i = at.waypoint - 1; i + 1 < m.plan.plan.path.size(); ++i) {
+        const Waypoint& a = m.plan.plan.path[i];
+        const Waypoint& b = m.plan.plan.path[i + 1];
+        for (int k = 0; k <= 50; ++k) {
+          const double t = k / 50.0;
+          nearest = std::min(nearest, std::hypot(a.x + t * (b.x - a.x) - p.x, a.y + t * (b.y - a.y) - p.y));
+        }
+      }
+      if (nearest > 2 * g.cell_size()) {
+        seen.cells = {c};
+        break;
+      }
+    }
+  }
+  ASSERT_EQ(seen.cells.size(), 1u);
+  absl::StatusOr<ReplanResult> r = Replan(m.plan, at, seen, ReplanOptions(), nullptr);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.num_encounters, 0);
+  EXPECT_EQ(r->stats.method, "unchanged");
+  ExpectGoodReplan(*r, m.plan, at, seen);
+}
+
+TEST(Replan, AnExpiredDeadlineStillGetsTheGreedyDetour) {
+  const Mission m = Office();
+  const RobotProgress at = Early(m.plan.plan);
+  ReplanOptions options;
+  options.stop = StopToken::WithDeadline(absl::Now() - absl::Seconds(1));
+  ReplanEstimator estimator;
+  absl::StatusOr<ReplanResult> r = Replan(m.plan, at, m.furniture, options, &estimator);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.method, "greedy_detour");
+  ExpectGoodReplan(*r, m.plan, at, m.furniture);
+}
+
+// Encounters whose time-to-reach is too short for a replan are driven around
+// (greedy detour); Algorithm 1 replans at the first one with enough time.
+TEST(Replan, EncountersWithTooLittleTimeAreDetouredAndALaterOneReplanned) {
+  const Mission m = Office();
+  const RobotProgress at = Early(m.plan.plan);
+  ReplanEstimator estimator;
+  ReplanOptions options;
+  ReplanOptions probe;
+  probe.method = ReplanMethod::kGreedyDetour;
+  absl::StatusOr<ReplanResult> all = Replan(m.plan, at, m.furniture, probe, &estimator);
+  ASSERT_TRUE(all.ok());
+  ASSERT_GE(all->stats.num_encounters, 3);
+  // Keep back more than the first encounter's time-to-reach but less than a later one's.
+  absl::StatusOr<ReplanResult> first = Replan(m.plan, at, m.furniture, ReplanOptions(), &estimator);
+  ASSERT_TRUE(first.ok());
+  ASSERT_EQ(first->stats.replanned_encounter, 0);
+  options.safety_margin_s = first->stats.time_to_encounter_s + 0.5;
+  absl::StatusOr<ReplanResult> r = Replan(m.plan, at, m.furniture, options, &estimator);
+  ASSERT_TRUE(r.ok()) << r.status();
+  ExpectGoodReplan(*r, m.plan, at, m.furniture);
+  ASSERT_FALSE(r->stats.greedy_detours.empty());
+  EXPECT_EQ(r->stats.greedy_detours.front(), 0);
+  EXPECT_GT(r->stats.replanned_encounter, 0);
+  EXPECT_GT(r->stats.time_to_encounter_s, options.safety_margin_s);
+}
+
+TEST(Replan, MalformedProgressAndObstaclesAreInvalidArgument) {
+  const Mission m = Office();
+  const int n = static_cast<int>(m.plan.plan.path.size());
+  struct Case {
+    RobotProgress at;
+    Observations seen;
+    const char* message;
+  };
+  RobotProgress past;
+  past.waypoint = n;
+  past.position = Point2{0, 0};
+  RobotProgress nan_pos = Early(m.plan.plan);
+  nan_pos.position = Point2{std::nan(""), 1.0};
+  RobotProgress far = Early(m.plan.plan);
+  far.position->x += 5.0;
+  RobotProgress beyond;
+  beyond.distance_m = 1e6;
+  RobotProgress negative;
+  negative.distance_m = -1;
+  RobotProgress nothing;
+  Observations off_grid;
+  off_grid.cells = {{-1, 3}};
+  Observations nan_point;
+  nan_point.points = {{1.0, std::nan("")}};
+  Observations bad_polygon;
+  bad_polygon.polygons = {{{{1, 1}, {3, 1}, {1, 3}, {3, 3}, {1, 1}}, {}}};
+  const std::vector<Case> cases = {
+      {past, {}, "progress.waypoint"},
+      {nan_pos, {}, "progress.position"},
+      {far, {}, "from segment"},
+      {beyond, {}, "past the end"},
+      {negative, {}, "progress.distance_m"},
+      {nothing, {}, "progress:"},
+      {Early(m.plan.plan), off_grid, "obstacles.cells[0]"},
+      {Early(m.plan.plan), nan_point, "obstacles.points[0]"},
+      {Early(m.plan.plan), bad_polygon, "obstacles.polygons[0].outer"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    absl::StatusOr<ReplanResult> r = Replan(m.plan, cases[i].at, cases[i].seen, ReplanOptions(), nullptr);
+    EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument) << i << ": " << r.status();
+    EXPECT_THAT(std::string(r.status().message()), HasSubstr(cases[i].message)) << i;
+  }
+}
+
+TEST(Estimator, LearnsFromSolvesAndPersists) {
+  ReplanEstimator e;
+  const int64_t prior = e.Budget(0.5);
+  EXPECT_GT(prior, 0);
+  EXPECT_EQ(e.Budget(0.0), -1);
+  EXPECT_LE(e.Budget(0.1), e.Budget(1.0));  // monotone
+  // Slow solves: 20 ms + 10 ms per new rank.
+  for (int m = 0; m < 40; ++m) e.Record(m, 0.02 + 0.01 * m);
+  const int64_t learned = e.Budget(0.555);
+  EXPECT_NEAR(static_cast<double>(learned), 53.0, 3.0);
+  EXPECT_LT(learned, prior);
+  EXPECT_NEAR(e.Predict(10), 0.12, 0.02);
+  ReplanEstimator restored;
+  ASSERT_TRUE(restored.Parse(e.Serialize()).ok());
+  EXPECT_EQ(restored.Budget(0.555), learned);
+  EXPECT_EQ(restored.num_samples(), 40);
+  EXPECT_FALSE(restored.Parse("garbage\n1 2\n").ok());
+  EXPECT_FALSE(restored.Parse("covplan.replan_estimator.v1\n-1 2\n").ok());
+}
+
+}  // namespace
+}  // namespace covplan
