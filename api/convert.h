@@ -32,6 +32,7 @@
 #include "planner/engine/site.h"
 #include "planner/geometry/area.h"
 #include "planner/plan/coverage_plan.h"
+#include "planner/replan/replanner.h"
 
 namespace covplan {
 
@@ -82,6 +83,18 @@ void RetainedPlanToProto(const RetainedPlan& plan, v1::PlanResponse* out);
 // The inverse (e.g. to render a server's answer as SVG). InvalidArgument on
 // an inconsistent response.
 absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response);
+
+// Replanning (convert_replan.cc). Range checks of progress and obstacles
+// happen in the replanner, with the same field names.
+absl::StatusOr<ReplanMethod> ReplanMethodFromProto(v1::ReplanMethod method);
+absl::StatusOr<RobotProgress> ProgressFromProto(const v1::RobotProgress& progress);
+Observations ObstaclesFromProto(const v1::Obstacles& obstacles);
+// `retained` is the new plan as the server keeps it (plan_id set).
+void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1::ReplanResponse* out);
+// A plan the server did not retain, rebuilt on the map it was planned on.
+absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& plan,
+                                                    const PlanningEngine& engine,
+                                                    const MapSource& source);
 
 // Canonical protobuf JSON, snake_case field names, primitive fields always
 // printed, indented. This is the CLI's plan.json.

@@ -219,4 +219,29 @@ int64_t MapStore::size() const {
   return static_cast<int64_t>(index_.size());
 }
 
+namespace {
+bool IsStateName(const std::string& name) {
+  if (name.size() < 5 || name.compare(name.size() - 4, 4, ".txt") != 0) return false;
+  for (size_t i = 0; i + 4 < name.size(); ++i) {
+    if (!((name[i] >= 'a' && name[i] <= 'z') || name[i] == '_')) return false;
+  }
+  return true;
+}
+}  // namespace
+
+absl::Status MapStore::PutState(const std::string& name, absl::string_view contents) {
+  if (!IsStateName(name)) return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
+  absl::MutexLock write_lock(&write_mu_);
+  return AtomicWrite(dir_, dir_ + "/" + name, contents);
+}
+
+absl::StatusOr<std::string> MapStore::GetState(const std::string& name) const {
+  if (!IsStateName(name)) return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
+  std::ifstream in(dir_ + "/" + name, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat("no state file ", name));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
 }  // namespace covplan

@@ -54,6 +54,11 @@ class MapStore {
   int64_t size() const;
   const std::string& dir() const { return dir_; }
 
+  // Small server state beside the maps (e.g. the replan estimator), written
+  // atomically. `name` is [a-z_]+ with a ".txt" suffix. NotFound if absent.
+  absl::Status PutState(const std::string& name, absl::string_view contents);
+  absl::StatusOr<std::string> GetState(const std::string& name) const;
+
  private:
   explicit MapStore(std::string dir) : dir_(std::move(dir)) {}
   std::string PathFor(const std::string& map_id) const;

@@ -52,6 +52,34 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                                  "Memory budget of the cache");
   maps_stored_ = NewGauge(r, "covplan_maps_stored", "Maps in the registry");
   plans_retained_ = NewGauge(r, "covplan_plans_retained", "Plans addressable by plan_id");
+  replans_ = &prometheus::BuildCounter()
+                  .Name("covplan_replans_total")
+                  .Help("Replans answered, by the method that produced the plan")
+                  .Register(r);
+  replan_duration_ = &prometheus::BuildHistogram()
+                          .Name("covplan_replan_duration_seconds")
+                          .Help("Compute time of one replan")
+                          .Register(r)
+                          .Add({}, LatencyBuckets());
+  greedy_detours_ = NewCounter(r, "covplan_replan_greedy_detours_total",
+                               "Encounters handled by greedy detour (too little time to replan)");
+  estimator_ = &prometheus::BuildGauge()
+                    .Name("covplan_replan_estimator")
+                    .Help("Replan runtime model f(m) = a + b m + c m^3 (seconds) and its sample count")
+                    .Register(r);
+}
+
+void ServerMetrics::RecordReplan(const std::string& method, double seconds, int greedy_detours) {
+  replans_->Add({{"method", method}}).Increment();
+  replan_duration_->Observe(seconds);
+  greedy_detours_->Increment(greedy_detours);
+}
+
+void ServerMetrics::SetReplanEstimator(double a, double b, double c, int64_t samples) {
+  estimator_->Add({{"term", "a"}}).Set(a);
+  estimator_->Add({{"term", "b"}}).Set(b);
+  estimator_->Add({{"term", "c"}}).Set(c);
+  estimator_->Add({{"term", "samples"}}).Set(static_cast<double>(samples));
 }
 
 void ServerMetrics::RecordRequest(const std::string& method, const std::string& code,

@@ -39,6 +39,8 @@ class ServerMetrics : public CacheObserver {
   // `code` is the gRPC status code name, e.g. "OK", "INVALID_ARGUMENT".
   void RecordRequest(const std::string& method, const std::string& code, double seconds);
   void RecordSolve(double seconds, bool cut_short);
+  void RecordReplan(const std::string& method, double seconds, int greedy_detours);
+  void SetReplanEstimator(double a, double b, double c, int64_t samples);
 
   prometheus::Gauge& queue_depth() { return *queue_depth_; }
   prometheus::Gauge& in_flight() { return *in_flight_; }
@@ -72,6 +74,10 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge* cache_budget_bytes_;
   prometheus::Gauge* maps_stored_;
   prometheus::Gauge* plans_retained_;
+  prometheus::Family<prometheus::Counter>* replans_;
+  prometheus::Histogram* replan_duration_;
+  prometheus::Counter* greedy_detours_;
+  prometheus::Family<prometheus::Gauge>* estimator_;
 };
 
 }  // namespace covplan

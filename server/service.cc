@@ -13,6 +13,8 @@
 namespace covplan {
 namespace {
 
+constexpr char kEstimatorFile[] = "replan_estimator.txt";
+
 grpc::Status ToGrpc(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
   return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
@@ -99,6 +101,15 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
   metrics_->queue_capacity().Set(options.max_queue);
   metrics_->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
   metrics_->maps_stored().Set(static_cast<double>(store_->size()));
+  // The replan estimator learned by earlier runs of this server.
+  if (absl::StatusOr<std::string> saved = store_->GetState(kEstimatorFile); saved.ok()) {
+    const absl::Status parsed = estimator_.Parse(*saved);
+    LogLine(parsed.ok() ? "info" : "warn", "replan estimator loaded",
+            {{"samples", absl::StrCat(estimator_.num_samples())},
+             {"detail", parsed.ok() ? "" : std::string(parsed.message())}});
+  }
+  metrics_->SetReplanEstimator(estimator_.coefficients().a, estimator_.coefficients().b,
+                               estimator_.coefficients().c, estimator_.num_samples());
 }
 
 CoveragePlannerService::~CoveragePlannerService() { Shutdown(); }
@@ -443,6 +454,115 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
   }
   RetainedPlanToProto(*plan, response);  // in memory, no blocking
   FinishCall(reactor, call, absl::OkStatus(), request->plan_id());
+  return reactor;
+}
+
+// ---------------------------------------------------------------- replans
+
+absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
+                                               const StopToken& cancel, v1::ReplanResponse* response) {
+  const absl::Time start = absl::Now();
+  if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
+  ASSIGN_OR_RETURN(RobotProgress progress, ProgressFromProto(request.progress()));
+  ASSIGN_OR_RETURN(ReplanMethod method, ReplanMethodFromProto(request.method()));
+  ReplanOptions options;
+  options.method = method;
+  options.seed = request.seed();
+  // Never late: the call's deadline (less the reply margin) bounds the work;
+  // the time to each encounter bounds it further inside the replanner.
+  options.stop = call.deadline != absl::InfiniteFuture()
+                     ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
+                     : cancel.WithEarlierDeadline(start + options_.max_request_time);
+  std::shared_ptr<const RetainedPlan> old;
+  switch (request.plan_ref_case()) {
+    case v1::ReplanRequest::kPlanId:
+      old = plans_.Get(request.plan_id());
+      if (old == nullptr) {
+        return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '",
+                                                request.plan_id().substr(0, 80), "'"));
+      }
+      break;
+    case v1::ReplanRequest::kPlan: {
+      const v1::PlanRequest& pr = request.plan().request();
+      std::string map_id;
+      std::shared_ptr<const v1::Map> inline_map;
+      if (pr.map_ref_case() == v1::PlanRequest::kMapId) {
+        RETURN_IF_ERROR(ValidateMapId(pr.map_id()));
+        map_id = pr.map_id();
+      } else if (pr.map_ref_case() == v1::PlanRequest::kMap) {
+        map_id = ComputeMapId(pr.map());
+        inline_map = std::make_shared<const v1::Map>(pr.map());
+      } else {
+        return absl::InvalidArgumentError("plan.request needs map_id or an inline map");
+      }
+      ASSIGN_OR_RETURN(RetainedPlan rebuilt,
+                       RetainedPlanFromInline(request.plan(), engine_, SourceFor(map_id, inline_map)));
+      old = std::make_shared<const RetainedPlan>(std::move(rebuilt));
+      break;
+    }
+    default:
+      return absl::InvalidArgumentError("ReplanRequest needs plan_id or an inline plan");
+  }
+  ASSIGN_OR_RETURN(ReplanResult result,
+                   covplan::Replan(*old, progress, ObstaclesFromProto(request.obstacles()), options,
+                                   &estimator_));
+  auto retained = std::make_shared<RetainedPlan>();
+  retained->plan_id = NewPlanId();
+  retained->map_id = old->map_id;
+  retained->plan = std::move(result.plan);
+  retained->area = result.area;
+  retained->request = old->request;
+  result.plan = retained->plan;
+  ReplanToProto(result, *retained, response);
+  plans_.Put(retained);
+  metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
+  metrics_->RecordReplan(result.stats.method, result.stats.total_ms * 1e-3,
+                         static_cast<int>(result.stats.greedy_detours.size()));
+  metrics_->SetReplanEstimator(estimator_.coefficients().a, estimator_.coefficients().b,
+                               estimator_.coefficients().c, estimator_.num_samples());
+  if (result.stats.replanned_encounter >= 0) {
+    // Kept across restarts; a failed write only costs what was learned since.
+    if (absl::Status s = store_->PutState(kEstimatorFile, estimator_.Serialize()); !s.ok()) {
+      LogLine("warn", "replan estimator not saved", {{"detail", std::string(s.message())}});
+    }
+  }
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerContext* context,
+                                                         const v1::ReplanRequest* request,
+                                                         v1::ReplanResponse* response) {
+  auto* reactor = new PlanReactor();
+  CallInfo call = StartCall(context, "Replan");
+  if (draining()) {
+    FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (!TryAdmitSolve()) {
+    FinishCall(reactor, call,
+               absl::ResourceExhaustedError(absl::StrFormat(
+                   "server busy: %d workers and a queue of %d are full; retry later",
+                   options_.worker_threads, options_.max_queue)));
+    return reactor;
+  }
+  const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
+    metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    const absl::Status status = RunReplan(call, *request, reactor->cancel(), response);
+    metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
+    ReleaseSolve();
+    std::string detail;
+    if (status.ok()) {
+      detail = absl::StrFormat("plan=%s method=%s encounters=%d detours=%d new_ranks=%d",
+                               response->plan().plan_id(), response->replan().method(),
+                               response->replan().num_encounters(),
+                               response->replan().greedy_detours_size(), response->replan().new_ranks());
+    }
+    FinishCall(reactor, call, status, detail);
+  });
+  if (!queued) {
+    ReleaseSolve();
+    FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
+  }
   return reactor;
 }
 

@@ -36,6 +36,7 @@
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "api/convert.h"
 #include "planner/engine/engine.h"
+#include "planner/replan/replanner.h"
 #include "server/artifact_lru.h"
 #include "server/map_store.h"
 #include "server/metrics.h"
@@ -91,6 +92,9 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   grpc::ServerUnaryReactor* GetPlan(grpc::CallbackServerContext* context,
                                     const v1::GetPlanRequest* request,
                                     v1::PlanResponse* response) override;
+  grpc::ServerUnaryReactor* Replan(grpc::CallbackServerContext* context,
+                                   const v1::ReplanRequest* request,
+                                   v1::ReplanResponse* response) override;
 
   void StartDraining() {
     draining_.store(true);
@@ -109,6 +113,10 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                        const StopToken& cancel, v1::PlanResponse* response);
   void UpdateQueueGauges();
+  // The Replan work proper (runs on a worker).
+  absl::Status RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
+                         const StopToken& cancel, v1::ReplanResponse* response);
+  const ReplanEstimator& estimator() const { return estimator_; }
 
  private:
   CallInfo StartCall(grpc::CallbackServerContext* context, const char* method);
@@ -135,6 +143,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   const PlannerRegistry registry_;
   const PlanningEngine engine_;
   PlanRegistry plans_;
+  // Learns replan runtimes from this server's solves; kept in the store dir.
+  ReplanEstimator estimator_;
   std::atomic<bool> draining_{false};
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};

@@ -148,6 +148,15 @@ absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest&
   return resolved.planner->Prepare(ctx);
 }
 
+absl::StatusOr<std::shared_ptr<const CoverageArea>> PlanningEngine::AreaFor(
+    const MapSource& source, const PlanRequest& request) const {
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
+  PlanContext ctx;
+  bool all_cached = true;
+  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  return ctx.area;
+}
+
 absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
                                                   const PlanRequest& request) const {
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));

@@ -86,6 +86,10 @@ class PlanningEngine {
   absl::StatusOr<EngineResult> Plan(const MapSource& source, const PlanRequest& request) const;
   // Builds every per-map artifact `request` needs, without planning.
   absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
+  // The coverage area `request` plans on (validated like Plan), e.g. to
+  // continue a plan the server did not retain.
+  absl::StatusOr<std::shared_ptr<const CoverageArea>> AreaFor(const MapSource& source,
+                                                              const PlanRequest& request) const;
 
   const PlannerRegistry& registry() const { return *registry_; }
   const EngineLimits& limits() const { return limits_; }
