@@ -69,10 +69,25 @@ void CheckArea(const covplan::Area& area) {
   if (centre->width() != inside->width() || centre->height() != inside->height()) {
     Fail("raster rules give different sizes", res);
   }
+  const covplan::Point2 o = centre->origin();
   for (int r = 0; r < inside->height(); ++r) {
     for (int c = 0; c < inside->width(); ++c) {
       if (inside->IsFree(r, c) && !centre->IsFree(r, c)) Fail("kInside pixel not kCentre", r);
       if (inside->at(r, c) == covplan::CellState::kUnknown) Fail("unknown pixel", r);
+      if ((r * 31 + c * 17) % 29 != 0) continue;  // point tests on a sample of pixels
+      const covplan::Point2 mid{o.x + (c + 0.5) * res, o.y + (r + 0.5) * res};
+      if (centre->IsFree(r, c) != area.Contains(mid)) Fail("kCentre pixel disagrees", c);
+      // kInside is conservative up to 1e-9 of a pixel, and corners on the boundary may round
+      // either way: test them pulled 1e-6 of a pixel towards the centre.
+      const auto corner_in = [&](double fx, double fy) {
+        const double e = 1e-6 * res;
+        return area.Contains(
+            {o.x + (c + fx) * res + (fx > 0 ? -e : e), o.y + (r + fy) * res + (fy > 0 ? -e : e)});
+      };
+      if (inside->IsFree(r, c) &&
+          !(corner_in(0, 0) && corner_in(1, 0) && corner_in(0, 1) && corner_in(1, 1))) {
+        Fail("kInside pixel with a corner outside", c);
+      }
     }
   }
 }

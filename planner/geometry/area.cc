@@ -12,6 +12,7 @@
 #include "planner/common/status_macros.h"
 #include "planner/geometry/area_data.h"
 #include "planner/geometry/edge_queries.h"
+#include "planner/geometry/polygon_union.h"
 #include "planner/geometry/polygon_validation.h"
 
 namespace covplan {
@@ -30,25 +31,6 @@ using geometry_internal::FromBoost;
 using geometry_internal::ToBoost;
 namespace bg = geometry_internal::bg;
 namespace bgi = geometry_internal::bgi;
-
-// Unions in a balanced tree so that n polygons cost O(n log n) overlay work, not O(n^2).
-BMultiPolygon UnionAll(std::vector<BPolygon> polygons) {
-  std::vector<BMultiPolygon> parts;
-  parts.reserve(polygons.size());
-  for (BPolygon& p : polygons) parts.push_back(BMultiPolygon{std::move(p)});
-  while (parts.size() > 1) {
-    std::vector<BMultiPolygon> next;
-    next.reserve((parts.size() + 1) / 2);
-    for (size_t i = 0; i + 1 < parts.size(); i += 2) {
-      BMultiPolygon u;
-      bg::union_(parts[i], parts[i + 1], u);
-      next.push_back(std::move(u));
-    }
-    if (parts.size() % 2 == 1) next.push_back(std::move(parts.back()));
-    parts = std::move(next);
-  }
-  return parts.empty() ? BMultiPolygon() : std::move(parts[0]);
-}
 
 bool PointLess(const BPoint& a, const BPoint& b) {
   return std::tie(a.x(), a.y()) < std::tie(b.x(), b.y());
@@ -77,6 +59,13 @@ void Normalise(BMultiPolygon& shape) {
             [](const BPolygon& a, const BPolygon& b) { return RingLess(a.outer(), b.outer()); });
 }
 
+BPolygon RingPolygon(const BRing& ring) {
+  BPolygon p;
+  p.outer() = ring;
+  bg::correct(p);
+  return p;
+}
+
 void AddEdges(const BRing& ring, AreaData& d) {
   for (size_t i = 0; i + 1 < ring.size(); ++i) {
     d.edges.push_back(Edge{FromBoost(ring[i]), FromBoost(ring[i + 1])});
@@ -103,34 +92,25 @@ std::vector<Point2> RingPoints(const BRing& ring) {
 bool Finite(Point2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
 double Distance(Point2 p, const Edge& e) {
-  const double dx = e.b.x - e.a.x, dy = e.b.y - e.a.y;
-  const double len2 = dx * dx + dy * dy;
-  double t = len2 > 0 ? ((p.x - e.a.x) * dx + (p.y - e.a.y) * dy) / len2 : 0.0;
-  t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(p.x - (e.a.x + t * dx), p.y - (e.a.y + t * dy));
+  return bg::distance(ToBoost(p), BSegment(ToBoost(e.a), ToBoost(e.b)));
 }
 
 }  // namespace
 
-absl::StatusOr<Area> Area::Create(const std::vector<PolygonInput>& polygons,
-                                  std::string_view field, const AreaLimits& limits) {
+absl::StatusOr<Area> Area::Create(const std::vector<PolygonInput>& polygons, std::string_view field,
+                                  const AreaLimits& limits) {
   ASSIGN_OR_RETURN(std::vector<BPolygon> valid,
                    geometry_internal::ValidatePolygons(polygons, field, limits));
   auto d = std::make_shared<AreaData>();
-  try {
-    d->shape = UnionAll(std::move(valid));
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat(std::string(field), ": polygon union failed: ", e.what()));
-  }
+  ASSIGN_OR_RETURN(d->shape, geometry_internal::UnionPolygons(std::move(valid), field));
   Normalise(d->shape);
-  std::string reason;
-  if (!d->shape.empty() && !bg::is_valid(d->shape, reason)) {
-    return absl::InternalError(absl::StrCat(std::string(field), ": union of the polygons is invalid: ",
-                                            reason));
-  }
   for (const BPolygon& p : d->shape) {
     AddEdges(p.outer(), *d);
-    for (const BRing& hole : p.inners()) AddEdges(hole, *d);
+    d->rings.plus.push_back(RingPolygon(p.outer()));
+    for (const BRing& hole : p.inners()) {
+      AddEdges(hole, *d);
+      d->rings.minus.push_back(RingPolygon(hole));
+    }
   }
   std::vector<BoxIndex> boxes;
   boxes.reserve(d->edges.size());
@@ -186,8 +166,8 @@ double Area::SegmentLengthInInterior(Point2 a, Point2 b) const {
   }
   std::sort(ts.begin(), ts.end());
   const double len = std::sqrt(len2);
-  const double tol = 1e-9 + 1e-13 * std::max({std::abs(a.x), std::abs(a.y), std::abs(b.x),
-                                              std::abs(b.y)});
+  const double tol =
+      1e-9 + 1e-13 * std::max({std::abs(a.x), std::abs(a.y), std::abs(b.x), std::abs(b.y)});
   auto at = [&](double t) { return Point2{a.x + t * dx, a.y + t * dy}; };
   double inside = 0.0;
   for (size_t i = 0; i + 1 < ts.size(); ++i) {
@@ -221,9 +201,14 @@ double Area::BoxOverlapM2(double x0, double y0, double x1, double y1) const {
   if (x1 <= lo.x || x0 >= hi.x || y1 <= lo.y || y0 >= hi.y) return 0.0;
   if (x0 <= lo.x && y0 <= lo.y && x1 >= hi.x && y1 >= hi.y) return data_->area_m2;
   const geometry_internal::AreaData& d = *data_;
-  return geometry_internal::ClipBoxM2(d, d.shape, x0, y0, x1, y1, [&d](Point2 p) {
-    return bg::within(ToBoost(p), d.shape);
-  });
+  // Clip to a box half as large again first, so that the final clip's snapping grid (1e-7 of
+  // its inputs' extent) is that of the box, not of the whole area.
+  const double mx = std::max(0.5 * (x1 - x0), 1e-5 * (hi.x - lo.x));
+  const double my = std::max(0.5 * (y1 - y0), 1e-5 * (hi.y - lo.y));
+  const geometry_internal::RingPieces near =
+      geometry_internal::ClipToBox(d.rings, x0 - mx, y0 - my, x1 + mx, y1 + my);
+  return geometry_internal::ClipBoxM2(d, near, x0, y0, x1, y1,
+                                      [&d](Point2 p) { return bg::within(ToBoost(p), d.shape); });
 }
 
 std::string Area::CanonicalText() const {

@@ -40,6 +40,9 @@ struct PolygonInput {
 
 struct AreaLimits {
   int64_t max_vertices = 100000;  // over all rings of one Area, closing points included
+  // Largest width or height of all polygons together. Boost.Geometry snaps overlay points to
+  // 1/round(1e7 / extent) m: 0.1 m at 1000 km, whole metres from 10,000 km on.
+  double max_extent_m = 1e6;
 };
 
 class Area {
@@ -52,7 +55,9 @@ class Area {
   // "no_go[1].outer: ring is not closed: ..." or "regions[0].outer vertex 4: ...". Rings must
   // be closed, finite, simple (no self-intersection or spike), of non-zero area; holes must lie
   // inside their outer ring and not overlap each other. Different polygons may overlap or
-  // touch: they are unioned. An empty vector gives an empty Area.
+  // touch: they are unioned. An empty vector gives an empty Area. Polygons with features finer
+  // than Boost.Geometry can resolve in their extent (see AreaLimits) may be InvalidArgument;
+  // Internal if its union fails on anything else (not seen so far).
   static absl::StatusOr<Area> Create(const std::vector<PolygonInput>& polygons,
                                      std::string_view field, const AreaLimits& limits = {});
 
@@ -92,9 +97,10 @@ class Area {
 
 // Fraction in [0, 1] of each cell covered by `area`, for a rows x cols grid of square cells of
 // side `cell` whose cell (r, c) is origin + (c*cell, r*cell) .. + ((c+1)*cell, (r+1)*cell);
-// row-major, row 0 = smallest y. Cells the boundary touches are clipped with Boost.Geometry
+// row-major, row 0 = smallest y. Cells the boundary enters are clipped with Boost.Geometry
 // (exact up to its overlay precision, about 1e-7 of the area's extent); the others are 0 or 1
-// from a scan-line parity test; only cells overlapping the bounding box are visited.
+// from a scan-line parity test; only cells overlapping the bounding box are visited. About
+// 0.1 s for 10^6 cells and a 130-vertex polygon.
 // Returns rows*cols zeros when the area is empty or the grid is degenerate (cell <= 0, not
 // finite, rows or cols <= 0 gives an empty vector).
 std::vector<float> CellOverlapFractions(const Area& area, int rows, int cols, double cell,
@@ -102,7 +108,7 @@ std::vector<float> CellOverlapFractions(const Area& area, int rows, int cols, do
 
 // How RasterizeArea decides that a pixel is free.
 enum class RasterRule {
-  kCentre,  // the pixel centre lies in the closed area
+  kCentre,  // the pixel centre, origin + ((c + 0.5) * res, (r + 0.5) * res), lies in the area
   kInside,  // the whole closed pixel square lies in the closed area (conservative, up to
             // 1e-9 of a pixel), for obstacle checks
 };

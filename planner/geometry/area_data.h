@@ -9,10 +9,6 @@
 #ifndef COVPLAN_PLANNER_GEOMETRY_AREA_DATA_H_
 #define COVPLAN_PLANNER_GEOMETRY_AREA_DATA_H_
 
-#include <cstdint>
-#include <utility>
-#include <vector>
-
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/box.hpp>
 #include <boost/geometry/geometries/multi_polygon.hpp>
@@ -20,6 +16,9 @@
 #include <boost/geometry/geometries/polygon.hpp>
 #include <boost/geometry/geometries/segment.hpp>
 #include <boost/geometry/index/rtree.hpp>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "planner/grid/occupancy_map.h"
 
@@ -53,10 +52,19 @@ struct Edge {
   Point2 b;
 };
 
+// An area as its outer rings minus its holes, each ring a polygon of its own (counter-
+// clockwise, no holes). Boost 1.74's overlay is most reliable for a box against one simple
+// ring; rings that touch each other at a point are a case it gets wrong.
+struct RingPieces {
+  BMultiPolygon plus;
+  BMultiPolygon minus;
+};
+
 struct AreaData {
-  BMultiPolygon shape;       // valid, normalised (see Area::CanonicalText)
-  std::vector<Edge> edges;   // every boundary edge of every ring
-  SegmentTree edge_tree;     // envelopes of `edges`, value = index into edges
+  BMultiPolygon shape;      // valid, normalised (see Area::CanonicalText)
+  RingPieces rings;         // the rings of `shape`
+  std::vector<Edge> edges;  // every boundary edge of every ring
+  SegmentTree edge_tree;    // envelopes of `edges`, value = index into edges
   Point2 min_corner;
   Point2 max_corner;
   double area_m2 = 0.0;

@@ -14,20 +14,15 @@ namespace covplan {
 namespace {
 
 using geometry_internal::AreaData;
-using geometry_internal::BBox;
-using geometry_internal::BMultiPolygon;
-using geometry_internal::BoxIndex;
-using geometry_internal::BoxPolygon;
 using geometry_internal::ClipBoxM2;
+using geometry_internal::ClipToBox;
 using geometry_internal::EdgeEntersBox;
 using geometry_internal::EdgeNear;
-using geometry_internal::BPoint;
-using geometry_internal::BSegment;
 using geometry_internal::GridFrame;
 using geometry_internal::GridScanner;
+using geometry_internal::RingPieces;
 using geometry_internal::ToBoost;
 namespace bg = geometry_internal::bg;
-namespace bgi = geometry_internal::bgi;
 
 bool Finite(Point2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
@@ -58,11 +53,12 @@ bool CentreFree(const AreaData& d, const GridScanner& scan, Point2 p, double tol
 
 // The closed square lies in the closed area.
 bool SquareFree(const AreaData& d, const GridScanner& scan, double x0, double y0, double side) {
-  return !EdgeEntersBox(d, x0, y0, x0 + side, y0 + side) && scan.InsideAtCentreLine(x0 + 0.5 * side);
+  return !EdgeEntersBox(d, x0, y0, x0 + side, y0 + side) &&
+         scan.InsideAtCentreLine(x0 + 0.5 * side);
 }
 
-// Columns per clipped piece of a row: pieces only pay off when the area has many edges.
-int BlockColumns(const AreaData& d) { return d.edges.size() > 256 ? 16 : INT_MAX / 2; }
+// Columns per clipped piece of a row.
+constexpr int kBlockColumns = 16;
 
 }  // namespace
 
@@ -76,20 +72,22 @@ std::vector<float> CellOverlapFractions(const Area& area, int rows, int cols, do
   GridScanner scan(d, frame);
   RunClassifier runs(scan);
   const double cell_area = cell * cell;
-  // Boundary cells are clipped against a piece of the area cut to their row and block of
-  // columns, so that no clip sees more than the local boundary. The pieces reach half a cell
-  // beyond the cells: Boost 1.74 moves the points it creates on a cut line by up to ~1e-7 of
-  // the extent, and a cut line on a cell edge would leave slivers that its overlay misjudges.
-  const double margin = 0.5 * cell;
-  const int block = BlockColumns(d);
+  // Boundary cells are clipped against a piece of the area cut to their row and a block of
+  // columns: no clip sees more than the local boundary, and Boost's snapping grid (1e-7 of the
+  // extent of each overlay's inputs, see AreaLimits) is that of the block, not of the area.
+  // The pieces reach beyond the cells by a margin larger than the snapping of the cuts, so
+  // that no snapped cut point lands in a cell.
+  const double area_extent =
+      std::max(d.max_corner.x - d.min_corner.x, d.max_corner.y - d.min_corner.y);
+  const double margin = std::max(0.5 * cell, 1e-5 * area_extent);
   for (int r = scan.row_begin(); r < scan.row_end(); ++r) {
     scan.LoadRow(r);
     runs.StartRow();
     float* row = out.data() + static_cast<size_t>(r) * cols;
     const double y0 = frame.Y(r) - margin, y1 = frame.Y(r + 1) + margin;
-    BMultiPolygon strip;
+    RingPieces strip;
     bool have_strip = false;
-    BMultiPolygon piece;
+    RingPieces piece;
     int piece_end = scan.col_begin();  // columns [.., piece_end) are covered by `piece`
     for (int c = scan.col_begin(); c < scan.col_end(); ++c) {
       const double cx = origin.x + (c + 0.5) * cell;
@@ -104,20 +102,18 @@ std::vector<float> CellOverlapFractions(const Area& area, int rows, int cols, do
         row[c] = inside(Point2{cx, 0}) ? 1.0f : 0.0f;
         continue;
       }
-      if (!have_strip) {
-        bg::intersection(BoxPolygon(frame.X(scan.col_begin()) - margin, y0,
-                                    frame.X(scan.col_end()) + margin, y1),
-                         d.shape, strip);
-        have_strip = true;
-      }
       if (c >= piece_end) {
-        piece_end = std::min(c + block, scan.col_end());
-        piece.clear();
-        bg::intersection(BoxPolygon(frame.X(c) - margin, y0, frame.X(piece_end) + margin, y1),
-                         strip, piece);
+        piece_end = std::min(c + kBlockColumns, scan.col_end());
+        if (piece_end < scan.col_end() && !have_strip) {
+          strip = ClipToBox(d.rings, frame.X(scan.col_begin()) - margin, y0,
+                            frame.X(scan.col_end()) + margin, y1);
+          have_strip = true;
+        }
+        piece = ClipToBox(have_strip ? strip : d.rings, frame.X(c) - margin, y0,
+                          frame.X(piece_end) + margin, y1);
       }
-      const double a = ClipBoxM2(d, piece, frame.X(c), frame.Y(r), frame.X(c + 1), frame.Y(r + 1),
-                                 inside);
+      const double a =
+          ClipBoxM2(d, piece, frame.X(c), frame.Y(r), frame.X(c + 1), frame.Y(r + 1), inside);
       const double fraction = std::clamp(a / cell_area, 0.0, 1.0);
       row[c] = fraction >= 0 ? static_cast<float>(fraction) : 0.0f;  // NaN: cell_area underflow
     }
@@ -140,19 +136,18 @@ absl::StatusOr<OccupancyMap> RasterizeArea(const Area& area, double resolution, 
   double height = std::max(1.0, std::ceil(d.max_corner.y / resolution) - row0);
   if (origin.x + width * resolution < d.max_corner.x) width += 1;
   if (origin.y + height * resolution < d.max_corner.y) height += 1;
-  if (!(width * height <= static_cast<double>(max_pixels)) || width > INT_MAX ||
-      height > INT_MAX) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "a %.0f x %.0f image at %g m/px exceeds the limit of %d pixels", width, height,
-        resolution, max_pixels));
+  if (!(width * height <= static_cast<double>(max_pixels)) || width > INT_MAX || height > INT_MAX) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("a %.0f x %.0f image at %g m/px exceeds the limit of %d pixels", width,
+                        height, resolution, max_pixels));
   }
   OccupancyMap map(static_cast<int>(width), static_cast<int>(height), resolution, origin);
   const GridFrame frame{map.height(), map.width(), resolution, origin};
   GridScanner scan(d, frame);
   RunClassifier runs(scan);
-  const double tol = 1e-9 * resolution +
-                     1e-12 * std::max({std::abs(d.min_corner.x), std::abs(d.min_corner.y),
-                                       std::abs(d.max_corner.x), std::abs(d.max_corner.y)});
+  const double tol =
+      1e-9 * resolution + 1e-12 * std::max({std::abs(d.min_corner.x), std::abs(d.min_corner.y),
+                                            std::abs(d.max_corner.x), std::abs(d.max_corner.y)});
   for (int r = 0; r < map.height(); ++r) {
     const bool scanned = r >= scan.row_begin() && r < scan.row_end();
     if (scanned) {

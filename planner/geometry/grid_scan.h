@@ -58,13 +58,13 @@ class GridScanner {
   const AreaData& data_;
   GridFrame frame_;
   int row_begin_ = 0, row_end_ = 0, col_begin_ = 0, col_end_ = 0;
-  double slack_ = 0.0;                                // widening of each edge's footprint
-  std::vector<std::vector<uint32_t>> row_edges_;      // per row in [row_begin, row_end)
+  double slack_ = 0.0;                            // widening of each edge's footprint
+  std::vector<std::vector<uint32_t>> row_edges_;  // per row in [row_begin, row_end)
   int row_ = 0;
   double centre_y_ = 0.0;
-  std::vector<uint8_t> boundary_;                     // per col in [col_begin, col_end)
-  std::vector<int> marked_;                           // cols set in boundary_
-  std::vector<double> crossings_;                     // sorted x on the centre line
+  std::vector<uint8_t> boundary_;  // per col in [col_begin, col_end)
+  std::vector<int> marked_;        // cols set in boundary_
+  std::vector<double> crossings_;  // sorted x on the centre line
 };
 
 }  // namespace covplan::geometry_internal

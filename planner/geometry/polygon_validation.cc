@@ -104,8 +104,8 @@ absl::Status CheckRing(const std::vector<Point2>& ring, const std::string& name)
   std::sort(distinct.begin(), distinct.end());
   const size_t num_distinct = std::unique(distinct.begin(), distinct.end()) - distinct.begin();
   if (num_distinct < 3) {
-    return RingError(name, absl::StrFormat("ring has %d distinct points; at least 3 are needed",
-                                           num_distinct));
+    return RingError(
+        name, absl::StrFormat("ring has %d distinct points; at least 3 are needed", num_distinct));
   }
   if (Collinear(ring)) return RingError(name, "ring has zero area (all points on one line)");
   if (std::optional<std::string> crossing = FindSelfIntersection(ring)) {
@@ -143,9 +143,9 @@ absl::Status CheckHoles(const BPolygon& polygon, const std::string& name) {
     boxes.emplace_back(bg::return_envelope<BBox>(holes.back()), static_cast<uint32_t>(h));
     if (!bg::covered_by(holes.back(), outer)) {
       const bool interiors_meet = bg::relate(holes.back(), outer, bg::de9im::mask("T********"));
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "%s.holes[%d]: hole lies %soutside its outer ring", name, h,
-          interiors_meet ? "partly " : ""));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("%s.holes[%d]: hole lies %soutside its outer ring", name, h,
+                          interiors_meet ? "partly " : ""));
     }
   }
   const SegmentTree tree(boxes.begin(), boxes.end());
@@ -189,6 +189,24 @@ absl::StatusOr<std::vector<BPolygon>> ValidatePolygons(const std::vector<Polygon
   if (total > limits.max_vertices) {
     return absl::InvalidArgumentError(absl::StrFormat("%s: %d vertices exceed the limit of %d",
                                                       field, total, limits.max_vertices));
+  }
+  double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
+  auto extend = [&](const std::vector<Point2>& ring) {
+    for (const Point2& p : ring) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;  // reported with its ring
+      lo_x = std::min(lo_x, p.x), hi_x = std::max(hi_x, p.x);
+      lo_y = std::min(lo_y, p.y), hi_y = std::max(hi_y, p.y);
+    }
+  };
+  for (const PolygonInput& p : polygons) {
+    extend(p.outer);
+    for (const auto& hole : p.holes) extend(hole);
+  }
+  const double extent = std::max(hi_x - lo_x, hi_y - lo_y);
+  if (extent > limits.max_extent_m) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s: the polygons span %g m, more than the limit of %g m", field, extent,
+                        limits.max_extent_m));
   }
   std::vector<BPolygon> out;
   out.reserve(polygons.size());

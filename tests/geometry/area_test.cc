@@ -59,10 +59,9 @@ TEST(AreaValidationTest, NonFiniteCoordinate) {
 
 TEST(AreaValidationTest, SelfIntersectionNamesPointAndEdges) {
   const Ring bad = {{0, 0}, {4, 0}, {4, 2}, {1, 2}, {1, 5}, {3, 4}, {0, 0}};
-  ExpectInvalid({{Box(10, 0, 11, 1), {}}, {Box(12, 0, 13, 1), {}}, {Box(14, 0, 15, 1), {}},
-                 {bad, {}}},
-                "map.polygons",
-                "map.polygons[3].outer: ring intersects itself at (1.5, 2) (edges 2 and 5)");
+  ExpectInvalid(
+      {{Box(10, 0, 11, 1), {}}, {Box(12, 0, 13, 1), {}}, {Box(14, 0, 15, 1), {}}, {bad, {}}},
+      "map.polygons", "map.polygons[3].outer: ring intersects itself at (1.5, 2) (edges 2 and 5)");
   // A ring touching itself at a vertex (figure eight) and a spike are not simple either.
   ExpectInvalid({{{{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 1}, {0, 0}}, {}}}, "a",
                 "a[0].outer: ring intersects itself at (1, 1) (edges 1 and 4)");
@@ -71,8 +70,8 @@ TEST(AreaValidationTest, SelfIntersectionNamesPointAndEdges) {
   ExpectInvalid({{{{0, 0}, {2, 0}, {2, 2}, {1, 2}, {1, 3}, {1, 2.5}, {0, 2}, {0, 0}}, {}}}, "a",
                 "a[0].outer: ring intersects itself at (1, 2.5) (edges 3 and 4)");
   // Repeated points are not edges.
-  EXPECT_TRUE(Area::Create({{{{0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}, {0, 0}}, {}}}, "a")
-                  .ok());
+  EXPECT_TRUE(
+      Area::Create({{{{0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}, {0, 0}}, {}}}, "a").ok());
 }
 
 TEST(AreaValidationTest, ZeroArea) {
@@ -100,6 +99,23 @@ TEST(AreaValidationTest, VertexLimit) {
   EXPECT_TRUE(Area::Create({{Box(0, 0, 1, 1), {}}, {Box(2, 0, 3, 1), {}}}, "r", limits).ok());
   ExpectInvalid({{Box(0, 0, 1, 1), {Box(0.2, 0.2, 0.5, 0.5)}}, {Box(2, 0, 3, 1), {}}}, "r",
                 "r: 15 vertices exceed the limit of 10", limits);
+}
+
+// Found by fuzz/geojson_fuzzer: Boost's union cannot resolve 1 m features 1.9e9 m apart.
+TEST(AreaValidationTest, TooFineForExtent) {
+  const std::vector<PolygonInput> far = {{{{0, 0}, {1, 0}, {5, 4}, {0, 0}}, {}},
+                                         {{{1, 1}, {3, 2}, {2, 4}, {1888888888, 3}, {1, 1}}, {}}};
+  ExpectInvalid(far, "z", "z: the polygons span 1.88889e+09 m, more than the limit of 1e+06 m");
+  AreaLimits unlimited;
+  unlimited.max_extent_m = 1e10;
+  ExpectInvalid(far, "z", "z[0] and 1 other polygon(s) overlapping it: too fine for their extent",
+                unlimited);
+  ExpectInvalid({{{{0, 0}, {1, 0}, {2, 2}, {0, 2}, {0, 0}}, {}},
+                 {{{1, 1}, {3, 1}, {388888, 3}, {1, 1}}, {}}},
+                "z", "z[0] and 1 other polygon(s) overlapping it: too fine for their extent");
+  // Far apart but not overlapping: nothing to union, nothing lost.
+  Area apart = MustCreate({{Box(0, 0, 1, 1), {}}, {Box(9e5, 0, 9e5 + 1, 1), {}}});
+  EXPECT_NEAR(apart.AreaM2(), 2.0, 1e-6);
 }
 
 TEST(AreaTest, EmptyInputGivesEmptyArea) {
@@ -154,14 +170,14 @@ TEST(AreaTest, HoleReducesAreaAndPointTests) {
 
 TEST(AreaTest, SegmentLengthInInterior) {
   Area sq = MustCreate({{Box(0, 0, 4, 4), {}}});
-  EXPECT_NEAR(sq.SegmentLengthInInterior({-1, 1}, {5, 1}), 4.0, 1e-12);     // crossing
-  EXPECT_NEAR(sq.SegmentLengthInInterior({-1, 3}, {1, 5}), 0.0, 1e-9);      // touches corner
-  EXPECT_NEAR(sq.SegmentLengthInInterior({-1, 0}, {5, 0}), 0.0, 1e-9);      // along an edge
+  EXPECT_NEAR(sq.SegmentLengthInInterior({-1, 1}, {5, 1}), 4.0, 1e-12);  // crossing
+  EXPECT_NEAR(sq.SegmentLengthInInterior({-1, 3}, {1, 5}), 0.0, 1e-9);   // touches corner
+  EXPECT_NEAR(sq.SegmentLengthInInterior({-1, 0}, {5, 0}), 0.0, 1e-9);   // along an edge
   EXPECT_NEAR(sq.SegmentLengthInInterior({4, 1}, {4, 3}), 0.0, 1e-9);
   EXPECT_NEAR(sq.SegmentLengthInInterior({1, 1}, {3, 2}), std::sqrt(5.0), 1e-12);  // inside
   EXPECT_NEAR(sq.SegmentLengthInInterior({0, 0}, {4, 4}), std::sqrt(32.0), 1e-12);
   Area holed = MustCreate({{Box(0, 0, 4, 4), {Box(1, 1, 3, 3)}}});
-  EXPECT_NEAR(holed.SegmentLengthInInterior({-1, 2}, {5, 2}), 2.0, 1e-12);   // through hole
+  EXPECT_NEAR(holed.SegmentLengthInInterior({-1, 2}, {5, 2}), 2.0, 1e-12);     // through hole
   EXPECT_NEAR(holed.SegmentLengthInInterior({1, 0.5}, {1, 3.5}), 1.0, 1e-12);  // along hole side
   Area ell = MustCreate({{{{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}, {0, 0}}, {}}});
   EXPECT_NEAR(ell.SegmentLengthInInterior({-1, 1}, {3, 1}), 1.0, 1e-12);  // then along an edge
@@ -303,18 +319,41 @@ TEST(CellOverlapFractionsTest, GridAlignedEdgesAndOutsideGrid) {
   EXPECT_TRUE(CellOverlapFractions(a, 0, 5, 1.0, {0, 0}).empty());
 }
 
-// Found by fuzz/geojson_fuzzer: edge (6,0)-(3,3) passes through cell corners, where Boost
-// 1.74's overlay returned whole cells.
-TEST(CellOverlapFractionsTest, EdgeThroughCellCorners) {
+// Found by fuzz/geojson_fuzzer, all wrong in Boost 1.74's overlay: an edge through cell
+// corners (whole cells returned), polygons touching at a cell corner (seen as crossing), and
+// a hole touching its outer ring on a cell side.
+TEST(CellOverlapFractionsTest, FuzzFoundDegenerateCells) {
   Area a = MustCreate({{{{0, 0}, {2, 0}, {3, 2}, {0, 2}, {0, 0}}, {}},
                        {{{1, 1}, {6, 0}, {3, 3}, {0, 3}, {1, 1}}, {}}});
   const double cell = 6.0 / 14;
-  const std::vector<float> f = CellOverlapFractions(a, 16, 16, cell, {-cell, -cell});
+  std::vector<float> f = CellOverlapFractions(a, 16, 16, cell, {-cell, -cell});
   double total = 0.0;
   for (float v : f) total += v * cell * cell;
   EXPECT_NEAR(total, a.AreaM2(), 1e-5);
   EXPECT_EQ(f[4 * 16 + 12], 0.0f);
   EXPECT_EQ(f[5 * 16 + 11], 0.0f);
+  Area touching = MustCreate(
+      {{{{0, 0}, {2, 0}, {0, 2}, {0, 0}}, {}}, {{{1, 1}, {7, 2}, {6, 3}, {1, 3}, {1, 1}}, {}}});
+  ASSERT_EQ(touching.ToPolygons().size(), 2u);
+  f = CellOverlapFractions(touching, 16, 16, 0.5, {-0.5, -0.5});
+  EXPECT_NEAR(f[3 * 16 + 2], 0.5, 1e-5);
+  EXPECT_NEAR(f[3 * 16 + 3], 11.0 / 12, 1e-5);
+  EXPECT_NEAR(touching.BoxOverlapM2(0.5, 1, 1, 1.5), 0.125, 1e-6);
+  Area hole = MustCreate(
+      {{{{0, 0}, {5, 0}, {4, 4}, {0, 43}, {0, 0}}, {{{1, 1}, {0, 2}, {4, 2}, {2, 1}, {1, 1}}}}});
+  const double c = 43.0 / 14;
+  f = CellOverlapFractions(hole, 16, 16, c, {-c, -c});
+  EXPECT_NEAR(f[1 * 16 + 1], ReferenceBoxArea(hole, 0, 0, c, c) / (c * c), 1e-5);
+  total = 0.0;
+  for (float v : f) total += v * c * c;
+  EXPECT_NEAR(total, hole.AreaM2(), 1e-4);
+  // A hole edge through a cell corner: Boost clipped the hole to the whole cell.
+  Area corner = MustCreate(
+      {{{{0, 0}, {8, 0}, {4, 4}, {0, 20}, {0, 0}}, {{{1, 1}, {5, 0}, {2, 4}, {3, 2}, {1, 1}}}}});
+  const double k = 20.0 / 14;
+  f = CellOverlapFractions(corner, 16, 16, k, {-k, -k});
+  EXPECT_NEAR(f[3 * 16 + 3], ReferenceBoxArea(corner, 2 * k, 2 * k, 3 * k, 3 * k) / (k * k), 1e-5);
+  EXPECT_NEAR(corner.BoxOverlapM2(2 * k, 2 * k, 3 * k, 3 * k) / (k * k), f[3 * 16 + 3], 1e-5);
 }
 
 // Areas with many edges are clipped in blocks of columns; compare a band of cells.
@@ -365,7 +404,8 @@ TEST(RasterizeAreaTest, CentreAndInsideRulesMatchPointTests) {
         ASSERT_EQ(centre->IsFree(r, c), area.Contains(mid)) << r << "," << c;
         EXPECT_NE(centre->at(r, c), CellState::kUnknown);
         const double x0 = o.x + c * res, y0 = o.y + r * res;
-        const bool covered = area.BoxOverlapM2(x0, y0, x0 + res, y0 + res) >= res * res * (1 - 1e-9);
+        const bool covered =
+            area.BoxOverlapM2(x0, y0, x0 + res, y0 + res) >= res * res * (1 - 1e-9);
         ASSERT_EQ(inside->IsFree(r, c), covered) << r << "," << c;
         if (inside->IsFree(r, c)) {
           EXPECT_TRUE(area.Contains({x0, y0}) && area.Contains({x0 + res, y0 + res}));

@@ -47,8 +47,9 @@ TEST(GeoJsonTest, PolygonWithHoleAndThirdCoordinate) {
 }
 
 TEST(GeoJsonTest, MultiPolygonGeometryCollectionAndFeatures) {
-  const std::string multi = R"({"type":"MultiPolygon","coordinates":[[[[10,0],[11,0],[11,1],[10,0]]],)"
-                            R"([[[20,0],[21,0],[21,1],[20,0]]]]})";
+  const std::string multi =
+      R"({"type":"MultiPolygon","coordinates":[[[[10,0],[11,0],[11,1],[10,0]]],)"
+      R"([[[20,0],[21,0],[21,1],[20,0]]]]})";
   EXPECT_EQ(MustParse(multi).size(), 2u);
   const std::string collection =
       R"({"type":"GeometryCollection","geometries":[)" + Polygon(kSquare) + "," + multi + "]}";
@@ -57,8 +58,8 @@ TEST(GeoJsonTest, MultiPolygonGeometryCollectionAndFeatures) {
   EXPECT_EQ(c[0].outer[1].x, 4.0);
   EXPECT_EQ(c[1].outer[0].x, 10.0);
   EXPECT_EQ(c[2].outer[0].x, 20.0);
-  const std::string feature = R"({"type":"Feature","properties":{"name":"a"},"geometry":)" +
-                              collection + "}";
+  const std::string feature =
+      R"({"type":"Feature","properties":{"name":"a"},"geometry":)" + collection + "}";
   EXPECT_EQ(MustParse(feature).size(), 3u);
   const std::string features = R"({"type":"FeatureCollection","features":[)"
                                R"({"type":"Feature","geometry":null,"properties":{}},)" +
@@ -83,8 +84,8 @@ TEST(GeoJsonTest, BadPositionsNamePath) {
   const std::string bad_feature =
       R"({"type":"Feature","geometry":{"type":"Polygon","coordinates":[)"
       R"([[0,0],[4,0],[4,4],[0,4],[2,2],[1],[0,0]]]}})";
-  ExpectError(R"({"type":"FeatureCollection","features":[)" + ok_feature + "," + ok_feature +
-                  "," + bad_feature + "]}",
+  ExpectError(R"({"type":"FeatureCollection","features":[)" + ok_feature + "," + ok_feature + "," +
+                  bad_feature + "]}",
               "site.geojson: features[2].geometry.coordinates[0][5]: expected a position [x, y] "
               "of numbers");
   ExpectError(Polygon(R"([[0,0],["1",0],[0,0]])"), "site.geojson: coordinates[0][1]: expected a");
@@ -136,7 +137,8 @@ TEST(GeoJsonTest, InvalidJsonTooLargeNothingFound) {
   std::string deep = Polygon(kSquare);
   for (int i = 0; i < 9; ++i) deep = R"({"type":"GeometryCollection","geometries":[)" + deep + "]}";
   ExpectError(deep, "geometries[0]: GeometryCollections nested too deeply");
-  for (int i = 0; i < 30; ++i) deep = R"({"type":"GeometryCollection","geometries":[)" + deep + "]}";
+  for (int i = 0; i < 30; ++i)
+    deep = R"({"type":"GeometryCollection","geometries":[)" + deep + "]}";
   ExpectError(deep, "site.geojson: not valid JSON: ");  // protobuf's own depth limit
 }
 
