@@ -309,21 +309,29 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
 
   out.plan.planner = "oarp-replan";
   out.plan.grid = c.drive;
-  // GREEDY_DETOUR over everything: the answer whenever nothing better is ready.
+  // GREEDY_DETOUR over everything, computed first (it is cheap): the answer
+  // whenever nothing better is ready in time.
+  const Walk whole = GreedyWalk(drive, c.legs, c.at.at, c.at.heading, -1);
+  st.num_encounters = whole.encounters;
   auto greedy = [&]() {
-    const Walk walk = GreedyWalk(drive, c.legs, c.at.at, c.at.heading, -1);
-    out.plan.path = walk.path;
-    out.plan.sweeps = walk.sweeps;
-    st.num_encounters = walk.encounters;
+    out.plan.path = whole.path;
+    out.plan.sweeps = whole.sweeps;
     st.greedy_detours.clear();
-    for (int k = 0; k < walk.encounters; ++k) st.greedy_detours.push_back(k);
+    for (int k = 0; k < whole.encounters; ++k) st.greedy_detours.push_back(k);
     st.replanned_encounter = -1;
+    st.time_to_encounter_s = 0.0;
+    st.rank_budget = -1;
+    st.new_ranks = st.kept_ranks = st.kept_path_pieces = 0;
+    st.kept_path_m = 0.0;
     st.method = ReplanMethodName(ReplanMethod::kGreedyDetour);
     out.plan.termination = Termination::Converged("greedy detour: no search");
     out.plan.detail = old.plan.detail;  // whole coverage legs keep their rank tags
   };
-  const Walk whole = GreedyWalk(drive, c.legs, c.at.at, c.at.heading, -1);
-  st.num_encounters = whole.encounters;
+  // The call's own deadline, less the time kept for building the reply.
+  const StopToken call_stop =
+      options.stop.has_deadline()
+          ? options.stop.WithEarlierDeadline(options.stop.deadline() - absl::Seconds(options.safety_margin_s))
+          : options.stop;
 
   if (options.method == ReplanMethod::kGreedyDetour || whole.encounters == 0) {
     greedy();
@@ -335,8 +343,12 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
     const absl::Time t0 = absl::Now();
     std::vector<Rank> ranks;
     if (st.remaining_cells > 0) {
-      ASSIGN_OR_RETURN(RankPartition p, MinCutPartitioner().Partition(w, options.stop));
-      ranks = std::move(p.ranks);
+      absl::StatusOr<RankPartition> p = MinCutPartitioner().Partition(w, call_stop);
+      if (!p.ok() && !absl::IsDeadlineExceeded(p.status()) && !absl::IsCancelled(p.status())) {
+        return p.status();
+      }
+      if (p.ok()) ranks = std::move(p->ranks);
+      if (!p.ok()) ranks.clear();
     }
     st.rank_replan_ms = MsSince(t0);
     st.new_ranks = static_cast<int64_t>(ranks.size());
@@ -351,8 +363,10 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
     detail->ranks = ranks;
     out.plan.detail = detail;
     const std::vector<bool> all_new(ranks.size(), true);
-    ASSIGN_OR_RETURN(bool done, TourReplan(c, at_robot, ranks, all_new, options, options.stop,
-                                           30.0, &out));
+    bool done = false;
+    if (!call_stop.ShouldStop() && !(ranks.empty() && st.remaining_cells > 0)) {
+      ASSIGN_OR_RETURN(done, TourReplan(c, at_robot, ranks, all_new, options, call_stop, 30.0, &out));
+    }
     if (!done) greedy();
   } else {
     // Algorithm 1: encounters in path order, each with the budget its
@@ -362,7 +376,7 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
       const Walk prefix = GreedyWalk(drive, c.legs, c.at.at, c.at.heading, k);
       const double tau = PathTime(prefix.path, c.robot);
       const double budget_s = tau - options.safety_margin_s - absl::ToDoubleSeconds(absl::Now() - start);
-      const StopToken stop = options.stop.WithEarlierDeadline(absl::Now() + absl::Seconds(std::max(0.0, budget_s)));
+      const StopToken stop = call_stop.WithEarlierDeadline(absl::Now() + absl::Seconds(std::max(0.0, budget_s)));
       const int64_t m_bar = estimator != nullptr ? estimator->Budget(0.7 * budget_s) : -1;
       if (budget_s <= 0 || m_bar < 0 || stop.ShouldStop()) {
         st.greedy_detours.push_back(k);
