@@ -95,11 +95,16 @@ absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& inline
         g.rows(), g.cols(), g.cell_size(), drive.rows(), drive.cols(), drive.cell_size()));
   }
   // The inline plan's grid may have lost cells to earlier replans: keep the
-  // area's barriers and obstacle pixels, with the plan's free cells.
-  std::vector<uint8_t> free = drive.free_flags(), cover = area->cover->free_flags();
-  for (size_t i = 0; i < free.size(); ++i) {
-    free[i] = free[i] && g.free_flags()[i];
-    cover[i] = cover[i] && free[i];
+  // area's barriers and obstacle pixels, with the plan's free cells. What it
+  // still has to cover is what its sweeps cover (a replanned plan covers only
+  // the remainder of its mission).
+  std::vector<uint8_t> free = drive.free_flags(), cover(free.size(), 0);
+  for (size_t i = 0; i < free.size(); ++i) free[i] = free[i] && g.free_flags()[i];
+  for (const CoverageSweep& s : plan.sweeps) {
+    for (const CellIndex& c : s.cells) {
+      const int64_t i = drive.Index(c.row, c.col);
+      cover[i] = area->cover->free_flags()[i] && free[i];
+    }
   }
   auto derived = std::make_shared<CoverageArea>(*area);
   derived->drive = std::make_shared<const Grid>(drive.WithFreeFlags(std::move(free)));

@@ -2,6 +2,7 @@
 //
 //   covplan plan --map FILE [--resolution M] [--tool-width M] [--local | --server HOST:PORT]
 //                [--out plan.json] [--svg plan.svg] ...
+//   covplan replan --server HOST:PORT --plan-id P --waypoint K --at X,Y --obstacle "x,y ..."
 //   covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S] [--deadline-ms D]
 //   covplan gtsp ...
 //
@@ -13,6 +14,7 @@
 #include "client/gtsp_command.h"
 #include "client/load_command.h"
 #include "client/plan_command.h"
+#include "client/replan_command.h"
 
 namespace {
 
@@ -20,6 +22,7 @@ constexpr char kUsage[] =
     "usage: covplan <command> [flags]\n"
     "commands:\n"
     "  plan   plan a coverage path (--local or through a server); writes plan.json / SVG\n"
+    "  replan report new obstacles for a retained plan; get the replanned remainder\n"
     "  load   load-test a server's Plan method; prints one JSON object\n"
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
     "Run 'covplan <command> --help' for its flags.\n";
@@ -34,6 +37,7 @@ int main(int argc, char** argv) {
   const std::string command = argv[1];
   const std::vector<std::string> args(argv + 2, argv + argc);
   if (command == "plan") return covplan::RunPlanCommand(args);
+  if (command == "replan") return covplan::RunReplanCommand(args);
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {

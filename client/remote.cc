@@ -53,4 +53,15 @@ absl::StatusOr<v1::PlanResponse> RemotePlanner::Plan(const v1::PlanRequest& requ
   return response;
 }
 
+absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest& request,
+                                                         std::optional<absl::Duration> timeout) {
+  grpc::ClientContext context;
+  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
+  v1::ReplanResponse response;
+  if (absl::Status s = FromGrpc(impl_->stub->Replan(&context, request, &response)); !s.ok()) {
+    return s;
+  }
+  return response;
+}
+
 }  // namespace covplan

@@ -30,6 +30,8 @@ class RemotePlanner {
   // No timeout: the call has no deadline (the server's default budget applies).
   absl::StatusOr<v1::PlanResponse> Plan(const v1::PlanRequest& request,
                                         std::optional<absl::Duration> timeout);
+  absl::StatusOr<v1::ReplanResponse> Replan(const v1::ReplanRequest& request,
+                                            std::optional<absl::Duration> timeout);
 
  private:
   struct Impl;

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -242,6 +243,52 @@ absl::StatusOr<std::string> MapStore::GetState(const std::string& name) const {
   std::ostringstream buffer;
   buffer << in.rdbuf();
   return buffer.str();
+}
+
+namespace {
+bool IsPlanId(const std::string& id) {
+  if (id.empty() || id.size() > 64) return false;
+  for (char c : id) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
+  }
+  return true;
+}
+}  // namespace
+
+absl::Status MapStore::PutPlan(const std::string& plan_id, absl::string_view contents) {
+  if (!IsPlanId(plan_id)) return absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id));
+  const std::string dir = dir_ + "/plans";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", ec.message()));
+  return AtomicWrite(dir, dir + "/" + plan_id + ".plan", contents);
+}
+
+absl::StatusOr<std::string> MapStore::GetPlan(const std::string& plan_id) const {
+  if (!IsPlanId(plan_id)) return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
+  std::ifstream in(dir_ + "/plans/" + plan_id + ".plan", std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+int64_t MapStore::TrimPlans(int64_t keep) {
+  std::error_code ec;
+  std::vector<std::pair<std::filesystem::file_time_type, std::filesystem::path>> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_ + "/plans", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp.") != std::string::npos) {  // a write that a crash interrupted
+      std::filesystem::remove(entry.path(), ec);
+      continue;
+    }
+    files.emplace_back(entry.last_write_time(ec), entry.path());
+  }
+  if (static_cast<int64_t>(files.size()) <= keep) return 0;
+  std::sort(files.begin(), files.end());
+  int64_t removed = 0;
+  for (size_t i = 0; i + keep < files.size(); ++i) removed += std::filesystem::remove(files[i].second, ec);
+  return removed;
 }
 
 }  // namespace covplan

@@ -59,6 +59,13 @@ class MapStore {
   absl::Status PutState(const std::string& name, absl::string_view contents);
   absl::StatusOr<std::string> GetState(const std::string& name) const;
 
+  // Retained plans, so a mission survives a restart: one file per plan id
+  // under plans/, written atomically. `plan_id` is [a-z0-9-]{1,64}.
+  // NotFound when absent. TrimPlans keeps the newest `keep` files.
+  absl::Status PutPlan(const std::string& plan_id, absl::string_view contents);
+  absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const;
+  int64_t TrimPlans(int64_t keep);
+
  private:
   explicit MapStore(std::string dir) : dir_(std::move(dir)) {}
   std::string PathFor(const std::string& map_id) const;

@@ -102,6 +102,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
   metrics_->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
   metrics_->maps_stored().Set(static_cast<double>(store_->size()));
   // The replan estimator learned by earlier runs of this server.
+  store_->TrimPlans(options_.max_stored_plans);
   if (absl::StatusOr<std::string> saved = store_->GetState(kEstimatorFile); saved.ok()) {
     const absl::Status parsed = estimator_.Parse(*saved);
     LogLine(parsed.ok() ? "info" : "warn", "replan estimator loaded",
@@ -366,6 +367,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   retained->request = std::move(plan_request);
   retained->request.common.stop = StopToken();  // the call's token ends with the call
   RetainedPlanToProto(*retained, response);
+  if (request.map_ref_case() == v1::PlanRequest::kMapId) PersistPlan(request, *response);
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, retained->plan.stats.tour_cut_short);
   const int64_t mean = mean_solve_us_.load();
@@ -459,6 +461,41 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
 
 // ---------------------------------------------------------------- replans
 
+void CoveragePlannerService::PersistPlan(const v1::PlanRequest& origin, const v1::PlanResponse& plan) {
+  v1::InlinePlan record;
+  *record.mutable_request() = origin;
+  *record.mutable_plan() = plan;
+  std::string bytes;
+  if (!record.SerializeToString(&bytes)) return;
+  if (absl::Status s = store_->PutPlan(plan.plan_id(), bytes); !s.ok()) {
+    LogLine("warn", "plan not persisted", {{"plan", plan.plan_id()}, {"detail", std::string(s.message())}});
+    return;
+  }
+  if (persisted_.fetch_add(1) % 256 == 255) store_->TrimPlans(options_.max_stored_plans);
+}
+
+std::shared_ptr<const RetainedPlan> CoveragePlannerService::FindPlan(const std::string& plan_id,
+                                                                     v1::PlanRequest* origin) {
+  absl::StatusOr<std::string> bytes = store_->GetPlan(plan_id);
+  v1::InlinePlan record;
+  const bool stored = bytes.ok() && record.ParseFromString(*bytes);
+  if (stored) *origin = record.request();
+  if (std::shared_ptr<const RetainedPlan> in_memory = plans_.Get(plan_id)) return in_memory;
+  if (!stored || record.request().map_ref_case() != v1::PlanRequest::kMapId) return nullptr;
+  // After a restart: rebuild the plan on its stored map.
+  absl::StatusOr<RetainedPlan> rebuilt =
+      RetainedPlanFromInline(record, engine_, SourceFor(record.request().map_id(), nullptr));
+  if (!rebuilt.ok()) {
+    LogLine("warn", "stored plan could not be rebuilt",
+            {{"plan", plan_id}, {"detail", std::string(rebuilt.status().message())}});
+    return nullptr;
+  }
+  rebuilt->plan_id = plan_id;
+  auto plan = std::make_shared<const RetainedPlan>(std::move(*rebuilt));
+  plans_.Put(plan);
+  return plan;
+}
+
 absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
                                                const StopToken& cancel, v1::ReplanResponse* response) {
   const absl::Time start = absl::Now();
@@ -474,9 +511,12 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
                      ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
                      : cancel.WithEarlierDeadline(start + options_.max_request_time);
   std::shared_ptr<const RetainedPlan> old;
+  v1::PlanRequest origin;  // the Plan request the mission started with
+  bool has_origin = false;
   switch (request.plan_ref_case()) {
     case v1::ReplanRequest::kPlanId:
-      old = plans_.Get(request.plan_id());
+      old = FindPlan(request.plan_id(), &origin);
+      has_origin = old != nullptr && origin.map_ref_case() == v1::PlanRequest::kMapId;
       if (old == nullptr) {
         return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '",
                                                 request.plan_id().substr(0, 80), "'"));
@@ -498,6 +538,8 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
       ASSIGN_OR_RETURN(RetainedPlan rebuilt,
                        RetainedPlanFromInline(request.plan(), engine_, SourceFor(map_id, inline_map)));
       old = std::make_shared<const RetainedPlan>(std::move(rebuilt));
+      origin = pr;
+      has_origin = pr.map_ref_case() == v1::PlanRequest::kMapId;
       break;
     }
     default:
@@ -514,6 +556,7 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
   retained->request = old->request;
   result.plan = retained->plan;
   ReplanToProto(result, *retained, response);
+  if (has_origin) PersistPlan(origin, response->plan());
   plans_.Put(retained);
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   metrics_->RecordReplan(result.stats.method, result.stats.total_ms * 1e-3,

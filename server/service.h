@@ -57,6 +57,10 @@ struct ServiceOptions {
   absl::Duration deadline_margin = absl::Milliseconds(25);  // kept for the reply
   absl::Duration plan_ttl = absl::Minutes(10);
   size_t max_retained_plans = 256;
+  // Plans on stored maps are also written to the store (plans/), so a robot
+  // resumes its mission with its plan_id after a restart; the newest this
+  // many are kept.
+  int64_t max_stored_plans = 4096;
 
   absl::Status Validate() const;
 };
@@ -135,6 +139,11 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // it is full).
   void WarmInBackground(const MapSource& source, PlanRequest request);
   std::string NewPlanId();
+  // Writes the plan (with the original request it continues) to the store;
+  // best effort: a failure is logged and counted, the call still succeeds.
+  void PersistPlan(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
+  // A retained plan from memory, or else from the store (after a restart).
+  std::shared_ptr<const RetainedPlan> FindPlan(const std::string& plan_id, v1::PlanRequest* origin);
 
   const ServiceOptions options_;
   MapStore* const store_;
@@ -149,6 +158,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};
   std::atomic<int> admitted_{0};
+  std::atomic<uint64_t> persisted_{0};
   // Exponentially weighted mean wall time of a solve (microseconds), for the
   // deadline-aware admission: a call whose expected queue wait would leave no
   // time to plan before its deadline is refused at once.

@@ -6,9 +6,12 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "api/convert.h"
+#include "client/replan_command.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
@@ -209,6 +212,30 @@ TEST_F(ReplanServiceTest, TheEstimatorIsKeptAcrossRestarts) {
   server_.reset();
   Start();
   EXPECT_EQ(server_->service().estimator().num_samples(), samples);
+}
+
+TEST_F(ReplanServiceTest, TheReplanCommandTalksToTheServer) {
+  v1::PlanResponse plan;
+  ASSERT_TRUE(Plan(PlanRequestForOffice(), &plan).ok());
+  const v1::ReplanRequest r = RequestFor(plan);
+  const std::string out = dir_ + "/replanned.json";
+  const std::string server = absl::StrCat("127.0.0.1:", server_->port());
+  ASSERT_EQ(RunReplanCommand({"--server", server, "--plan-id", plan.plan_id(), "--waypoint",
+                              absl::StrCat(r.progress().waypoint()), "--at",
+                              absl::StrCat(r.progress().position().x(), ",", r.progress().position().y()),
+                              "--obstacle", "9,9.2 10.2,9.2 10.2,10 9,10", "--method", "ilp2", "--out", out}),
+            0);
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_THAT(ss.str(), HasSubstr("\"sweeps\""));
+  EXPECT_THAT(ss.str(), HasSubstr("\"planner\": \"oarp-replan\""));
+  // Bad flags and server errors give a non-zero exit.
+  EXPECT_NE(RunReplanCommand({"--server", server, "--plan-id", plan.plan_id()}), 0);
+  EXPECT_NE(RunReplanCommand({"--server", server, "--plan-id", "p-unknown", "--distance", "3"}), 0);
+  EXPECT_NE(RunReplanCommand({"--server", server, "--plan-id", plan.plan_id(), "--distance", "3",
+                              "--method", "magic"}),
+            0);
 }
 
 }  // namespace

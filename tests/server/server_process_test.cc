@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <thread>
+#include <set>
+#include <csignal>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -126,6 +128,51 @@ TEST_F(ServerProcessTest, MapsSurviveARestart) {
   const grpc::Status status = Plan(Request(map_id, 0.4, 0.5), &plan);
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_GT(plan.ranks_size(), 0);
+}
+
+// A server killed with SIGKILL mid-mission: after the restart the robot goes
+// on replanning with the plan_id it holds, twice over (the replanned plan is
+// persisted too).
+TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
+  StartServer();
+  const std::string map_id = PutMap(OfficeMap());
+  v1::PlanResponse plan;
+  ASSERT_TRUE(Plan(Request(map_id, 0.8, 0.5), &plan).ok());
+  auto replan = [&](const v1::PlanResponse& p, v1::ReplanResponse* out) {
+    v1::ReplanRequest r;
+    r.set_plan_id(p.plan_id());
+    const int k = p.path_size() / 5;
+    r.mutable_progress()->set_waypoint(k);
+    r.mutable_progress()->mutable_position()->set_x(p.path(k - 1).x());
+    r.mutable_progress()->mutable_position()->set_y(p.path(k - 1).y());
+    v1::Point2* obstacle = r.mutable_obstacles()->add_points();
+    obstacle->set_x(p.path(k + 3).x());
+    obstacle->set_y(p.path(k + 3).y());
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    return stub_->Replan(&context, r, out);
+  };
+  ASSERT_EQ(::kill(server_->pid(), SIGKILL), 0);
+  EXPECT_EQ(server_->Wait(absl::Seconds(10)), 128 + SIGKILL);
+  stub_.reset();
+  channel_.reset();
+  StartServer();
+  v1::ReplanResponse first;
+  grpc::Status status = replan(plan, &first);
+  ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << server_->log();
+  EXPECT_GT(first.replan().remaining_cells(), 0);
+  ASSERT_EQ(::kill(server_->pid(), SIGKILL), 0);
+  EXPECT_EQ(server_->Wait(absl::Seconds(10)), 128 + SIGKILL);
+  stub_.reset();
+  channel_.reset();
+  StartServer();
+  v1::ReplanResponse second;
+  status = replan(first.plan(), &second);
+  ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << server_->log();
+  EXPECT_LE(second.replan().remaining_cells(), first.replan().remaining_cells());
+  std::set<int> swept;
+  for (const v1::CoverageSweep& s : second.plan().sweeps()) swept.insert(s.cells().begin(), s.cells().end());
+  EXPECT_EQ(static_cast<int>(swept.size()), second.replan().remaining_cells());
 }
 
 TEST_F(ServerProcessTest, CorruptedMapFileIsReportedNotServed) {
