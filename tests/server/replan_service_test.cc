@@ -6,6 +6,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -236,6 +238,79 @@ TEST_F(ReplanServiceTest, TheReplanCommandTalksToTheServer) {
   EXPECT_NE(RunReplanCommand({"--server", server, "--plan-id", plan.plan_id(), "--distance", "3",
                               "--method", "magic"}),
             0);
+}
+
+// Hostile replans: every numeric field of progress and obstacles drawn from
+// NaN, +-inf, 0, -0, huge, tiny and plausible values. Every reply is OK with a
+// plan that sweeps what it claims, or INVALID_ARGUMENT / NOT_FOUND with a
+// message; the server keeps answering.
+TEST_F(ReplanServiceTest, RandomHostileReplansAreAnsweredNeverCrash) {
+  v1::PlanResponse plan;
+  ASSERT_TRUE(Plan(PlanRequestForOffice(), &plan).ok());
+  std::mt19937 rng(7);
+  const double nasty[] = {std::nan(""), INFINITY, -INFINITY, 0.0, -0.0, 1e300, -1e300, 1e-300, 3.0, 12.5};
+  auto pick = [&]() { return nasty[rng() % (sizeof(nasty) / sizeof(nasty[0]))]; };
+  auto plausible = [&](int k, int axis) {
+    return axis == 0 ? plan.path(k).x() : plan.path(k).y();
+  };
+  int ok = 0, invalid = 0;
+  for (int i = 0; i < 60; ++i) {
+    v1::ReplanRequest r;
+    r.set_plan_id(plan.plan_id());
+    const int k = 1 + static_cast<int>(rng() % (plan.path_size() + 3));
+    switch (rng() % 3) {
+      case 0:
+        r.mutable_progress()->set_waypoint(k);
+        r.mutable_progress()->mutable_position()->set_x(rng() % 2 ? pick() : plausible(std::min(k, plan.path_size() - 1), 0));
+        r.mutable_progress()->mutable_position()->set_y(rng() % 2 ? pick() : plausible(std::min(k, plan.path_size() - 1), 1));
+        break;
+      case 1:
+        r.mutable_progress()->set_distance_m(rng() % 2 ? pick() : 7.0 * (rng() % 50));
+        break;
+      default:
+        r.mutable_progress()->set_waypoint(static_cast<int>(rng() % 7) - 3);
+    }
+    if (rng() % 2) r.mutable_progress()->set_tolerance_m(pick());
+    for (int n = rng() % 3; n > 0; --n) {
+      v1::Point2* p = r.mutable_obstacles()->add_points();
+      p->set_x(rng() % 2 ? pick() : 1.0 * (rng() % 28));
+      p->set_y(rng() % 2 ? pick() : 1.0 * (rng() % 19));
+    }
+    for (int n = rng() % 2; n > 0; --n) {
+      v1::CellRef* c = r.mutable_obstacles()->add_cells();
+      c->set_row(static_cast<int>(rng() % 40) - 5);
+      c->set_col(static_cast<int>(rng() % 50) - 5);
+    }
+    if (rng() % 3 == 0) {
+      v1::Ring* ring = r.mutable_obstacles()->add_polygons()->mutable_outer();
+      const double x = rng() % 2 ? pick() : 1.0 * (rng() % 27), y = 1.0 * (rng() % 18);
+      for (auto [dx, dy] : {std::pair{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 0.0}}) {
+        v1::Point2* p = ring->add_points();
+        p->set_x(x + dx);
+        p->set_y(y + dy);
+      }
+    }
+    r.set_method(static_cast<v1::ReplanMethod>(rng() % 7));
+    v1::ReplanResponse out;
+    const grpc::Status status = Replan(r, &out);
+    if (status.ok()) {
+      ++ok;
+      EXPECT_EQ(Swept(out.plan()), out.replan().remaining_cells()) << i;
+      for (const v1::Waypoint& w : out.plan().path()) {
+        ASSERT_TRUE(std::isfinite(w.x()) && std::isfinite(w.y()) && std::isfinite(w.theta())) << i;
+      }
+    } else {
+      ++invalid;
+      EXPECT_THAT(status.error_code(), ::testing::AnyOf(grpc::StatusCode::INVALID_ARGUMENT,
+                                                        grpc::StatusCode::NOT_FOUND))
+          << i << ": " << status.error_message();
+      EXPECT_FALSE(status.error_message().empty());
+    }
+  }
+  EXPECT_GT(ok, 5);
+  EXPECT_GT(invalid, 5);
+  v1::ReplanResponse out;
+  ASSERT_TRUE(Replan(RequestFor(plan), &out).ok());  // still serving
 }
 
 }  // namespace
