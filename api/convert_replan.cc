@@ -72,6 +72,7 @@ void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1:
   o->set_tour_ms(s.tour_ms);
   o->set_total_ms(s.total_ms);
   o->set_complete(s.newly_unreachable_cells == 0);
+  o->set_end_moved(s.end_moved);
   for (const CellIndex& c : result.unreachable) {
     v1::CellRef* r = out->add_unreachable();
     r->set_row(c.row);

@@ -178,6 +178,26 @@ const char* ReplanMethodName(ReplanMethod m) {
 
 namespace {
 
+// Appends transitions from `from` to `to` over `drive` (false when stopped).
+absl::StatusOr<bool> AppendRoute(const Grid& drive, Point2 from, const Pose2& to, const StopToken& stop,
+                                 std::vector<Waypoint>* path) {
+  if (std::hypot(from.x - to.x, from.y - to.y) < kMinSegmentM) return true;
+  ASSIGN_OR_RETURN(CellIndex a, JoinCell(drive, Pose2{from.x, from.y, 0}, "start"));
+  ASSIGN_OR_RETURN(CellIndex b, JoinCell(drive, to, "end"));
+  AnyAngleSearch search(drive);
+  if (!search.Run(a, stop)) return false;
+  std::vector<Point2> pts;
+  for (const CellIndex& cell : search.PathTo(b)) pts.push_back(drive.CellCenter(cell));
+  pts.push_back({to.x, to.y});
+  Point2 at = from;
+  for (const Point2& p : pts) {
+    if (std::hypot(p.x - at.x, p.y - at.y) < kMinSegmentM) continue;
+    path->push_back({p.x, p.y, std::atan2(p.y - at.y, p.x - at.x), SegmentKind::kTransition, -1});
+    at = p;
+  }
+  return true;
+}
+
 // Joins the walk's prefix (robot -> tour start) and the tour path.
 void Append(const std::vector<Waypoint>& tour, const std::vector<CoverageSweep>& tour_sweeps,
             CoveragePlan* plan) {
@@ -193,21 +213,8 @@ absl::StatusOr<bool> TourReplan(const Context& c, const Walk& walk, const std::v
   std::vector<PolylineElement> elements = TourElements(c, walk, ranks, is_new, &out->stats);
   if (elements.empty()) {
     // Nothing left to cover after the prefix: drive on to the old end.
-    const Grid& drive = *c.drive;
-    absl::StatusOr<CellIndex> from = JoinCell(drive, Pose2{walk.end.x, walk.end.y, 0}, "start");
-    absl::StatusOr<CellIndex> to = JoinCell(drive, c.end, "end");
-    if (!from.ok() || !to.ok()) return from.ok() ? to.status() : from.status();
-    AnyAngleSearch search(drive);
-    if (!search.Run(*from, stop)) return false;
-    std::vector<Point2> pts = {walk.end};
-    for (const CellIndex& cell : search.PathTo(*to)) pts.push_back(drive.CellCenter(cell));
-    pts.push_back({c.end.x, c.end.y});
-    Point2 at = walk.end;
-    for (const Point2& p : pts) {
-      if (std::hypot(p.x - at.x, p.y - at.y) < kMinSegmentM) continue;
-      out->plan.path.push_back({p.x, p.y, std::atan2(p.y - at.y, p.x - at.x), SegmentKind::kTransition, -1});
-      at = p;
-    }
+    ASSIGN_OR_RETURN(bool routed, AppendRoute(*c.drive, walk.end, c.end, stop, &out->plan.path));
+    if (!routed) return false;
     out->plan.termination = Termination::Converged("nothing left to cover: drive to the end");
     return true;
   }
@@ -285,6 +292,20 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   }
   c.drive = std::make_shared<const Grid>(old_drive.WithFreeFlags(free));
   const Grid& drive = *c.drive;
+  const CellIndex end_cell = drive.CellAt({c.end.x, c.end.y});
+  const bool end_newly_closed = old_drive.IsFree(end_cell) && !drive.IsFree(end_cell);
+  if (end_newly_closed || !JoinCell(drive, c.end, "end").ok()) {
+    // The old end (a dock) is blocked or cut off by the new obstacles: end at
+    // the reachable cell nearest to it instead, and say so.
+    double best = INFINITY;
+    for (int64_t i = 0; i < drive.size(); ++i) {
+      if (!free[i]) continue;
+      const Point2 p = drive.CellCenter(drive.FromIndex(i));
+      const double d = std::hypot(p.x - c.end.x, p.y - c.end.y);
+      if (d < best) best = d, c.end = Pose2{p.x, p.y, c.end.theta};
+    }
+    st.end_moved = true;
+  }
   std::vector<uint8_t> to_cover(free.size(), 0);
   for (size_t i = 0; i < free.size(); ++i) {
     const bool was = old.area->cover->free_flags()[i] && !covered[i];
@@ -316,6 +337,9 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   auto greedy = [&]() {
     out.plan.path = whole.path;
     out.plan.sweeps = whole.sweeps;
+    // A walk that ended inside a blocked stretch (the old end cut off) still
+    // drives to the (moved) end; the route is short and needs no deadline.
+    AppendRoute(drive, whole.end, c.end, StopToken(), &out.plan.path).IgnoreError();
     st.greedy_detours.clear();
     for (int k = 0; k < whole.encounters; ++k) st.greedy_detours.push_back(k);
     st.replanned_encounter = -1;

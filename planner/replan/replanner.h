@@ -91,6 +91,7 @@ struct ReplanStats {
   double tour_ms = 0.0;
   double total_ms = 0.0;
   bool rank_lp_integral = true;          // the RANK-REPLAN relaxation was integral
+  bool end_moved = false;                // the old end was cut off: the plan ends at the nearest reachable cell
 };
 
 struct ReplanResult {

@@ -50,7 +50,9 @@ absl::StatusOr<std::shared_ptr<const TransitionTable>> TransitionTable::BuildFor
     std::vector<CellIndex> path;
     for (size_t g = next++; g < groups.size() && !stopped; g = next++) {
       const int source = groups[g][0];
-      if (!search.Run(table->endpoints_[source], stop)) {
+      // Small grids finish a search within the search's own polling interval:
+      // poll before each one too, so a deadline stops the table promptly.
+      if (stop.ShouldStop() || !search.Run(table->endpoints_[source], stop)) {
         stopped = true;
         return;
       }

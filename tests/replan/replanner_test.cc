@@ -228,6 +228,29 @@ TEST(Replan, EncountersWithTooLittleTimeAreDetouredAndALaterOneReplanned) {
   EXPECT_GT(r->stats.time_to_encounter_s, options.safety_margin_s);
 }
 
+// The old end (where the robot returns, e.g. its dock) is blocked by a new
+// obstacle: every method still answers; the plan ends at the nearest
+// reachable cell and says so.
+TEST(Replan, ABlockedEndMovesTheEndInsteadOfFailing) {
+  const Mission m = Office();
+  const RobotProgress at = Early(m.plan.plan);
+  const Waypoint& end = m.plan.plan.path.back();
+  Observations seen;
+  seen.points = {{end.x, end.y}};
+  for (ReplanMethod method : {ReplanMethod::kAuto, ReplanMethod::kGreedyDetour, ReplanMethod::kFull}) {
+    ReplanOptions options;
+    options.method = method;
+    absl::StatusOr<ReplanResult> r = Replan(m.plan, at, seen, options, nullptr);
+    ASSERT_TRUE(r.ok()) << ReplanMethodName(method) << ": " << r.status();
+    EXPECT_TRUE(r->stats.end_moved);
+    EXPECT_EQ(testing::CheckPlanConformance(r->plan, *r->area, m.plan.request.common.robot), "")
+        << ReplanMethodName(method);
+    const Waypoint& last = r->plan.path.back();
+    EXPECT_LT(std::hypot(last.x - end.x, last.y - end.y), 1.2) << ReplanMethodName(method);
+    EXPECT_TRUE(r->area->drive->IsFree(r->area->drive->CellAt({last.x, last.y})));
+  }
+}
+
 TEST(Replan, MalformedProgressAndObstaclesAreInvalidArgument) {
   const Mission m = Office();
   const int n = static_cast<int>(m.plan.plan.path.size());
