@@ -2,7 +2,7 @@
 // the replanned remainder (the Replan RPC); prints a summary, writes the
 // new plan as plan.json and optionally an SVG.
 //
-//   covplan replan --server 127.0.0.1:50051 --plan-id p-... --waypoint 40 --at 3.2,4.0 \
+//   covplan replan --server 127.0.0.1:50051 --plan-id p-... --waypoint 40 --at 3.2,4.0
 //       --obstacle "9,9.2 10.2,9.2 10.2,10 9,10" --out replanned.json
 //
 // Thread-safety: not applicable (command entry point).
