@@ -94,7 +94,7 @@ void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1:
 // A plan the server did not retain, rebuilt on the map it was planned on.
 absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& plan,
                                                     const PlanningEngine& engine,
-                                                    const MapSource& source);
+                                                    const MapSource& source, const StopToken& stop);
 
 // Canonical protobuf JSON, snake_case field names, primitive fields always
 // printed, indented. This is the CLI's plan.json.

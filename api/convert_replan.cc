@@ -82,8 +82,9 @@ void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1:
 
 absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& inline_plan,
                                                     const PlanningEngine& engine,
-                                                    const MapSource& source) {
+                                                    const MapSource& source, const StopToken& stop) {
   ASSIGN_OR_RETURN(PlanRequest request, PlanRequestFromProto(inline_plan.request()));
+  request.common.stop = stop;  // a cold grid build on a restarted server is bounded too
   ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area, engine.AreaFor(source, request));
   ASSIGN_OR_RETURN(CoveragePlan plan, PlanFromProto(inline_plan.plan()));
   const Grid& g = *plan.grid;
@@ -116,6 +117,7 @@ absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& inline
   out.map_id = source.map_id;
   out.plan = std::move(plan);
   out.request = std::move(request);
+  out.request.common.stop = StopToken();
   out.area = std::move(derived);
   return out;
 }

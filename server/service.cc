@@ -465,26 +465,47 @@ void CoveragePlannerService::PersistPlan(const v1::PlanRequest& origin, const v1
   v1::InlinePlan record;
   *record.mutable_request() = origin;
   *record.mutable_plan() = plan;
-  std::string bytes;
-  if (!record.SerializeToString(&bytes)) return;
-  if (absl::Status s = store_->PutPlan(plan.plan_id(), bytes); !s.ok()) {
-    LogLine("warn", "plan not persisted", {{"plan", plan.plan_id()}, {"detail", std::string(s.message())}});
-    return;
+  auto bytes = std::make_shared<std::string>();
+  if (!record.SerializeToString(bytes.get())) return;
+  const std::string plan_id = plan.plan_id();
+  {
+    absl::MutexLock lock(&origins_mu_);
+    origins_.emplace_back(plan_id, std::make_shared<const v1::PlanRequest>(origin));
+    while (origins_.size() > 4 * options_.max_retained_plans + 16) origins_.pop_front();
   }
-  if (persisted_.fetch_add(1) % 256 == 255) store_->TrimPlans(options_.max_stored_plans);
+  // Off the reply's path: the disk write (with its fsyncs) runs on the I/O
+  // pool after the answer is on its way.
+  const bool queued = SubmitIo([this, bytes, plan_id] {
+    if (absl::Status s = store_->PutPlan(plan_id, *bytes); !s.ok()) {
+      LogLine("warn", "plan not persisted", {{"plan", plan_id}, {"detail", std::string(s.message())}});
+      return;
+    }
+    if (persisted_.fetch_add(1) % 256 == 255) store_->TrimPlans(options_.max_stored_plans);
+  });
+  if (!queued) LogLine("warn", "plan not persisted: I/O queue full", {{"plan", plan_id}});
 }
 
 std::shared_ptr<const RetainedPlan> CoveragePlannerService::FindPlan(const std::string& plan_id,
+                                                                     const StopToken& stop,
                                                                      v1::PlanRequest* origin) {
+  if (std::shared_ptr<const RetainedPlan> in_memory = plans_.Get(plan_id)) {
+    absl::MutexLock lock(&origins_mu_);
+    for (auto it = origins_.rbegin(); it != origins_.rend(); ++it) {
+      if (it->first == plan_id) {
+        *origin = *it->second;
+        break;
+      }
+    }
+    return in_memory;
+  }
   absl::StatusOr<std::string> bytes = store_->GetPlan(plan_id);
   v1::InlinePlan record;
   const bool stored = bytes.ok() && record.ParseFromString(*bytes);
   if (stored) *origin = record.request();
-  if (std::shared_ptr<const RetainedPlan> in_memory = plans_.Get(plan_id)) return in_memory;
   if (!stored || record.request().map_ref_case() != v1::PlanRequest::kMapId) return nullptr;
   // After a restart: rebuild the plan on its stored map.
   absl::StatusOr<RetainedPlan> rebuilt =
-      RetainedPlanFromInline(record, engine_, SourceFor(record.request().map_id(), nullptr));
+      RetainedPlanFromInline(record, engine_, SourceFor(record.request().map_id(), nullptr), stop);
   if (!rebuilt.ok()) {
     LogLine("warn", "stored plan could not be rebuilt",
             {{"plan", plan_id}, {"detail", std::string(rebuilt.status().message())}});
@@ -500,6 +521,11 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
                                                const StopToken& cancel, v1::ReplanResponse* response) {
   const absl::Time start = absl::Now();
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
+  if (call.deadline != absl::InfiniteFuture() && call.deadline - options_.deadline_margin <= start) {
+    return absl::DeadlineExceededError(absl::StrFormat(
+        "deadline of %d ms left no time to replan (it waited %d ms for a worker)",
+        absl::ToInt64Milliseconds(call.deadline - call.start), absl::ToInt64Milliseconds(start - call.start)));
+  }
   ASSIGN_OR_RETURN(RobotProgress progress, ProgressFromProto(request.progress()));
   ASSIGN_OR_RETURN(ReplanMethod method, ReplanMethodFromProto(request.method()));
   ReplanOptions options;
@@ -515,7 +541,7 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
   bool has_origin = false;
   switch (request.plan_ref_case()) {
     case v1::ReplanRequest::kPlanId:
-      old = FindPlan(request.plan_id(), &origin);
+      old = FindPlan(request.plan_id(), options.stop, &origin);
       has_origin = old != nullptr && origin.map_ref_case() == v1::PlanRequest::kMapId;
       if (old == nullptr) {
         return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '",
@@ -535,8 +561,9 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
       } else {
         return absl::InvalidArgumentError("plan.request needs map_id or an inline map");
       }
-      ASSIGN_OR_RETURN(RetainedPlan rebuilt,
-                       RetainedPlanFromInline(request.plan(), engine_, SourceFor(map_id, inline_map)));
+      ASSIGN_OR_RETURN(RetainedPlan rebuilt, RetainedPlanFromInline(request.plan(), engine_,
+                                                                    SourceFor(map_id, inline_map),
+                                                                    options.stop));
       old = std::make_shared<const RetainedPlan>(std::move(rebuilt));
       origin = pr;
       has_origin = pr.map_ref_case() == v1::PlanRequest::kMapId;
@@ -564,10 +591,14 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
   metrics_->SetReplanEstimator(estimator_.coefficients().a, estimator_.coefficients().b,
                                estimator_.coefficients().c, estimator_.num_samples());
   if (result.stats.replanned_encounter >= 0) {
-    // Kept across restarts; a failed write only costs what was learned since.
-    if (absl::Status s = store_->PutState(kEstimatorFile, estimator_.Serialize()); !s.ok()) {
-      LogLine("warn", "replan estimator not saved", {{"detail", std::string(s.message())}});
-    }
+    // Kept across restarts (off the reply's path); a failed write only costs
+    // what was learned since.
+    auto text = std::make_shared<std::string>(estimator_.Serialize());
+    SubmitIo([this, text] {
+      if (absl::Status s = store_->PutState(kEstimatorFile, *text); !s.ok()) {
+        LogLine("warn", "replan estimator not saved", {{"detail", std::string(s.message())}});
+      }
+    });
   }
   return absl::OkStatus();
 }

@@ -27,6 +27,8 @@
 #define COVPLAN_SERVER_SERVICE_H_
 
 #include <atomic>
+#include <deque>
+#include <utility>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -143,7 +145,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // best effort: a failure is logged and counted, the call still succeeds.
   void PersistPlan(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
   // A retained plan from memory, or else from the store (after a restart).
-  std::shared_ptr<const RetainedPlan> FindPlan(const std::string& plan_id, v1::PlanRequest* origin);
+  std::shared_ptr<const RetainedPlan> FindPlan(const std::string& plan_id, const StopToken& stop,
+                                               v1::PlanRequest* origin);
 
   const ServiceOptions options_;
   MapStore* const store_;
@@ -159,6 +162,11 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   std::atomic<int> in_flight_{0};
   std::atomic<int> admitted_{0};
   std::atomic<uint64_t> persisted_{0};
+  // The Plan request each retained plan's mission started with (for
+  // persisting its replans without waiting for the disk), newest last.
+  absl::Mutex origins_mu_;
+  std::deque<std::pair<std::string, std::shared_ptr<const v1::PlanRequest>>> origins_
+      ABSL_GUARDED_BY(origins_mu_);
   // Exponentially weighted mean wall time of a solve (microseconds), for the
   // deadline-aware admission: a call whose expected queue wait would leave no
   // time to plan before its deadline is refused at once.

@@ -43,6 +43,22 @@ void ReplanEstimator::Record(int64_t new_ranks, double seconds) {
 
 void ReplanEstimator::Refit() {
   if (samples_.size() < static_cast<size_t>(kMinSamples)) return;
+  // The slope terms need at least two distinct rank counts; otherwise keep
+  // the prior's slope and fit only the constant (as a bound, like below).
+  bool distinct = false;
+  for (const auto& sample : samples_) distinct = distinct || sample.first != samples_.front().first;
+  if (!distinct) {
+    const Coefficients prior;
+    std::vector<double> residuals;
+    for (const auto& [m, sec] : samples_) {
+      const double x = static_cast<double>(m);
+      residuals.push_back(sec - prior.b * x - prior.c * x * x * x);
+    }
+    const size_t q = residuals.size() * 9 / 10;
+    std::nth_element(residuals.begin(), residuals.begin() + q, residuals.end());
+    coef_ = Coefficients{std::max(0.0, residuals[q]), prior.b, prior.c};
+    return;
+  }
   // Least squares on (1, m, m^3); a negative coefficient is dropped and the
   // rest refitted, so f stays non-negative and increasing.
   bool use[3] = {true, true, true};
@@ -68,7 +84,7 @@ void ReplanEstimator::Refit() {
       out[t] = sol(j++);
       if (!(out[t] >= 0.0)) use[t] = false, negative = true;
     }
-    if (!negative) {
+    if (!negative && (out[1] > 0.0 || out[2] > 0.0)) {
       // Headroom: the fit is of the mean, a budget needs a bound; lift the
       // curve by the 90th percentile of the residuals.
       std::vector<double> residuals;
@@ -83,8 +99,17 @@ void ReplanEstimator::Refit() {
       coef_.c = out[2];
       return;
     }
-    if (!use[0] && !use[1] && !use[2]) break;
+    if (!negative) use[1] = use[2] = false;  // flat fit: retry below with the prior's slope
+    if (!use[1] && !use[2]) break;
   }
+  // No increasing fit: keep the prior's slope, lift the constant to bound the samples.
+  const Coefficients prior;
+  double worst = 0.0;
+  for (const auto& [m, sec] : samples_) {
+    const double x = static_cast<double>(m);
+    worst = std::max(worst, sec - prior.b * x - prior.c * x * x * x);
+  }
+  coef_ = Coefficients{worst, prior.b, prior.c};
 }
 
 ReplanEstimator::Coefficients ReplanEstimator::coefficients() const {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <unordered_map>
 
 #include "absl/strings/str_format.h"
@@ -156,8 +158,46 @@ std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
   return legs;
 }
 
-Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, double heading,
-                int stop_at_encounter) {
+bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed) {
+  const double s = frame.cell_size();
+  const double ax = (a.x - frame.origin().x) / s, ay = (a.y - frame.origin().y) / s;
+  const double bx = (b.x - frame.origin().x) / s, by = (b.y - frame.origin().y) / s;
+  int cx = static_cast<int>(std::floor(ax)), cy = static_cast<int>(std::floor(ay));
+  const int ex = static_cast<int>(std::floor(bx)), ey = static_cast<int>(std::floor(by));
+  if (closed(cy, cx)) return true;
+  const double dx = bx - ax, dy = by - ay;
+  const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  double tx = dx != 0 ? ((sx > 0 ? cx + 1 : cx) - ax) / dx : inf;
+  double ty = dy != 0 ? ((sy > 0 ? cy + 1 : cy) - ay) / dy : inf;
+  const double dtx = dx != 0 ? sx / dx : inf, dty = dy != 0 ? sy / dy : inf;
+  for (int guard = std::abs(ex - cx) + std::abs(ey - cy) + 2; guard > 0 && (cx != ex || cy != ey); --guard) {
+    if (std::abs(tx - ty) <= 1e-12) {
+      if (tx > 1.0) break;
+      // Exactly through a grid corner: all four cells around it are touched.
+      if (closed(cy, cx + sx) || closed(cy + sy, cx)) return true;
+      cx += sx, cy += sy, tx += dtx, ty += dty;
+    } else if (tx < ty) {
+      if (tx > 1.0) break;
+      cx += sx, tx += dtx;
+    } else {
+      if (ty > 1.0) break;
+      cy += sy, ty += dty;
+    }
+    if (closed(cy, cx)) return true;
+  }
+  return false;
+}
+
+Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs, Point2 robot,
+                double heading) {
+  // A cell the walk must not touch: free on the old drive grid, not on the
+  // new one (a new obstacle, or cut off by one). Cells that were never free
+  // (a dock's cell, which the old path left by its join move) stay open.
+  auto closed = [&](int r, int c) {
+    if (!drive.InBounds(r, c)) return true;
+    return old_drive.IsFree(r, c) && !drive.IsFree(r, c);
+  };
   Walk w;
   w.swept.assign(static_cast<size_t>(drive.size()), 0);
   w.path.push_back({robot.x, robot.y, heading, SegmentKind::kStart, -1});
@@ -190,9 +230,13 @@ Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, d
     }
     return out;
   };
+  auto join = [&](Point2 p) {
+    absl::StatusOr<CellIndex> c = JoinCell(drive, Pose2{p.x, p.y, 0}, "point");
+    return c.ok() ? *c : drive.CellAt(p);
+  };
+  AnyAngleSearch search(drive);
   auto detour = [&](Point2 from, Point2 to) {
-    const CellIndex a = drive.CellAt(from), b = drive.CellAt(to);
-    AnyAngleSearch search(drive);
+    const CellIndex a = join(from), b = join(to);
     search.Run(a, StopToken());
     std::vector<CellIndex> corners = search.PathTo(b);
     emit(drive.CellCenter(a), SegmentKind::kTransition, {}, cur_heading);
@@ -208,10 +252,16 @@ Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, d
     const double axis = len >= kMinSegmentM ? std::atan2(leg.b.y - leg.a.y, leg.b.x - leg.a.x) : cur_heading;
     const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
     double run_start = 0.0, last_free_t = 0.0;
+    Point2 prev = leg.a;
     for (int s = 0; s <= n; ++s) {
       const double t = static_cast<double>(s) / n;
       const Point2 p = Lerp(leg.a, leg.b, t);
-      const bool free = drive.IsFree(drive.CellAt(p));
+      const CellIndex cell = drive.CellAt(p);
+      const bool open = !closed(cell.row, cell.col);
+      // Exact: the piece since the last sample must not touch a closed cell
+      // (a segment may clip a cell or pass a corner between two samples).
+      const bool free = open && (s == 0 || !SegmentTouches(drive, prev, p, closed));
+      prev = p;
       if (!blocked) {
         if (free) {
           last_free_t = t;
@@ -220,16 +270,9 @@ Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, d
         // Entering a blocked stretch: drive up to the last free point.
         emit(Lerp(leg.a, leg.b, last_free_t), leg.kind, part_cells(leg, run_start, last_free_t), axis);
         last_free = cursor;
-        if (stop_at_encounter == w.encounters) {
-          w.stopped = true;
-          w.end = cursor;
-          w.end_heading = cur_heading;
-          w.end_leg = static_cast<int>(j);
-          return w;
-        }
-        ++w.encounters;
+        w.at_encounter.push_back({w.path.size(), w.sweeps.size(), cursor, cur_heading, static_cast<int>(j)});
         blocked = true;
-      } else if (free) {
+      } else if (open && drive.IsFree(cell)) {
         // Out of it (drive' is one component: every free cell is reachable).
         detour(last_free, p);
         blocked = false;
@@ -242,10 +285,28 @@ Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, d
       emit(leg.b, leg.kind, part_cells(leg, run_start, 1.0), axis, unchanged ? leg.tag : -1);
     }
   }
+  w.encounters = static_cast<int>(w.at_encounter.size());
   w.end = cursor;
   w.end_heading = cur_heading;
   w.end_leg = static_cast<int>(legs.size()) - 1;
   return w;
+}
+
+Walk Walk::Prefix(int k, const Grid& drive) const {
+  const Snapshot& at = at_encounter[k];
+  Walk p;
+  p.path.assign(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(at.path_size));
+  p.sweeps.assign(sweeps.begin(), sweeps.begin() + static_cast<std::ptrdiff_t>(at.sweeps_size));
+  p.swept.assign(static_cast<size_t>(drive.size()), 0);
+  for (const CoverageSweep& s : p.sweeps) {
+    for (const CellIndex& c : s.cells) p.swept[drive.Index(c.row, c.col)] = 1;
+  }
+  p.encounters = k;
+  p.stopped = true;
+  p.end = at.end;
+  p.end_heading = at.heading;
+  p.end_leg = at.leg;
+  return p;
 }
 
 }  // namespace covplan::replan_internal

@@ -8,6 +8,7 @@
 #define COVPLAN_PLANNER_REPLAN_REPLAN_WALK_H_
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -46,22 +47,39 @@ absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Obser
 std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
                                std::vector<uint8_t>* covered);
 
-// The greedy walk over `legs` on `drive` (cells not free there are
-// obstacles). With stop_at_encounter = k >= 0 it stops where the walk would
-// enter its k-th blocked stretch (0-based) and reports that point; otherwise
-// it detours around every stretch and drives to the end.
+// True when the straight segment a-b (map frame) touches a cell for which
+// closed(row, col) holds: cells entered, clipped, or met at an exact grid
+// corner (all four cells around it count, as in LineOfSight).
+bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed);
+
+// The greedy walk over `legs`: drives the old path and, around every
+// stretch that touches a cell the new obstacles closed (free on old_drive,
+// not on drive), detours over `drive` and finishes the interrupted leg. It
+// records where it stood at each encounter, so the prefix up to encounter k
+// is Prefix(k) without walking again.
 struct Walk {
+  struct Snapshot {
+    size_t path_size = 0;
+    size_t sweeps_size = 0;
+    Point2 end;
+    double heading = 0.0;
+    int leg = -1;
+  };
   std::vector<Waypoint> path;        // from the robot
   std::vector<CoverageSweep> sweeps;
   std::vector<uint8_t> swept;        // per cell
-  int encounters = 0;                // blocked stretches met (up to the stop)
-  bool stopped = false;              // reached the requested encounter
+  int encounters = 0;                // blocked stretches met
+  bool stopped = false;              // a prefix: stops at an encounter
   Point2 end;
   double end_heading = 0.0;
-  int end_leg = -1;                  // leg where the walk stopped
+  int end_leg = -1;                  // leg where the walk ends
+  std::vector<Snapshot> at_encounter;
+
+  // The walk up to (not into) encounter k.
+  Walk Prefix(int k, const Grid& drive) const;
 };
-Walk GreedyWalk(const Grid& drive, const std::vector<Leg>& legs, Point2 robot, double heading,
-                int stop_at_encounter);
+Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs, Point2 robot,
+                double heading);
 
 }  // namespace covplan::replan_internal
 

@@ -91,16 +91,14 @@ std::vector<PolylineElement> TourElements(const Context& c, const Walk& walk,
     auto it = kept.find({static_cast<int>(k.orientation), k.first.row, k.first.col, k.last.row, k.last.col});
     return it == kept.end() ? -1 : it->second;
   };
+  const Grid& old_drive = *c.old->area->drive;
+  auto closed = [&](int r, int col) {
+    return !drive.InBounds(r, col) || (old_drive.IsFree(r, col) && !drive.IsFree(r, col));
+  };
   auto segment_clear = [&](int i) {
     const Waypoint& a = old.path[i - 1];
     const Waypoint& b = old.path[i];
-    const double len = std::hypot(b.x - a.x, b.y - a.y);
-    const int n = std::max(1, static_cast<int>(std::ceil(len / (drive.cell_size() / 8))));
-    for (int s = 0; s <= n; ++s) {
-      const double t = static_cast<double>(s) / n;
-      if (!drive.IsFree(drive.CellAt({a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)}))) return false;
-    }
-    return true;
+    return !replan_internal::SegmentTouches(drive, {a.x, a.y}, {b.x, b.y}, closed);
   };
   std::vector<bool> used(ranks.size(), false);
   std::vector<PolylineElement> elements;
@@ -262,7 +260,15 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   c.robot = old.request.common.robot;
   const Grid& old_drive = *old.area->drive;
   ASSIGN_OR_RETURN(c.at, replan_internal::Locate(old.plan, progress));
-  const CellIndex robot_cell = old_drive.CellAt(c.at.at);
+  // The robot's cell, or (at a dock in a cell that is not free) the free cell
+  // its path joins the grid at.
+  absl::StatusOr<CellIndex> joined = JoinCell(old_drive, Pose2{c.at.at.x, c.at.at.y, 0}, "robot");
+  if (!joined.ok()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "progress: the robot at (%.3f, %.3f) is neither in nor next to a free cell of the plan's grid",
+        c.at.at.x, c.at.at.y));
+  }
+  const CellIndex robot_cell = *joined;
   ASSIGN_OR_RETURN(std::vector<uint8_t> blocked,
                    replan_internal::BlockedCells(old_drive, observations, robot_cell));
   std::vector<uint8_t> covered;
@@ -277,11 +283,6 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   for (size_t i = 0; i < free.size(); ++i) {
     st.newly_blocked_cells += blocked[i];
     if (blocked[i]) free[i] = 0;
-  }
-  if (!old_drive.IsFree(robot_cell)) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "progress: the robot at (%.3f, %.3f) is not in a free cell of the plan's grid", c.at.at.x,
-        c.at.at.y));
   }
   {
     const Grid all = old_drive.WithFreeFlags(free);
@@ -332,7 +333,7 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   out.plan.grid = c.drive;
   // GREEDY_DETOUR over everything, computed first (it is cheap): the answer
   // whenever nothing better is ready in time.
-  const Walk whole = GreedyWalk(drive, c.legs, c.at.at, c.at.heading, -1);
+  const Walk whole = GreedyWalk(old_drive, drive, c.legs, c.at.at, c.at.heading);
   st.num_encounters = whole.encounters;
   auto greedy = [&]() {
     out.plan.path = whole.path;
@@ -396,13 +397,19 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
     // Algorithm 1: encounters in path order, each with the budget its
     // time-to-reach allows.
     bool done = false;
-    for (int k = 0; k < whole.encounters && !done; ++k) {
-      const Walk prefix = GreedyWalk(drive, c.legs, c.at.at, c.at.heading, k);
+    for (int k = 0; k < whole.encounters && !done && !call_stop.ShouldStop(); ++k) {
+      const Walk prefix = whole.Prefix(k, drive);
+      // Per-attempt figures start afresh (a failed attempt leaves none behind).
+      st.new_ranks = st.kept_ranks = st.kept_path_pieces = 0;
+      st.kept_path_m = st.rank_replan_ms = st.transitions_ms = st.tour_ms = 0.0;
+      st.rank_lp_integral = true;
       const double tau = PathTime(prefix.path, c.robot);
       const double budget_s = tau - options.safety_margin_s - absl::ToDoubleSeconds(absl::Now() - start);
       const StopToken stop = call_stop.WithEarlierDeadline(absl::Now() + absl::Seconds(std::max(0.0, budget_s)));
-      const int64_t m_bar = estimator != nullptr ? estimator->Budget(0.7 * budget_s) : -1;
-      if (budget_s <= 0 || m_bar < 0 || stop.ShouldStop()) {
+      // Without an estimator the budget is unlimited (the time limit still holds).
+      const int64_t m_bar =
+          estimator != nullptr ? estimator->Budget(0.7 * budget_s) : RankReplanInput::kUnlimited;
+      if (budget_s <= 0 || (estimator != nullptr && m_bar < 0) || stop.ShouldStop()) {
         st.greedy_detours.push_back(k);
         continue;
       }
@@ -454,7 +461,8 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
         st.greedy_detours.push_back(k);
         continue;
       }
-      if (estimator != nullptr) {
+      if (estimator != nullptr && w.CountFree() > 0 && st.new_ranks > 0) {
+        // Trivial replans (nothing to repartition) would teach it nothing.
         estimator->Record(st.new_ranks, absl::ToDoubleSeconds(absl::Now() - t0));
       }
       st.method = ReplanMethodName(options.method == ReplanMethod::kAuto ? ReplanMethod::kAuto : options.method);

@@ -295,6 +295,44 @@ TEST(Replan, MalformedProgressAndObstaclesAreInvalidArgument) {
   }
 }
 
+// A new obstacle that an old any-angle transition only clips (or meets at a
+// grid corner) is an encounter too: the replanned path must not cut into it.
+TEST(Replan, ACellThatAnOldSegmentOnlyClipsIsAvoided) {
+  OccupancyMap open(240, 240, 0.05, {0.0, 0.0});  // 12 m x 12 m, all free
+  for (int r = 0; r < 240; ++r) {
+    for (int c = 0; c < 240; ++c) open.set(r, c, CellState::kFree);
+  }
+  PlanOptions o;
+  o.robot.tool_width_m = 1.0;
+  o.tour_solver = TourSolver::kGreedy;
+  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(open, o);
+  ASSERT_TRUE(r.ok()) << r.status();
+  RetainedPlan old;
+  old.plan = r->plan;
+  old.area = r->area;
+  old.request = o.ToRequest();
+  // Replace the path by one long diagonal transition and its return.
+  old.plan.path = {{0.5, 0.5, 0, SegmentKind::kStart, -1},
+                   {10.5, 7.5, std::atan2(7.0, 10.0), SegmentKind::kTransition, -1},
+                   {0.5, 0.5, std::atan2(-7.0, -10.0), SegmentKind::kTransition, -1}};
+  old.plan.sweeps.clear();
+  // Cells the diagonal clips without any 1/8-cell sample landing in them.
+  for (const CellIndex& cell : {CellIndex{2, 4}, CellIndex{4, 6}, CellIndex{6, 9}}) {
+    RobotProgress at;
+    at.distance_m = 0.0;
+    Observations seen;
+    seen.cells = {cell};
+    for (ReplanMethod method : {ReplanMethod::kGreedyDetour, ReplanMethod::kAuto}) {
+      ReplanOptions options;
+      options.method = method;
+      absl::StatusOr<ReplanResult> res = Replan(old, at, seen, options, nullptr);
+      ASSERT_TRUE(res.ok()) << res.status();
+      EXPECT_EQ(testing::CheckPathStaysFree(*res->area->drive, res->plan.path), "")
+          << cell.row << "," << cell.col << " " << ReplanMethodName(method);
+    }
+  }
+}
+
 TEST(Estimator, LearnsFromSolvesAndPersists) {
   ReplanEstimator e;
   const int64_t prior = e.Budget(0.5);
@@ -312,6 +350,11 @@ TEST(Estimator, LearnsFromSolvesAndPersists) {
   EXPECT_EQ(restored.Budget(0.555), learned);
   EXPECT_EQ(restored.num_samples(), 40);
   EXPECT_FALSE(restored.Parse("garbage\n1 2\n").ok());
+  // Samples that all share one rank count cannot fix a slope: the prior's is kept.
+  ReplanEstimator flat;
+  for (int k = 0; k < 8; ++k) flat.Record(0, 0.2);
+  EXPECT_LT(flat.Budget(0.21), 10);
+  EXPECT_GE(flat.Predict(0), 0.2 - 1e-9);
   EXPECT_FALSE(restored.Parse("covplan.replan_estimator.v1\n-1 2\n").ok());
 }
 

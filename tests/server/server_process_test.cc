@@ -152,6 +152,14 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     return stub_->Replan(&context, r, out);
   };
+  // Plans are written to the store right after the reply (off its path).
+  auto stored = [&](const std::string& id) {
+    for (int i = 0; i < 250 && !std::filesystem::exists(store_ + "/plans/" + id + ".plan"); ++i) {
+      absl::SleepFor(absl::Milliseconds(20));
+    }
+    return std::filesystem::exists(store_ + "/plans/" + id + ".plan");
+  };
+  ASSERT_TRUE(stored(plan.plan_id()));
   ASSERT_EQ(::kill(server_->pid(), SIGKILL), 0);
   EXPECT_EQ(server_->Wait(absl::Seconds(10)), 128 + SIGKILL);
   stub_.reset();
@@ -161,6 +169,7 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   grpc::Status status = replan(plan, &first);
   ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << server_->log();
   EXPECT_GT(first.replan().remaining_cells(), 0);
+  ASSERT_TRUE(stored(first.plan().plan_id()));
   ASSERT_EQ(::kill(server_->pid(), SIGKILL), 0);
   EXPECT_EQ(server_->Wait(absl::Seconds(10)), 128 + SIGKILL);
   stub_.reset();
