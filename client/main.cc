@@ -5,6 +5,7 @@
 //   covplan replan --server HOST:PORT --plan-id P --waypoint K --at X,Y --obstacle "x,y ..."
 //   covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S] [--deadline-ms D]
 //   covplan gtsp ...
+//   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local]
 //
 // Subcommands parse their own flags (client/args.h); no global flags.
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "client/load_command.h"
 #include "client/plan_command.h"
 #include "client/replan_command.h"
+#include "client/simulate_command.h"
 
 namespace {
 
@@ -25,6 +27,7 @@ constexpr char kUsage[] =
     "  replan report new obstacles for a retained plan; get the replanned remainder\n"
     "  load   load-test a server's Plan method; prints one JSON object\n"
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
+    "  simulate  drive a plan through the true map, replanning on new obstacles; prints JSON\n"
     "Run 'covplan <command> --help' for its flags.\n";
 
 }  // namespace
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
   if (command == "replan") return covplan::RunReplanCommand(args);
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
+  if (command == "simulate") return covplan::RunSimulateCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

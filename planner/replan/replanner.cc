@@ -262,7 +262,11 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   ASSIGN_OR_RETURN(c.at, replan_internal::Locate(old.plan, progress));
   // The robot's cell, or (at a dock in a cell that is not free) the free cell
   // its path joins the grid at.
-  absl::StatusOr<CellIndex> joined = JoinCell(old_drive, Pose2{c.at.at.x, c.at.at.y, 0}, "robot");
+  // Probed a hair behind the robot along its segment: a robot exactly on a
+  // cell border stands in the cell it came from, not in the one ahead (which
+  // a new obstacle may block).
+  const Point2 probe{c.at.at.x - 1e-6 * std::cos(c.at.heading), c.at.at.y - 1e-6 * std::sin(c.at.heading)};
+  absl::StatusOr<CellIndex> joined = JoinCell(old_drive, Pose2{probe.x, probe.y, 0}, "robot");
   if (!joined.ok()) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "progress: the robot at (%.3f, %.3f) is neither in nor next to a free cell of the plan's grid",

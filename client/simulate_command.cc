@@ -1,0 +1,250 @@
+#include "client/simulate_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <numeric>
+#include <optional>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "client/args.h"
+#include "planner/common/status_macros.h"
+#include "planner/engine/engine.h"
+#include "planner/grid/grid.h"
+#include "planner/grid/map_io.h"
+#include "planner/plan/svg.h"
+#include "planner/sim/clutter.h"
+#include "planner/sim/simulator.h"
+
+namespace covplan {
+namespace {
+
+constexpr char kUsage[] =
+    "usage: covplan simulate --map KNOWN [--resolution M] [--tool-width M]\n"
+    "                        (--true-map TRUE | --clutter PCT) [--seed N]\n"
+    "                        [--method auto|ilp1|ilp2|greedy_detour|full] [--sensor-range M]\n"
+    "                        [--local] [--svg run.svg] [--time-limit S] [--step S]\n"
+    "                        [--replan-tour-limit S] [--clutter-may-disconnect]\n"
+    "                        [--no-offline-bound]\n"
+    "                        [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
+    "                        [--free-thresh P] [--occupied-thresh P] [--negate]\n"
+    "Plans OARP on KNOWN, drives the plan through the true map (TRUE, or KNOWN with\n"
+    "random rotated rectangles over PCT % of its free area, placed with --seed) with a\n"
+    "radial line-of-sight sensor (default 5.6 m), replans with --method (default auto)\n"
+    "whenever new obstacles cut the path, and prints one JSON object: total_time_s =\n"
+    "drive_time_s + stoppage_s, replans, coverage of the true map's free area, and\n"
+    "offline_lower_bound_s (OARP planned on the true map) and offline_cell_bound_s (OARP\n"
+    "on the known map with the cells the true map blocks filled: the bound of the cell\n"
+    "model the replanner and the simulated robot work in, which ignores new obstacles\n"
+    "smaller than half a cell; length_in_obstacles_m says how far the robot drove\n"
+    "through such).\n"
+    "Clutter rectangles have sides of 0.3-1.5 m and any orientation; one that would cut\n"
+    "free cells of the tool-width grid off the rest is redrawn, unless\n"
+    "--clutter-may-disconnect. --time-limit is the initial plan's search budget (default\n"
+    "1 s), --replan-tour-limit the cap of each replan's tour search (default 1 s).\n"
+    "--no-offline-bound skips planning the true map (offline_lower_bound_s is null).\n"
+    "Maps are map_server .yaml files or bare .pgm/.png images (these need\n"
+    "--resolution; --free-thresh, --occupied-thresh and --negate apply to them, a\n"
+    "YAML names its own). Both maps must have the same size, resolution and origin.\n"
+    "Only --local (in-process, the default) is implemented: running against a server\n"
+    "needs the streaming replanning session, which does not exist yet, so --server\n"
+    "is refused. --svg draws the true map, the driven path, the replan points (blue)\n"
+    "and the obstacle cells found (red).\n";
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\', out += ch;
+    } else if (c < 0x20) {
+      absl::StrAppendFormat(&out, "\\u%04x", c);
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+std::string JsonNumber(double v) { return std::isfinite(v) ? absl::StrFormat("%.6f", v) : "null"; }
+
+absl::StatusOr<ReplanMethod> ParseMethod(const std::string& name) {
+  for (ReplanMethod m : {ReplanMethod::kAuto, ReplanMethod::kIlp1, ReplanMethod::kIlp2,
+                         ReplanMethod::kGreedyDetour, ReplanMethod::kFull}) {
+    if (name == ReplanMethodName(m)) return m;
+  }
+  return absl::InvalidArgumentError(absl::StrCat(
+      "--method must be auto, ilp1, ilp2, greedy_detour or full, got '", name, "'"));
+}
+
+// The true map with the driven path, replan points and found obstacles.
+std::string RenderRunSvg(const OccupancyMap& truth, const Grid& grid, const SimulationResult& r,
+                         const RobotModel& robot) {
+  CoveragePlan drawn;
+  drawn.grid = std::make_shared<const Grid>(grid);
+  drawn.path = r.driven;
+  drawn.stats = ComputePathStats(r.driven, robot);  // the legend: segments, turns, drive time
+  for (const Waypoint& w : r.driven) drawn.stats.num_ranks += w.kind == SegmentKind::kCoverage;
+  std::string svg = RenderPlanSvg(drawn, &truth);
+  const double s = grid.cell_size();
+  const double h = std::max(grid.rows() * s, truth.height() * truth.resolution());
+  std::string extra = absl::StrFormat("<g transform=\"matrix(1 0 0 -1 0 %.4f)\">\n", h + 2 * grid.origin().y);
+  absl::StrAppendFormat(&extra, "<g fill=\"none\" stroke=\"#d62728\" stroke-width=\"%.4f\">\n", 0.08 * s);
+  for (const CellIndex& c : r.obstacles_found) {
+    absl::StrAppendFormat(&extra, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\"/>\n",
+                          grid.origin().x + c.col * s, grid.origin().y + c.row * s, s, s);
+  }
+  absl::StrAppendFormat(&extra, "</g>\n<g fill=\"#1f5fa8\" fill-opacity=\"0.8\">\n");
+  for (const Point2& p : r.replan_points) {
+    absl::StrAppendFormat(&extra, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\"/>\n", p.x, p.y, 0.25 * s);
+  }
+  absl::StrAppend(&extra, "</g>\n</g>\n");
+  const size_t end = svg.rfind("</svg>");
+  svg.insert(end == std::string::npos ? svg.size() : end, extra);
+  return svg;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args) {
+  ASSIGN_OR_RETURN(ParsedArgs a,
+                   ParseArgs(args,
+                             {"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
+                              "sensor-range", "svg", "time-limit", "step", "max-speed", "acceleration",
+                              "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit"},
+                             {"local", "negate", "clutter-may-disconnect", "no-offline-bound"}));
+  if (a.Get("server")) {
+    return absl::InvalidArgumentError(
+        "--server is not available yet: simulating against a server needs the streaming "
+        "replanning session, which does not exist yet; use --local");
+  }
+  if (!a.Get("map")) return absl::InvalidArgumentError("--map KNOWN is required");
+  if (a.Get("true-map").has_value() == a.Get("clutter").has_value()) {
+    return absl::InvalidArgumentError("give exactly one of --true-map TRUE and --clutter PCT");
+  }
+  MapLoadOptions load;
+  ASSIGN_OR_RETURN(std::optional<double> resolution, a.GetDouble("resolution"));
+  if (resolution) load.resolution = *resolution, load.override_resolution = true;
+  ASSIGN_OR_RETURN(std::optional<double> free_thresh, a.GetDouble("free-thresh"));
+  if (free_thresh) load.free_thresh = *free_thresh;
+  ASSIGN_OR_RETURN(std::optional<double> occupied_thresh, a.GetDouble("occupied-thresh"));
+  if (occupied_thresh) load.occupied_thresh = *occupied_thresh;
+  load.negate = a.Has("negate");
+
+  SimulationOptions o;
+  ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
+  if (seed && (*seed < 0 || *seed > UINT32_MAX)) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
+  o.seed = seed.value_or(1);
+  if (auto m = a.Get("method")) {
+    ASSIGN_OR_RETURN(o.method, ParseMethod(*m));
+  }
+  ASSIGN_OR_RETURN(std::optional<double> range, a.GetDouble("sensor-range"));
+  if (range) o.sensor_range_m = *range;
+  ASSIGN_OR_RETURN(std::optional<double> step, a.GetDouble("step"));
+  if (step) o.step_s = *step;
+  ASSIGN_OR_RETURN(std::optional<double> tour_limit, a.GetDouble("replan-tour-limit"));
+  if (tour_limit) o.replan_tour_time_limit_s = *tour_limit;
+  RobotModel& robot = o.plan.robot;
+  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
+  if (tool) robot.tool_width_m = *tool;
+  ASSIGN_OR_RETURN(std::optional<double> speed, a.GetDouble("max-speed"));
+  if (speed) robot.max_speed_mps = *speed;
+  ASSIGN_OR_RETURN(std::optional<double> accel, a.GetDouble("acceleration"));
+  if (accel) robot.acceleration_mps2 = *accel;
+  ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
+  if (turn) robot.turn_rate_deg_s = *turn;
+  ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
+  o.plan.time_limit_s = limit.value_or(1.0);
+  o.plan.seed = o.seed;
+  if (!(o.plan.time_limit_s > 0.0 && o.plan.time_limit_s <= 3600.0)) {
+    return absl::InvalidArgumentError("--time-limit must be in (0, 3600] s");
+  }
+
+  ASSIGN_OR_RETURN(OccupancyMap known, LoadMapFile(*a.Get("map"), load));
+  OccupancyMap truth;
+  std::string truth_name;
+  if (auto path = a.Get("true-map")) {
+    ASSIGN_OR_RETURN(truth, LoadMapFile(*path, load));
+    truth_name = *path;
+  } else {
+    ASSIGN_OR_RETURN(std::optional<double> percent, a.GetDouble("clutter"));
+    ClutterOptions clutter;
+    if (!a.Has("clutter-may-disconnect")) clutter.keep_connected_cell_m = robot.tool_width_m;
+    ASSIGN_OR_RETURN(truth, AddClutter(known, *percent, o.seed, clutter));
+    truth_name = absl::StrFormat("clutter %g %% seed %d", *percent, o.seed);
+  }
+  ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o));
+  OfflineBound bound, cell_bound;
+  bound.duration_s = bound.covered_free_area_ratio = cell_bound.duration_s = std::nan("");
+  if (!a.Has("no-offline-bound")) {
+    ASSIGN_OR_RETURN(bound, OfflineLowerBound(truth, o.plan));
+    ASSIGN_OR_RETURN(OccupancyMap cells, CellLevelTruth(known, truth, o.plan));
+    ASSIGN_OR_RETURN(cell_bound, OfflineLowerBound(cells, o.plan));
+  }
+
+  if (auto svg_path = a.Get("svg")) {
+    GridOptions go;
+    go.cell_size = robot.tool_width_m;
+    go.min_free_fraction = o.plan.min_free_fraction;
+    ASSIGN_OR_RETURN(Grid grid, BuildGrid(truth, go));
+    std::ofstream out(*svg_path, std::ios::binary | std::ios::trunc);
+    out << RenderRunSvg(truth, grid, r, robot);
+    out.close();
+    if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot write ", *svg_path));
+  }
+
+  const double total_ms = std::accumulate(r.replan_ms.begin(), r.replan_ms.end(), 0.0);
+  double max_ms = 0.0;
+  for (double ms : r.replan_ms) max_ms = std::max(max_ms, ms);
+  std::string problems = "[";
+  for (size_t i = 0; i < r.problems.size(); ++i) absl::StrAppend(&problems, i ? "," : "", JsonString(r.problems[i]));
+  problems += "]";
+  std::string json = "{";
+  auto field = [&](const char* name, const std::string& value) {
+    absl::StrAppend(&json, json.size() > 1 ? ", " : "", "\"", name, "\": ", value);
+  };
+  field("method", JsonString(ReplanMethodName(o.method)));
+  field("true_map", JsonString(truth_name));
+  field("total_time_s", JsonNumber(r.total_time_s));
+  field("drive_time_s", JsonNumber(r.drive_time_s));
+  field("stoppage_s", JsonNumber(r.stoppage_s));
+  field("num_replans", absl::StrCat(r.num_replans));
+  field("num_encounters", absl::StrCat(r.num_encounters));
+  field("num_greedy_detours", absl::StrCat(r.num_greedy_detours));
+  field("num_turns", absl::StrCat(r.num_turns));
+  field("path_length_m", JsonNumber(r.path_length_m));
+  field("covered_free_area_ratio", JsonNumber(r.covered_free_area_ratio));
+  field("mean_replan_ms", JsonNumber(r.replan_ms.empty() ? 0.0 : total_ms / r.replan_ms.size()));
+  field("max_replan_ms", JsonNumber(max_ms));
+  field("obstacle_cells_found", absl::StrCat(r.obstacles_found.size()));
+  field("touch_detections", absl::StrCat(r.num_touch_detections));
+  field("planned_duration_s", JsonNumber(r.planned_duration_s));
+  field("offline_lower_bound_s", JsonNumber(bound.duration_s));
+  field("offline_covered_free_area_ratio", JsonNumber(bound.covered_free_area_ratio));
+  field("offline_cell_bound_s", JsonNumber(cell_bound.duration_s));
+  field("length_in_obstacles_m", JsonNumber(r.length_in_obstacles_m));
+  field("completed", r.completed ? "true" : "false");
+  field("termination", JsonString(r.termination));
+  field("problems", problems);
+  return json + "}";
+}
+
+namespace {
+
+absl::Status Run(const std::vector<std::string>& args) {
+  ASSIGN_OR_RETURN(std::string json, SimulateCommandJson(args));
+  std::printf("%s\n", json.c_str());
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+int RunSimulateCommand(const std::vector<std::string>& args) {
+  return RunSubcommand("simulate", kUsage, args, &Run);
+}
+
+}  // namespace covplan

@@ -1,0 +1,117 @@
+// The replanning simulator (thesis §4.6): plan OARP on the map the robot
+// knows, then drive that plan under the robot model through the map as it
+// really is. A radial range sensor with line of sight reports the cells the
+// known map called free that are in fact blocked; when they cut the path
+// still to drive, OARP-Replan (planner/replan) gives a new plan from where
+// the robot is, and the robot drives on along it. The replan's compute time
+// beyond what the robot still drives before it meets the obstacle is
+// stoppage; total time = drive time + stoppage.
+//
+//   SimulationOptions o;
+//   o.method = ReplanMethod::kAuto;
+//   o.plan.robot.tool_width_m = 0.8;
+//   ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o));
+//   r.total_time_s, r.stoppage_s, r.covered_free_area_ratio, r.driven ...
+//   ASSIGN_OR_RETURN(OfflineBound lb, OfflineLowerBound(truth, o.plan));  // OARP knowing everything
+//
+// Time is simulated; only the replans' compute time is measured (wall
+// clock), so stoppage, and with it the plans Algorithm 1 picks, varies a
+// little from run to run and with the machine.
+// Thread-safety: Simulate is reentrant (each call has its own estimator).
+#ifndef COVPLAN_PLANNER_SIM_SIMULATOR_H_
+#define COVPLAN_PLANNER_SIM_SIMULATOR_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "planner/engine/plan_coverage.h"
+#include "planner/grid/occupancy_map.h"
+#include "planner/plan/coverage_plan.h"
+#include "planner/replan/replanner.h"
+
+namespace covplan {
+
+struct SimulationOptions {
+  ReplanMethod method = ReplanMethod::kAuto;
+  // Radial range sensor with line of sight over the true map's pixels.
+  double sensor_range_m = 5.6;
+  // The robot senses at least every step_s of driving and at every waypoint.
+  double step_s = 0.1;
+  uint64_t seed = 1;  // for the replans (the initial plan uses plan.seed)
+  PlanOptions plan;   // robot, tool width, time limit ... of the initial plan
+  // ReplanOptions::tour_time_limit_s of every replan: the anytime tour search
+  // stops there even when the robot is far from the obstacle.
+  double replan_tour_time_limit_s = 1.0;
+  // Bounds that make every run end: at most this many replans, and at most
+  // max_time_factor x the initial plan's duration + 3600 s of driving.
+  int max_replans = 10'000;
+  double max_time_factor = 20.0;
+
+  // InvalidArgument naming the field.
+  absl::Status Validate() const;
+};
+
+struct SimulationResult {
+  double total_time_s = 0.0;  // drive_time_s + stoppage_s
+  double drive_time_s = 0.0;  // the driven path under the robot model
+  double stoppage_s = 0.0;    // waiting for replans
+  int num_replans = 0;        // Replan calls (one per event of new obstacles on the path)
+  int num_encounters = 0;     // entries of the path into new obstacles, over all replans
+  int num_greedy_detours = 0; // encounters handled by greedy detour, over all replans
+  int num_turns = 0;
+  double path_length_m = 0.0;
+  // Free area of the TRUE map inside the cells actually swept, over the true
+  // map's free area.
+  double covered_free_area_ratio = 0.0;
+  double planned_duration_s = 0.0;  // the initial plan's estimated duration
+  std::vector<Waypoint> driven;     // the path actually driven
+  std::vector<CellIndex> obstacles_found;  // cells found blocked, in order
+  std::vector<double> replan_ms;           // compute time of each replan
+  std::vector<Point2> replan_points;       // where each replan started
+  std::vector<std::string> replan_methods; // ReplanStats::method of each
+  // Length of the driven path inside non-free pixels of the true map. The
+  // replanner takes new obstacles as blocked cells only: obstacles smaller
+  // than half a cell (chair legs, clutter corners) leave their cells free,
+  // and the robot drives through them as through the known map's free cells.
+  // A measure of how optimistic the cell model is; an offline plan of the
+  // true map keeps this at 0.
+  double length_in_obstacles_m = 0.0;
+  // Cells found by touch rather than sight: the next step would have
+  // entered them while the sensor could not see their centre.
+  int num_touch_detections = 0;
+  // Replanner errors and paths that entered a cell reported blocked, with
+  // the input that caused them; each was worked around by a greedy detour.
+  std::vector<std::string> problems;
+  bool completed = true;  // false: a bound of SimulationOptions stopped the run
+  std::string termination;
+};
+
+// InvalidArgument when the options are bad or the maps differ in size,
+// resolution or origin; errors of the initial plan are passed on.
+absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
+                                          const SimulationOptions& options);
+
+// The offline lower bound of the evaluation: OARP planned on the true map,
+// as if the robot had known it from the start.
+struct OfflineBound {
+  double duration_s = 0.0;  // the plan's estimated duration
+  double covered_free_area_ratio = 0.0;
+  int64_t num_ranks = 0;
+};
+absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth, const PlanOptions& options);
+
+// The true map as the simulation sees it: `known` with every cell that is
+// free on the known grid but blocked on the true grid filled (grid of
+// options.robot.tool_width_m). OfflineLowerBound of this map is the bound of
+// the cell model the replanner works in (new thin obstacles ignored, as the
+// simulated robot ignores them). InvalidArgument as Simulate for maps that
+// do not match.
+absl::StatusOr<OccupancyMap> CellLevelTruth(const OccupancyMap& known, const OccupancyMap& truth,
+                                            const PlanOptions& options);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_PLANNER_SIM_SIMULATOR_H_
