@@ -9,6 +9,7 @@
 #include "planner/engine/engine.h"
 #include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
+#include "tests/testing/shipped_maps.h"
 #include "tests/testing/plan_conformance.h"
 
 namespace covplan {
@@ -16,12 +17,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-OccupancyMap Load(const std::string& name) {
-  absl::StatusOr<OccupancyMap> map =
-      LoadMapFile(std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name, MapLoadOptions());
-  EXPECT_TRUE(map.ok()) << map.status();
-  return *map;
-}
+OccupancyMap Load(const std::string& name) { return testing::LoadShippedMap(name); }
 
 MapSource SourceOf(const OccupancyMap& map, const std::string& id) {
   MapSource s;

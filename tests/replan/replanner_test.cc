@@ -15,6 +15,7 @@
 #include "gtest/gtest.h"
 #include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
+#include "tests/testing/shipped_maps.h"
 #include "tests/testing/plan_conformance.h"
 
 namespace covplan {
@@ -22,12 +23,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-OccupancyMap Load(const std::string& name) {
-  absl::StatusOr<OccupancyMap> map =
-      LoadMapFile(std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name, MapLoadOptions());
-  EXPECT_TRUE(map.ok()) << map.status();
-  return *map;
-}
+OccupancyMap Load(const std::string& name) { return testing::LoadShippedMap(name); }
 
 struct Mission {
   RetainedPlan plan;

@@ -18,6 +18,7 @@
 #include "planner/engine/engine.h"
 #include "planner/grid/grid.h"
 #include "planner/grid/map_io.h"
+#include "tests/testing/shipped_maps.h"
 #include "planner/sim/clutter.h"
 
 namespace covplan {
@@ -27,11 +28,7 @@ using ::testing::HasSubstr;
 
 std::string MapPath(const std::string& name) { return std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name; }
 
-OccupancyMap Load(const std::string& name) {
-  absl::StatusOr<OccupancyMap> map = LoadMapFile(MapPath(name), MapLoadOptions());
-  EXPECT_TRUE(map.ok()) << map.status();
-  return *map;
-}
+OccupancyMap Load(const std::string& name) { return testing::LoadShippedMap(name); }
 
 SimulationOptions Options(ReplanMethod method) {
   SimulationOptions o;
