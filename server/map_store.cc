@@ -273,6 +273,24 @@ absl::StatusOr<std::string> MapStore::GetPlan(const std::string& plan_id) const 
   return buffer.str();
 }
 
+absl::Status MapStore::PutProgress(const std::string& plan_id, absl::string_view contents) {
+  if (!IsPlanId(plan_id)) return absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id.substr(0, 80)));
+  const std::string dir = dir_ + "/plans";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return absl::InternalError(absl::StrCat("cannot create the plans directory: ", ec.message()));
+  return AtomicWrite(dir, dir + "/" + plan_id + ".progress", contents);
+}
+
+absl::StatusOr<std::string> MapStore::GetProgress(const std::string& plan_id) const {
+  if (!IsPlanId(plan_id)) return absl::NotFoundError("no progress for that plan id");
+  std::ifstream in(dir_ + "/plans/" + plan_id + ".progress", std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat("no recorded progress for plan ", plan_id));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
 int64_t MapStore::TrimPlans(int64_t keep) {
   std::error_code ec;
   std::vector<std::pair<std::filesystem::file_time_type, std::filesystem::path>> files;

@@ -65,6 +65,10 @@ class MapStore {
   absl::Status PutPlan(const std::string& plan_id, absl::string_view contents);
   absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const;
   int64_t TrimPlans(int64_t keep);
+  // The robot's last reported progress on a plan (plans/<plan_id>.progress),
+  // written atomically; NotFound when none was recorded.
+  absl::Status PutProgress(const std::string& plan_id, absl::string_view contents);
+  absl::StatusOr<std::string> GetProgress(const std::string& plan_id) const;
 
  private:
   explicit MapStore(std::string dir) : dir_(std::move(dir)) {}

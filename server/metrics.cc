@@ -67,6 +67,9 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                     .Name("covplan_replan_estimator")
                     .Help("Replan runtime model f(m) = a + b m + c m^3 (seconds) and its sample count")
                     .Register(r);
+  drive_sessions_ = NewGauge(r, "covplan_drive_sessions", "Open Drive streaming sessions");
+  drive_superseded_ = NewCounter(r, "covplan_drive_superseded_total",
+                                 "Session replans dropped because a newer observation arrived");
 }
 
 void ServerMetrics::RecordReplan(const std::string& method, double seconds, int greedy_detours) {

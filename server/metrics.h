@@ -9,6 +9,8 @@
 //   covplan_artifact_cache_{hits,misses,evictions}_total  counters
 //   covplan_artifact_cache_{bytes,entries,budget_bytes}   gauges
 //   covplan_maps_stored / covplan_plans_retained       gauges
+//   covplan_drive_sessions                             gauge
+//   covplan_drive_superseded_total                     counter
 //
 //   ServerMetrics metrics;
 //   exposer.RegisterCollectable(metrics.registry());
@@ -49,6 +51,8 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge& cache_budget_bytes() { return *cache_budget_bytes_; }
   prometheus::Gauge& maps_stored() { return *maps_stored_; }
   prometheus::Gauge& plans_retained() { return *plans_retained_; }
+  prometheus::Gauge& drive_sessions() { return *drive_sessions_; }
+  prometheus::Counter& drive_superseded() { return *drive_superseded_; }
 
   // CacheObserver.
   void OnCacheHit() override { cache_hits_->Increment(); }
@@ -78,6 +82,8 @@ class ServerMetrics : public CacheObserver {
   prometheus::Histogram* replan_duration_;
   prometheus::Counter* greedy_detours_;
   prometheus::Family<prometheus::Gauge>* estimator_;
+  prometheus::Gauge* drive_sessions_;
+  prometheus::Counter* drive_superseded_;
 };
 
 }  // namespace covplan

@@ -4,6 +4,7 @@
 #include <random>
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "planner/common/status_macros.h"
@@ -79,6 +80,8 @@ absl::Status ServiceOptions::Validate() const {
   if (max_request_time <= absl::ZeroDuration()) {
     return absl::InvalidArgumentError("max_request_time must be > 0");
   }
+  if (max_sessions < 0) return absl::InvalidArgumentError("max_sessions must be >= 0");
+  if (session_idle <= absl::ZeroDuration()) return absl::InvalidArgumentError("session_idle must be > 0");
   return absl::OkStatus();
 }
 
@@ -91,6 +94,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       registry_(PlannerRegistry::WithBuiltins()),
       engine_(&registry_, &cache_, EngineLimitsFor(options.limits)),
       plans_(options.plan_ttl, options.max_retained_plans),
+      sessions_(options.max_sessions, options.session_idle),
       id_salt_(std::random_device{}()),
       io_pool_(/*threads=*/2, /*max_queue=*/64),
       // Admission is bounded by TryAdmitSolve; the pool's own bound is slack
@@ -536,54 +540,60 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
   options.stop = call.deadline != absl::InfiniteFuture()
                      ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
                      : cancel.WithEarlierDeadline(start + options_.max_request_time);
-  std::shared_ptr<const RetainedPlan> old;
-  v1::PlanRequest origin;  // the Plan request the mission started with
-  bool has_origin = false;
-  switch (request.plan_ref_case()) {
-    case v1::ReplanRequest::kPlanId:
-      old = FindPlan(request.plan_id(), options.stop, &origin);
-      has_origin = old != nullptr && origin.map_ref_case() == v1::PlanRequest::kMapId;
-      if (old == nullptr) {
-        return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '",
-                                                request.plan_id().substr(0, 80), "'"));
-      }
-      break;
-    case v1::ReplanRequest::kPlan: {
-      const v1::PlanRequest& pr = request.plan().request();
-      std::string map_id;
-      std::shared_ptr<const v1::Map> inline_map;
-      if (pr.map_ref_case() == v1::PlanRequest::kMapId) {
-        RETURN_IF_ERROR(ValidateMapId(pr.map_id()));
-        map_id = pr.map_id();
-      } else if (pr.map_ref_case() == v1::PlanRequest::kMap) {
-        map_id = ComputeMapId(pr.map());
-        inline_map = std::make_shared<const v1::Map>(pr.map());
-      } else {
-        return absl::InvalidArgumentError("plan.request needs map_id or an inline map");
-      }
-      ASSIGN_OR_RETURN(RetainedPlan rebuilt, RetainedPlanFromInline(request.plan(), engine_,
-                                                                    SourceFor(map_id, inline_map),
-                                                                    options.stop));
-      old = std::make_shared<const RetainedPlan>(std::move(rebuilt));
-      origin = pr;
-      has_origin = pr.map_ref_case() == v1::PlanRequest::kMapId;
-      break;
-    }
-    default:
-      return absl::InvalidArgumentError("ReplanRequest needs plan_id or an inline plan");
-  }
+  ResolvedPlan old;
+  RETURN_IF_ERROR(ResolvePlan(request.plan_id(),
+                              request.plan_ref_case() == v1::ReplanRequest::kPlan ? &request.plan() : nullptr,
+                              options.stop, &old));
   ASSIGN_OR_RETURN(ReplanResult result,
-                   covplan::Replan(*old, progress, ObstaclesFromProto(request.obstacles()), options,
+                   covplan::Replan(*old.plan, progress, ObstaclesFromProto(request.obstacles()), options,
                                    &estimator_));
+  if (request.plan_ref_case() == v1::ReplanRequest::kPlanId) RecordProgress(request.plan_id(), request.progress());
+  KeepReplan(std::move(result), old, response);
+  return absl::OkStatus();
+}
+
+absl::Status CoveragePlannerService::ResolvePlan(const std::string& plan_id, const v1::InlinePlan* inline_plan,
+                                                 const StopToken& stop, ResolvedPlan* out) {
+  if (inline_plan == nullptr) {
+    if (plan_id.empty()) return absl::InvalidArgumentError("needs plan_id or an inline plan");
+    out->plan = FindPlan(plan_id, stop, &out->origin);
+    if (out->plan == nullptr) {
+      return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", plan_id.substr(0, 80), "'"));
+    }
+    out->has_origin = out->origin.map_ref_case() == v1::PlanRequest::kMapId;
+    return absl::OkStatus();
+  }
+  const v1::PlanRequest& pr = inline_plan->request();
+  std::string map_id;
+  std::shared_ptr<const v1::Map> inline_map;
+  if (pr.map_ref_case() == v1::PlanRequest::kMapId) {
+    RETURN_IF_ERROR(ValidateMapId(pr.map_id()));
+    map_id = pr.map_id();
+  } else if (pr.map_ref_case() == v1::PlanRequest::kMap) {
+    map_id = ComputeMapId(pr.map());
+    inline_map = std::make_shared<const v1::Map>(pr.map());
+  } else {
+    return absl::InvalidArgumentError("plan.request needs map_id or an inline map");
+  }
+  ASSIGN_OR_RETURN(RetainedPlan rebuilt,
+                   RetainedPlanFromInline(*inline_plan, engine_, SourceFor(map_id, inline_map), stop));
+  out->plan = std::make_shared<const RetainedPlan>(std::move(rebuilt));
+  out->origin = pr;
+  out->has_origin = pr.map_ref_case() == v1::PlanRequest::kMapId;
+  return absl::OkStatus();
+}
+
+void CoveragePlannerService::KeepReplan(ReplanResult result, const ResolvedPlan& old,
+                                        v1::ReplanResponse* response) {
   auto retained = std::make_shared<RetainedPlan>();
   retained->plan_id = NewPlanId();
-  retained->map_id = old->map_id;
+  retained->map_id = old.plan->map_id;
   retained->plan = std::move(result.plan);
   retained->area = result.area;
-  retained->request = old->request;
+  retained->request = old.plan->request;
   result.plan = retained->plan;
   ReplanToProto(result, *retained, response);
-  if (has_origin) PersistPlan(origin, response->plan());
+  if (old.has_origin) PersistPlan(old.origin, response->plan());
   plans_.Put(retained);
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   metrics_->RecordReplan(result.stats.method, result.stats.total_ms * 1e-3,
@@ -600,14 +610,13 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
       }
     });
   }
-  return absl::OkStatus();
 }
 
-grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerContext* context,
-                                                         const v1::ReplanRequest* request,
-                                                         v1::ReplanResponse* response) {
+grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
+    grpc::CallbackServerContext* context, const char* method,
+    std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work) {
   auto* reactor = new PlanReactor();
-  CallInfo call = StartCall(context, "Replan");
+  CallInfo call = StartCall(context, method);
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
@@ -619,25 +628,229 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerCon
                    options_.worker_threads, options_.max_queue)));
     return reactor;
   }
-  const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
+  const bool queued = pool_.TrySubmit([this, reactor, call, work = std::move(work)] {
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
-    const absl::Status status = RunReplan(call, *request, reactor->cancel(), response);
+    std::string detail;
+    const absl::Status status = work(call, reactor->cancel(), &detail);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     ReleaseSolve();
-    std::string detail;
-    if (status.ok()) {
-      detail = absl::StrFormat("plan=%s method=%s encounters=%d detours=%d new_ranks=%d",
-                               response->plan().plan_id(), response->replan().method(),
-                               response->replan().num_encounters(),
-                               response->replan().greedy_detours_size(), response->replan().new_ranks());
-    }
-    FinishCall(reactor, call, status, detail);
+    FinishCall(reactor, call, status, status.ok() ? detail : "");
   });
   if (!queued) {
     ReleaseSolve();
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
   return reactor;
+}
+
+namespace {
+std::string ReplanDetail(const v1::ReplanResponse& r) {
+  return absl::StrFormat("plan=%s method=%s encounters=%d detours=%d new_ranks=%d", r.plan().plan_id(),
+                         r.replan().method(), r.replan().num_encounters(), r.replan().greedy_detours_size(),
+                         r.replan().new_ranks());
+}
+}  // namespace
+
+grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerContext* context,
+                                                         const v1::ReplanRequest* request,
+                                                         v1::ReplanResponse* response) {
+  return ServeSolve(context, "Replan",
+                    [this, request, response](const CallInfo& call, const StopToken& cancel, std::string* detail) {
+                      absl::Status status = RunReplan(call, *request, cancel, response);
+                      if (status.ok()) *detail = ReplanDetail(*response);
+                      return status;
+                    });
+}
+
+grpc::ServerUnaryReactor* CoveragePlannerService::Resume(grpc::CallbackServerContext* context,
+                                                         const v1::ResumeRequest* request,
+                                                         v1::ReplanResponse* response) {
+  return ServeSolve(context, "Resume",
+                    [this, request, response](const CallInfo& call, const StopToken& cancel, std::string* detail) {
+                      absl::Status status = RunResume(call, *request, cancel, response);
+                      if (status.ok()) {
+                        *detail = absl::StrCat(ReplanDetail(*response), " from=", response->replan().progress_source());
+                      }
+                      return status;
+                    });
+}
+
+absl::Status CoveragePlannerService::RunResume(const CallInfo& call, const v1::ResumeRequest& request,
+                                               const StopToken& cancel, v1::ReplanResponse* response) {
+  const absl::Time start = absl::Now();
+  if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
+  if (call.deadline != absl::InfiniteFuture() && call.deadline - options_.deadline_margin <= start) {
+    return absl::DeadlineExceededError("the deadline left no time to resume");
+  }
+  if (request.plan_id().empty()) return absl::InvalidArgumentError("plan_id: required (the interrupted plan)");
+  if (!request.has_pose()) return absl::InvalidArgumentError("pose: required (where the robot is now)");
+  const Pose2 pose{request.pose().x(), request.pose().y(), request.pose().theta()};
+  ASSIGN_OR_RETURN(ReplanMethod method, ReplanMethodFromProto(request.method()));
+  ReplanOptions options;
+  options.method = method;
+  options.seed = request.seed();
+  options.stop = call.deadline != absl::InfiniteFuture()
+                     ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
+                     : cancel.WithEarlierDeadline(start + options_.max_request_time);
+  ResolvedPlan old;
+  RETURN_IF_ERROR(ResolvePlan(request.plan_id(), nullptr, options.stop, &old));
+  v1::RobotProgress at;
+  std::string source;
+  if (request.has_progress()) {
+    at = request.progress();
+    source = "request";
+  } else if (std::optional<v1::RobotProgress> recorded = RecordedProgress(request.plan_id())) {
+    at = *recorded;
+    source = "recorded";
+  } else {
+    at.set_distance_m(0.0);  // nothing reported: nothing counted as covered
+    source = "plan_start";
+  }
+  ASSIGN_OR_RETURN(RobotProgress progress, ProgressFromProto(at));
+  double rejoin_m = 0.0;
+  absl::StatusOr<ReplanResult> result = covplan::Resume(*old.plan, progress, pose,
+                                                        ObstaclesFromProto(request.obstacles()), options,
+                                                        &estimator_, &rejoin_m);
+  if (!result.ok()) {
+    if (source == "request" || !absl::IsInvalidArgument(result.status()) ||
+        absl::StartsWith(result.status().message(), "pose")) {
+      return result.status();
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat("the progress recorded for this plan (", source, ") no longer fits it: ",
+                     result.status().message()));
+  }
+  RecordProgress(request.plan_id(), at);
+  KeepReplan(std::move(*result), old, response);
+  response->mutable_replan()->set_progress_source(source);
+  response->mutable_replan()->set_rejoin_m(rejoin_m);
+  return absl::OkStatus();
+}
+
+// ---------------------------------------------------------------- sessions
+
+namespace {
+// Ends a Drive call at once (draining, or too many sessions).
+class RefusedDrive final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent> {
+ public:
+  explicit RefusedDrive(const grpc::Status& status) { Finish(status); }
+  void OnDone() override { delete this; }
+};
+}  // namespace
+
+grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* CoveragePlannerService::Drive(
+    grpc::CallbackServerContext* context) {
+  const CallInfo call = StartCall(context, "Drive");
+  if (draining()) {
+    metrics_->RecordRequest("Drive", "UNAVAILABLE", 0.0);
+    return new RefusedDrive(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
+  }
+  auto* session = new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id));
+  if (!sessions_.Add(session)) {
+    session->Unref();
+    metrics_->RecordRequest("Drive", "RESOURCE_EXHAUSTED", 0.0);
+    LogLine("warn", "drive session refused", {{"request_id", call.request_id}, {"detail", "too many sessions"}});
+    return new RefusedDrive(grpc::Status(
+        grpc::StatusCode::RESOURCE_EXHAUSTED,
+        absl::StrFormat("too many drive sessions (%d open, --max_sessions); retry later", options_.max_sessions)));
+  }
+  UpdateSessionGauge();
+  LogLine("info", "drive session started", {{"request_id", call.request_id}});
+  session->Start();
+  return session;
+}
+
+absl::StatusOr<CoveragePlannerService::AdoptedPlan> CoveragePlannerService::AdoptPlan(
+    const v1::DriveRequest& first, const StopToken& stop) {
+  const StopToken bounded = stop.WithEarlierDeadline(absl::Now() + options_.max_request_time);
+  ResolvedPlan resolved;
+  RETURN_IF_ERROR(ResolvePlan(first.plan_id(),
+                              first.plan_ref_case() == v1::DriveRequest::kPlan ? &first.plan() : nullptr, bounded,
+                              &resolved));
+  AdoptedPlan out;
+  out.grid = resolved.plan->plan.grid;
+  if (first.plan_ref_case() == v1::DriveRequest::kPlanId) {
+    out.plan_id = first.plan_id();
+    return out;
+  }
+  // An inline plan: retained under a new id so the session's replans name it.
+  auto retained = std::make_shared<RetainedPlan>(*resolved.plan);
+  retained->plan_id = NewPlanId();
+  out.plan_id = retained->plan_id;
+  if (resolved.has_origin) {
+    v1::PlanResponse proto;
+    RetainedPlanToProto(*retained, &proto);
+    PersistPlan(resolved.origin, proto);
+  }
+  plans_.Put(retained);
+  return out;
+}
+
+bool CoveragePlannerService::SubmitSolve(std::function<void()> work) {
+  if (draining() || !TryAdmitSolve()) return false;
+  const bool queued = pool_.TrySubmit([this, work = std::move(work)] {
+    metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    work();
+    metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
+    ReleaseSolve();
+  });
+  if (!queued) ReleaseSolve();
+  return queued;
+}
+
+void CoveragePlannerService::RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) {
+  if (plan_id.empty() || plan_id.size() > 64) return;
+  bool queue = false;
+  {
+    absl::MutexLock lock(&progress_mu_);
+    progress_[plan_id] = {++progress_clock_, progress};
+    progress_dirty_.insert(plan_id);
+    const size_t cap = 4 * options_.max_retained_plans + 64;
+    while (progress_.size() > cap) {
+      auto oldest = progress_.begin();
+      for (auto it = progress_.begin(); it != progress_.end(); ++it) {
+        if (it->second.first < oldest->second.first) oldest = it;
+      }
+      progress_dirty_.erase(oldest->first);
+      progress_.erase(oldest);
+    }
+    if (!progress_flush_queued_) queue = progress_flush_queued_ = true;
+  }
+  if (queue && !SubmitIo([this] { FlushProgress(); })) {
+    absl::MutexLock lock(&progress_mu_);
+    progress_flush_queued_ = false;  // the next report tries again
+  }
+}
+
+void CoveragePlannerService::FlushProgress() {
+  std::vector<std::pair<std::string, std::string>> writes;
+  {
+    absl::MutexLock lock(&progress_mu_);
+    for (const std::string& id : progress_dirty_) {
+      auto it = progress_.find(id);
+      if (it != progress_.end()) writes.emplace_back(id, it->second.second.SerializeAsString());
+    }
+    progress_dirty_.clear();
+    progress_flush_queued_ = false;
+  }
+  // Coalesced: reports that arrive while these are written are flushed by
+  // the next task.
+  for (const auto& [id, bytes] : writes) {
+    if (absl::Status s = store_->PutProgress(id, bytes); !s.ok()) {
+      LogLine("warn", "progress not persisted", {{"plan", id}, {"detail", std::string(s.message())}});
+    }
+  }
+}
+
+std::optional<v1::RobotProgress> CoveragePlannerService::RecordedProgress(const std::string& plan_id) {
+  {
+    absl::MutexLock lock(&progress_mu_);
+    if (auto it = progress_.find(plan_id); it != progress_.end()) return it->second.second;
+  }
+  absl::StatusOr<std::string> bytes = store_->GetProgress(plan_id);
+  v1::RobotProgress progress;
+  if (!bytes.ok() || !progress.ParseFromString(*bytes)) return std::nullopt;
+  return progress;
 }
 
 }  // namespace covplan

@@ -27,11 +27,15 @@
 #define COVPLAN_SERVER_SERVICE_H_
 
 #include <atomic>
-#include <deque>
-#include <utility>
 #include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
@@ -40,6 +44,7 @@
 #include "planner/engine/engine.h"
 #include "planner/replan/replanner.h"
 #include "server/artifact_lru.h"
+#include "server/drive_session.h"
 #include "server/map_store.h"
 #include "server/metrics.h"
 #include "server/plan_registry.h"
@@ -63,6 +68,10 @@ struct ServiceOptions {
   // resumes its mission with its plan_id after a restart; the newest this
   // many are kept.
   int64_t max_stored_plans = 4096;
+  // Drive streaming sessions: how many may be open, and how long one may go
+  // without a message before it is ended.
+  int max_sessions = 64;
+  absl::Duration session_idle = absl::Seconds(120);
 
   absl::Status Validate() const;
 };
@@ -101,10 +110,16 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   grpc::ServerUnaryReactor* Replan(grpc::CallbackServerContext* context,
                                    const v1::ReplanRequest* request,
                                    v1::ReplanResponse* response) override;
+  grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* Drive(
+      grpc::CallbackServerContext* context) override;
+  grpc::ServerUnaryReactor* Resume(grpc::CallbackServerContext* context,
+                                   const v1::ResumeRequest* request,
+                                   v1::ReplanResponse* response) override;
 
   void StartDraining() {
     draining_.store(true);
     background_stop_.Cancel();
+    sessions_.EndAll();
   }
   bool draining() const { return draining_.load(); }
   // Runs what is queued (cancelled calls finish quickly) and joins workers.
@@ -123,6 +138,28 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   absl::Status RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
                          const StopToken& cancel, v1::ReplanResponse* response);
   const ReplanEstimator& estimator() const { return estimator_; }
+  // The Resume work proper (runs on a worker).
+  absl::Status RunResume(const CallInfo& call, const v1::ResumeRequest& request,
+                         const StopToken& cancel, v1::ReplanResponse* response);
+
+  // For Drive sessions. A plan named by the session's first message, found
+  // (plan_id) or rebuilt and retained (inline), with its grid.
+  struct AdoptedPlan {
+    std::string plan_id;
+    std::shared_ptr<const Grid> grid;
+  };
+  absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first, const StopToken& stop);
+  // Runs `work` on the solve pool under the same admission bound as unary
+  // solves; false (and `work` dropped) when the server is full or draining.
+  bool SubmitSolve(std::function<void()> work);
+  // The robot's latest progress on a plan, kept in memory and written to the
+  // store off the caller's path (coalesced), for Resume.
+  void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress);
+  // The recorded progress, from memory or the store.
+  std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id);
+  void CountSuperseded() { metrics_->drive_superseded().Increment(); }
+  void UpdateSessionGauge() { metrics_->drive_sessions().Set(sessions_.size()); }
+  const SessionRegistry& sessions() const { return sessions_; }
 
  private:
   CallInfo StartCall(grpc::CallbackServerContext* context, const char* method);
@@ -147,6 +184,22 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // A retained plan from memory, or else from the store (after a restart).
   std::shared_ptr<const RetainedPlan> FindPlan(const std::string& plan_id, const StopToken& stop,
                                                v1::PlanRequest* origin);
+  // The plan a Replan / Resume / Drive continues: by id, or inline (rebuilt
+  // on its map), with the Plan request its mission started with.
+  struct ResolvedPlan {
+    std::shared_ptr<const RetainedPlan> plan;
+    v1::PlanRequest origin;
+    bool has_origin = false;  // on a stored map: its replans are persisted
+  };
+  absl::Status ResolvePlan(const std::string& plan_id, const v1::InlinePlan* inline_plan,
+                           const StopToken& stop, ResolvedPlan* out);
+  // Retains (and persists) a replan's result and fills the reply.
+  void KeepReplan(ReplanResult result, const ResolvedPlan& old, v1::ReplanResponse* response);
+  // A unary solve (Replan, Resume): admission, the pool, the reply.
+  grpc::ServerUnaryReactor* ServeSolve(
+      grpc::CallbackServerContext* context, const char* method,
+      std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work);
+  void FlushProgress();
 
   const ServiceOptions options_;
   MapStore* const store_;
@@ -171,6 +224,13 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // deadline-aware admission: a call whose expected queue wait would leave no
   // time to plan before its deadline is refused at once.
   std::atomic<int64_t> mean_solve_us_{0};
+  // Latest progress per plan (bounded), and those not yet written.
+  absl::Mutex progress_mu_;
+  std::map<std::string, std::pair<uint64_t, v1::RobotProgress>> progress_ ABSL_GUARDED_BY(progress_mu_);
+  std::set<std::string> progress_dirty_ ABSL_GUARDED_BY(progress_mu_);
+  bool progress_flush_queued_ ABSL_GUARDED_BY(progress_mu_) = false;
+  uint64_t progress_clock_ ABSL_GUARDED_BY(progress_mu_) = 0;
+  SessionRegistry sessions_;
   uint64_t id_salt_;
   StopToken background_stop_;  // cancelled when draining or shutting down
   // Last: their threads stop before the rest is destroyed.

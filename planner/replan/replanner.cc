@@ -505,4 +505,59 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   return out;
 }
 
+absl::Status ValidateObservations(const Grid& grid, const Observations& observations) {
+  return replan_internal::BlockedCells(grid, observations, CellIndex{-1, -1}).status();
+}
+
+absl::StatusOr<ReplanResult> Resume(const RetainedPlan& old, const RobotProgress& stopped_at,
+                                    const Pose2& robot, const Observations& observations,
+                                    const ReplanOptions& options, ReplanEstimator* estimator,
+                                    double* rejoin_m) {
+  const absl::Time start = absl::Now();
+  if (!std::isfinite(robot.x) || !std::isfinite(robot.y) || !std::isfinite(robot.theta)) {
+    return absl::InvalidArgumentError("pose: x, y and theta must be finite");
+  }
+  // The remainder from the stop point (its budgets count from there, which
+  // only leaves more time: the robot first drives back).
+  ASSIGN_OR_RETURN(ReplanResult out, Replan(old, stopped_at, observations, options, estimator));
+  if (out.plan.path.empty() || out.area == nullptr || out.area->drive == nullptr) {
+    return absl::InternalError("replan returned no path to resume");
+  }
+  const Grid& drive = *out.area->drive;
+  absl::StatusOr<CellIndex> joined = JoinCell(drive, robot, "pose");
+  if (!joined.ok()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "pose: the robot at (%.3f, %.3f) is neither in nor next to a free cell it can drive from",
+        robot.x, robot.y));
+  }
+  const Waypoint stop = out.plan.path.front();
+  std::vector<Waypoint> path = {{robot.x, robot.y, robot.theta, SegmentKind::kStart, -1}};
+  ASSIGN_OR_RETURN(bool routed, AppendRoute(drive, {robot.x, robot.y}, Pose2{stop.x, stop.y, stop.theta},
+                                            options.stop, &path));
+  if (!routed) return absl::DeadlineExceededError("no time left to route the robot back to where it stopped");
+  const Point2 reached{path.back().x, path.back().y};
+  if (std::hypot(reached.x - stop.x, reached.y - stop.y) > 1e-6) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "pose: the robot at (%.3f, %.3f) cannot reach where it stopped (%.3f, %.3f)", robot.x, robot.y,
+        stop.x, stop.y));
+  }
+  double back = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) back += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
+  if (rejoin_m != nullptr) *rejoin_m = back;
+  const int offset = static_cast<int>(path.size()) - 1;
+  for (size_t i = 1; i < out.plan.path.size(); ++i) path.push_back(out.plan.path[i]);
+  for (CoverageSweep& s : out.plan.sweeps) s.waypoint += offset;
+  out.plan.path = std::move(path);
+  PlanStats& s = out.plan.stats;
+  const PlanStats moved = ComputePathStats(out.plan.path, old.request.common.robot);
+  s.num_turns = moved.num_turns;
+  s.coverage_length_m = moved.coverage_length_m;
+  s.transition_length_m = moved.transition_length_m;
+  s.estimated_duration_s = moved.estimated_duration_s;
+  s.turning_time_s = moved.turning_time_s;
+  out.stats.total_ms = MsSince(start);
+  s.planning_ms = out.stats.total_ms;
+  return out;
+}
+
 }  // namespace covplan

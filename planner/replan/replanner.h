@@ -110,6 +110,22 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
                                     const Observations& observations, const ReplanOptions& options,
                                     ReplanEstimator* estimator);
 
+// The checks Replan applies to `observations` on a plan of `grid`'s size
+// (cells inside the grid, finite points, valid polygons), without planning.
+absl::Status ValidateObservations(const Grid& grid, const Observations& observations);
+
+// Resume an interrupted plan (battery swap, e-stop, restart): the robot
+// stopped at `stopped_at` on `old` and now stands at `robot` (anywhere in or
+// next to a free cell, e.g. on its dock). The plan drives from `robot` back
+// to where it stopped, then on over what it had not covered, replanning
+// around `observations` as Replan does. `rejoin_m` (optional) receives the
+// length of the drive back. InvalidArgument names `pose` when the robot is
+// off the grid or cannot reach the stop point.
+absl::StatusOr<ReplanResult> Resume(const RetainedPlan& old, const RobotProgress& stopped_at,
+                                    const Pose2& robot, const Observations& observations,
+                                    const ReplanOptions& options, ReplanEstimator* estimator,
+                                    double* rejoin_m = nullptr);
+
 }  // namespace covplan
 
 #endif  // COVPLAN_PLANNER_REPLAN_REPLANNER_H_

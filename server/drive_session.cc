@@ -1,0 +1,396 @@
+#include "server/drive_session.h"
+
+#include <utility>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "server/log.h"
+#include "server/service.h"
+
+namespace covplan {
+namespace {
+
+grpc::Status ToGrpcStatus(const absl::Status& status) {
+  if (status.ok()) return grpc::Status::OK;
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+}
+
+int ObstacleItems(const v1::Obstacles& o) { return o.cells_size() + o.points_size() + o.polygons_size(); }
+
+}  // namespace
+
+// What a reaction decided under the lock, done after releasing it (gRPC
+// operations are started without holding mu_, and Finish is the last touch).
+struct DriveSession::Actions {
+  const v1::DriveEvent* write = nullptr;
+  bool read = false;
+  bool finish = false;
+  grpc::Status status;
+};
+
+DriveSession::DriveSession(CoveragePlannerService* service, grpc::CallbackServerContext* context,
+                           SessionRegistry* registry, std::string session_id)
+    : service_(service), context_(context), registry_(registry), session_id_(std::move(session_id)) {}
+
+void DriveSession::Start() {
+  {
+    absl::MutexLock lock(&mu_);
+    last_message_ = absl::Now();
+  }
+  StartRead(&in_);
+}
+
+void DriveSession::Perform(const Actions& a) {
+  if (a.write != nullptr) StartWrite(a.write);
+  if (a.read) StartRead(&in_);
+  if (a.finish) Finish(a.status);  // may delete this (through OnDone): last
+}
+
+void DriveSession::OnReadDone(bool ok) {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    if (!ok) {
+      reads_done_ = true;  // the client closed its side (or the call ended)
+    } else {
+      last_message_ = absl::Now();
+      HandleMessage(&a);
+      a.read = !ending_;
+    }
+    CheckFinish(&a);
+  }
+  Perform(a);
+}
+
+void DriveSession::OnWriteDone(bool ok) {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    writing_ = false;
+    out_.pop_front();
+    if (!ok) {
+      EndLocked(grpc::Status(grpc::StatusCode::CANCELLED, "the client stopped reading"));
+    } else if (!out_.empty() && !ending_) {
+      writing_ = true;
+      a.write = &out_.front();
+    }
+    CheckFinish(&a);
+  }
+  Perform(a);
+}
+
+void DriveSession::OnCancel() {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    EndLocked(grpc::Status(grpc::StatusCode::CANCELLED, "session cancelled"));
+    CheckFinish(&a);
+  }
+  Perform(a);
+}
+
+void DriveSession::OnDone() {
+  LogLine("info", "drive session ended", {{"session", session_id_}});
+  registry_->Remove(this);
+  service_->UpdateSessionGauge();
+  Unref();
+}
+
+bool DriveSession::ExpireIfIdle(absl::Time idle_before) {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    if (finished_ || ending_ || running_ || last_message_ >= idle_before) return false;
+    EndLocked(grpc::Status(
+        grpc::StatusCode::DEADLINE_EXCEEDED,
+        absl::StrFormat("drive session idle for more than %g s without a message (--session_idle_s)",
+                        absl::ToDoubleSeconds(registry_->idle_timeout()))));
+    CheckFinish(&a);
+  }
+  Perform(a);
+  return true;
+}
+
+void DriveSession::End(const grpc::Status& status) {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    EndLocked(status);
+    CheckFinish(&a);
+  }
+  Perform(a);
+}
+
+void DriveSession::EndLocked(const grpc::Status& status) {
+  if (ending_ || finished_) return;
+  ending_ = true;
+  end_status_ = status;
+  running_stop_.Cancel();
+  pending_.reset();
+}
+
+void DriveSession::CheckFinish(Actions* a) {
+  if (finished_) return;
+  if (!ending_ && !reads_done_) return;  // the client may still send
+  if (running_ || writing_) return;      // a cancelled replan returns soon
+  if (!ending_ && (pending_.has_value() || !out_.empty())) return;
+  finished_ = true;
+  a->finish = true;
+  a->status = end_status_;
+}
+
+void DriveSession::Push(v1::DriveEvent event, Actions* a) {
+  if (ending_) return;
+  out_.push_back(std::move(event));
+  if (!writing_) {
+    writing_ = true;
+    a->write = &out_.front();
+  }
+}
+
+void DriveSession::PushError(uint64_t sequence, const absl::Status& status, Actions* a) {
+  v1::DriveEvent event;
+  event.set_sequence(sequence);
+  event.mutable_error()->set_code(static_cast<int32_t>(status.code()));
+  event.mutable_error()->set_message(std::string(status.message()));
+  Push(std::move(event), a);
+}
+
+bool DriveSession::KnowsPlan(const std::string& plan_id) const {
+  for (const std::string& p : plans_) {
+    if (p == plan_id) return true;
+  }
+  return false;
+}
+
+void DriveSession::HandleMessage(Actions* a) {
+  const uint64_t seq = in_.sequence();
+  if (!started_) {
+    started_ = true;
+    if (in_.plan_ref_case() == v1::DriveRequest::PLAN_REF_NOT_SET) {
+      EndLocked(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                             "the first DriveRequest needs plan_id or an inline plan"));
+      return;
+    }
+    if (absl::StatusOr<ReplanMethod> m = ReplanMethodFromProto(in_.method()); !m.ok()) {
+      EndLocked(ToGrpcStatus(m.status()));
+      return;
+    }
+    first_ = in_;
+    first_.clear_obstacles();
+    pending_ = Job{/*start=*/true, seq, "", {}, {}};
+    StartJob(a);
+    if (ObstacleItems(in_.obstacles()) == 0) return;
+    // Obstacles in the first message: replanned once the plan is adopted.
+  } else if (in_.plan_ref_case() == v1::DriveRequest::kPlan) {
+    PushError(seq, absl::InvalidArgumentError("only the first DriveRequest may carry an inline plan"), a);
+    return;
+  }
+  std::string plan_id = in_.plan_id();
+  if (!plan_id.empty() && !KnowsPlan(plan_id) && !(adopted_ == false && plan_id == first_.plan_id())) {
+    PushError(seq,
+              absl::InvalidArgumentError(absl::StrCat("plan_id '", plan_id.substr(0, 80),
+                                                      "' is not a plan of this session")),
+              a);
+    return;
+  }
+  const int items = ObstacleItems(in_.obstacles());
+  if (items == 0) {
+    // A progress report: kept for Resume.
+    if (in_.has_progress()) {
+      if (plan_id.empty() && !plans_.empty()) plan_id = plans_.back();
+      if (plan_id.empty() && first_.plan_ref_case() == v1::DriveRequest::kPlanId) plan_id = first_.plan_id();
+      if (!plan_id.empty()) service_->RecordProgress(plan_id, in_.progress());
+    }
+    return;
+  }
+  if (seen_items_ + items > kMaxObstacleItems) {
+    PushError(seq,
+              absl::ResourceExhaustedError(absl::StrFormat(
+                  "a drive session accepts at most %d obstacle items (cells, points, polygons); "
+                  "this one has %d and the message adds %d",
+                  kMaxObstacleItems, seen_items_, items)),
+              a);
+    return;
+  }
+  if (absl::Status s = CheckObservation(in_.obstacles()); !s.ok()) {
+    PushError(seq, s, a);
+    return;
+  }
+  seen_.MergeFrom(in_.obstacles());
+  seen_items_ += items;
+  Job job{/*start=*/false, seq, plan_id, in_.progress(), {}};
+  if (pending_.has_value() && !pending_->start) {
+    job.superseded = std::move(pending_->superseded);
+    job.superseded.push_back(pending_->sequence);
+    pending_.reset();
+  }
+  if (running_ && !running_start_) {
+    running_stop_.Cancel();  // superseded: its result will not be pushed
+    job.superseded.push_back(running_sequence_);
+  }
+  pending_ = std::move(job);
+  if (!running_) StartJob(a);
+}
+
+absl::Status DriveSession::CheckObservation(const v1::Obstacles& obstacles) const {
+  Observations seen = ObstaclesFromProto(obstacles);
+  if (grid_ != nullptr) return ValidateObservations(*grid_, seen);
+  // Before the plan is adopted only the grid-free checks apply (finite
+  // points, valid polygons); the replan checks the cells.
+  seen.cells.clear();
+  return ValidateObservations(Grid(1, 1, 1.0, {0.0, 0.0}, {1}), seen);
+}
+
+void DriveSession::StartJob(Actions* a) {
+  if (!pending_.has_value() || running_ || ending_) return;
+  Job job = std::move(*pending_);
+  pending_.reset();
+  if (!job.start && job.plan_id.empty() && !plans_.empty()) job.plan_id = plans_.back();
+  running_ = true;
+  running_start_ = job.start;
+  running_sequence_ = job.sequence;
+  running_stop_ = StopToken();
+  const StopToken stop = running_stop_;
+  v1::DriveRequest first = first_;
+  v1::Obstacles seen = seen_;
+  Ref();  // held by the worker
+  const bool queued = service_->SubmitSolve([this, job, first = std::move(first), seen = std::move(seen), stop] {
+    RunJob(job, first, seen, stop);
+    Unref();
+  });
+  if (!queued) {
+    running_ = false;
+    Unref();  // not the last: gRPC holds one until OnDone
+    const absl::Status busy = absl::ResourceExhaustedError(
+        "server busy: no worker free for this session's replan; the obstacles are kept for the next one");
+    if (job.start) {
+      EndLocked(ToGrpcStatus(busy));
+    } else {
+      PushError(job.sequence, busy, a);
+    }
+  }
+}
+
+void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen,
+                          const StopToken& stop) {
+  v1::DriveEvent event;
+  event.set_sequence(job.sequence);
+  absl::Status status;
+  std::shared_ptr<const Grid> grid;
+  std::string adopted;
+  if (job.start) {
+    absl::StatusOr<CoveragePlannerService::AdoptedPlan> plan = service_->AdoptPlan(first, stop);
+    status = plan.status();
+    if (plan.ok()) {
+      adopted = plan->plan_id;
+      grid = plan->grid;
+      v1::DriveReady* ready = event.mutable_ready();
+      ready->set_session_id(session_id_);
+      ready->set_plan_id(adopted);
+      ready->set_idle_timeout_s(absl::ToDoubleSeconds(registry_->idle_timeout()));
+    }
+  } else {
+    v1::ReplanRequest request;
+    request.set_plan_id(job.plan_id);
+    *request.mutable_progress() = job.progress;
+    *request.mutable_obstacles() = seen;
+    request.set_method(first.method());
+    request.set_seed(first.seed());
+    CallInfo call;
+    call.method = "Drive";
+    call.start = absl::Now();
+    call.request_id = absl::StrCat(session_id_, "/", job.sequence);
+    status = service_->RunReplan(call, request, stop, event.mutable_replan());
+  }
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    running_ = false;
+    if (job.start) {
+      if (!status.ok()) {
+        EndLocked(ToGrpcStatus(status));
+      } else {
+        adopted_ = true;
+        grid_ = grid;
+        plans_.push_back(adopted);
+        Push(std::move(event), &a);
+      }
+    } else if (pending_.has_value()) {
+      service_->CountSuperseded();  // a newer observation waits: this result is stale
+    } else if (!status.ok()) {
+      PushError(job.sequence, status, &a);
+    } else {
+      plans_.push_back(event.replan().plan().plan_id());
+      while (plans_.size() > kMaxSessionPlans) plans_.pop_front();
+      for (uint64_t s : job.superseded) event.add_superseded(s);
+      Push(std::move(event), &a);
+    }
+    StartJob(&a);
+    CheckFinish(&a);
+  }
+  Perform(a);
+}
+
+// ---------------------------------------------------------------- registry
+
+SessionRegistry::SessionRegistry(int max_sessions, absl::Duration idle_timeout)
+    : max_sessions_(max_sessions), idle_timeout_(idle_timeout), reaper_([this] { Reap(); }) {}
+
+SessionRegistry::~SessionRegistry() {
+  {
+    absl::MutexLock lock(&mu_);
+    stop_ = true;
+  }
+  reaper_.join();
+}
+
+bool SessionRegistry::Add(DriveSession* session) {
+  absl::MutexLock lock(&mu_);
+  if (static_cast<int>(sessions_.size()) >= max_sessions_) return false;
+  sessions_.insert(session);
+  return true;
+}
+
+void SessionRegistry::Remove(DriveSession* session) {
+  absl::MutexLock lock(&mu_);
+  sessions_.erase(session);
+}
+
+int SessionRegistry::size() const {
+  absl::MutexLock lock(&mu_);
+  return static_cast<int>(sessions_.size());
+}
+
+std::vector<DriveSession*> SessionRegistry::Snapshot() {
+  absl::MutexLock lock(&mu_);
+  std::vector<DriveSession*> out(sessions_.begin(), sessions_.end());
+  for (DriveSession* s : out) s->Ref();  // kept alive while inspected
+  return out;
+}
+
+void SessionRegistry::EndAll() {
+  for (DriveSession* s : Snapshot()) {
+    s->End(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
+    s->Unref();
+  }
+}
+
+void SessionRegistry::Reap() {
+  const absl::Duration tick = std::min(absl::Seconds(1), idle_timeout_ / 4);
+  for (;;) {
+    {
+      absl::MutexLock lock(&mu_);
+      if (mu_.AwaitWithTimeout(absl::Condition(&stop_), tick)) return;
+    }
+    const absl::Time idle_before = absl::Now() - idle_timeout_;
+    for (DriveSession* s : Snapshot()) {
+      s->ExpireIfIdle(idle_before);
+      s->Unref();
+    }
+  }
+}
+
+}  // namespace covplan

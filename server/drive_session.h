@@ -1,0 +1,163 @@
+// The Drive streaming session (covplan.v1.CoveragePlanner/Drive): a robot
+// streams progress and obstacle observations while it drives; the server
+// pushes a new plan whenever one is ready.
+//
+// One DriveSession per call, on gRPC's callback API: reads, writes and the
+// end of the call are driven by gRPC's reactions and by solves that run on
+// the service's worker pool (never on a gRPC thread). At most one replan of a
+// session runs at a time. An observation that arrives while one runs cancels
+// it (its StopToken) and waits: when the worker returns, the newest
+// observation is replanned with every obstacle the session has seen, so a
+// superseded observation loses nothing; its replan is simply not pushed.
+//
+// Sessions are bounded: SessionRegistry refuses sessions beyond its limit,
+// and its reaper ends sessions idle longer than the idle timeout with
+// DEADLINE_EXCEEDED. A client that goes away cancels the call, which cancels
+// the running replan and frees the session.
+//
+// Lifetime: gRPC holds one reference until OnDone; the reaper takes a
+// reference while it inspects a session, so a session is deleted by
+// whichever drops the last one.
+//
+// Thread-safety: all state is guarded by the session's mutex; gRPC
+// operations are started with it held and Finish() only without it.
+#ifndef COVPLAN_SERVER_DRIVE_SESSION_H_
+#define COVPLAN_SERVER_DRIVE_SESSION_H_
+
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "covplan/v1/covplan.grpc.pb.h"
+#include "planner/common/stop_token.h"
+#include "planner/grid/grid.h"
+
+namespace covplan {
+
+class CoveragePlannerService;
+class SessionRegistry;
+
+class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent> {
+ public:
+  // Most obstacle items (cells + points + polygons) one session may report.
+  static constexpr int kMaxObstacleItems = 20000;
+  // Most plans of a session that later messages may name.
+  static constexpr size_t kMaxSessionPlans = 64;
+
+  DriveSession(CoveragePlannerService* service, grpc::CallbackServerContext* context,
+               SessionRegistry* registry, std::string session_id);
+
+  // Starts reading (after the registry admitted the session).
+  void Start();
+
+  void OnReadDone(bool ok) override;
+  void OnWriteDone(bool ok) override;
+  void OnCancel() override;
+  void OnDone() override;
+
+  // Called by the reaper: ends the session if it has been idle since before
+  // `idle_before`. Returns true when it did.
+  bool ExpireIfIdle(absl::Time idle_before);
+  // Ends the session with `status` (server draining).
+  void End(const grpc::Status& status);
+
+  void Ref() { refs_.fetch_add(1); }
+  void Unref() {
+    if (refs_.fetch_sub(1) == 1) delete this;
+  }
+
+ private:
+  struct Job {
+    bool start = false;              // adopt the first message's plan
+    uint64_t sequence = 0;
+    std::string plan_id;             // the plan the progress refers to ("" = newest)
+    v1::RobotProgress progress;
+    std::vector<uint64_t> superseded;
+  };
+  struct Actions;
+
+  ~DriveSession() override = default;
+  void Perform(const Actions& a);
+  // Handles in_ (the message just read).
+  void HandleMessage(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  absl::Status CheckObservation(const v1::Obstacles& obstacles) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  bool KnowsPlan(const std::string& plan_id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void StartJob(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen, const StopToken& stop);
+  void Push(v1::DriveEvent event, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void PushError(uint64_t sequence, const absl::Status& status, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Stops taking input and pushing events; the call ends with `status`.
+  void EndLocked(const grpc::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Finishes the call once no replan runs and nothing is being written.
+  void CheckFinish(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+
+  CoveragePlannerService* const service_;
+  grpc::CallbackServerContext* const context_;
+  SessionRegistry* const registry_;
+  const std::string session_id_;
+  std::atomic<int> refs_{1};
+
+  mutable absl::Mutex mu_;
+  v1::DriveRequest in_ ABSL_GUARDED_BY(mu_);
+  std::deque<v1::DriveEvent> out_ ABSL_GUARDED_BY(mu_);  // front: being written
+  bool writing_ ABSL_GUARDED_BY(mu_) = false;
+  bool started_ ABSL_GUARDED_BY(mu_) = false;    // the first message was read
+  bool adopted_ ABSL_GUARDED_BY(mu_) = false;    // its plan was found
+  bool reads_done_ ABSL_GUARDED_BY(mu_) = false;
+  bool ending_ ABSL_GUARDED_BY(mu_) = false;     // cancelled, expired or failed: push nothing more
+  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+  grpc::Status end_status_ ABSL_GUARDED_BY(mu_);
+  v1::DriveRequest first_ ABSL_GUARDED_BY(mu_);  // method, seed, plan_ref
+  std::shared_ptr<const Grid> grid_ ABSL_GUARDED_BY(mu_);  // the plans' grid (for checks)
+  std::deque<std::string> plans_ ABSL_GUARDED_BY(mu_);     // newest last
+  v1::Obstacles seen_ ABSL_GUARDED_BY(mu_);
+  int seen_items_ ABSL_GUARDED_BY(mu_) = 0;
+  std::optional<Job> pending_ ABSL_GUARDED_BY(mu_);
+  bool running_ ABSL_GUARDED_BY(mu_) = false;
+  bool running_start_ ABSL_GUARDED_BY(mu_) = false;
+  uint64_t running_sequence_ ABSL_GUARDED_BY(mu_) = 0;
+  StopToken running_stop_ ABSL_GUARDED_BY(mu_);
+  absl::Time last_message_ ABSL_GUARDED_BY(mu_);
+};
+
+// The live sessions of a service: a bound on their number and a reaper
+// thread that ends idle ones.
+//
+// Thread-safety: all methods are thread-safe.
+class SessionRegistry {
+ public:
+  SessionRegistry(int max_sessions, absl::Duration idle_timeout);
+  ~SessionRegistry();  // stops the reaper; sessions must have ended
+
+  // False when `max_sessions` are open.
+  bool Add(DriveSession* session);
+  void Remove(DriveSession* session);
+  int size() const;
+  absl::Duration idle_timeout() const { return idle_timeout_; }
+  // Ends every open session with UNAVAILABLE (the server is draining).
+  void EndAll();
+
+ private:
+  void Reap();
+  // The open sessions, each with a reference the caller drops.
+  std::vector<DriveSession*> Snapshot();
+
+  const int max_sessions_;
+  const absl::Duration idle_timeout_;
+  mutable absl::Mutex mu_;
+  std::set<DriveSession*> sessions_ ABSL_GUARDED_BY(mu_);
+  bool stop_ ABSL_GUARDED_BY(mu_) = false;
+  std::thread reaper_;
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_SERVER_DRIVE_SESSION_H_
