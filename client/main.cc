@@ -3,9 +3,10 @@
 //   covplan plan --map FILE [--resolution M] [--tool-width M] [--local | --server HOST:PORT]
 //                [--out plan.json] [--svg plan.svg] ...
 //   covplan replan --server HOST:PORT --plan-id P --waypoint K --at X,Y --obstacle "x,y ..."
+//   covplan resume --server HOST:PORT --plan-id P --at X,Y[,THETA] [--distance D]
 //   covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S] [--deadline-ms D]
 //   covplan gtsp ...
-//   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local]
+//   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local | --server H:P]
 //
 // Subcommands parse their own flags (client/args.h); no global flags.
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "client/plan_command.h"
 #include "client/replan_command.h"
 #include "client/simulate_command.h"
+#include "client/simulate_remote.h"
 
 namespace {
 
@@ -25,6 +27,7 @@ constexpr char kUsage[] =
     "commands:\n"
     "  plan   plan a coverage path (--local or through a server); writes plan.json / SVG\n"
     "  replan report new obstacles for a retained plan; get the replanned remainder\n"
+    "  resume continue an interrupted plan from where the robot is now\n"
     "  load   load-test a server's Plan method; prints one JSON object\n"
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
     "  simulate  drive a plan through the true map, replanning on new obstacles; prints JSON\n"
@@ -41,9 +44,10 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 2, argv + argc);
   if (command == "plan") return covplan::RunPlanCommand(args);
   if (command == "replan") return covplan::RunReplanCommand(args);
+  if (command == "resume") return covplan::RunResumeCommand(args);
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
-  if (command == "simulate") return covplan::RunSimulateCommand(args);
+  if (command == "simulate") return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

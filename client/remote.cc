@@ -64,4 +64,75 @@ absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest
   return response;
 }
 
+absl::StatusOr<v1::ReplanResponse> RemotePlanner::Resume(const v1::ResumeRequest& request,
+                                                         std::optional<absl::Duration> timeout) {
+  grpc::ClientContext context;
+  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
+  v1::ReplanResponse response;
+  if (absl::Status s = FromGrpc(impl_->stub->Resume(&context, request, &response)); !s.ok()) {
+    return s;
+  }
+  return response;
+}
+
+struct RemotePlanner::DriveSession::Stream {
+  grpc::ClientContext context;
+  std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> rw;
+};
+
+RemotePlanner::DriveSession::DriveSession(std::unique_ptr<Stream> stream) : stream_(std::move(stream)) {}
+
+RemotePlanner::DriveSession::~DriveSession() {
+  if (!closed_) {
+    stream_->context.TryCancel();
+    stream_->rw->Finish().ok();
+  }
+}
+
+absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(const v1::DriveRequest& first) {
+  auto stream = std::make_unique<DriveSession::Stream>();
+  stream->rw = impl_->stub->Drive(&stream->context);
+  std::unique_ptr<DriveSession> session(new DriveSession(std::move(stream)));
+  v1::DriveEvent event;
+  if (!session->stream_->rw->Write(first) || !session->stream_->rw->Read(&event)) {
+    session->closed_ = true;
+    const absl::Status s = FromGrpc(session->stream_->rw->Finish());
+    return s.ok() ? absl::UnavailableError("the drive session ended before it was ready") : s;
+  }
+  if (!event.has_ready()) return absl::InternalError("the drive session's first event is not `ready`");
+  session->ready_ = event.ready();
+  return session;
+}
+
+absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(const v1::DriveRequest& request) {
+  if (closed_) return absl::FailedPreconditionError("the drive session is closed");
+  if (!stream_->rw->Write(request)) {
+    const absl::Status s = Close();
+    return s.ok() ? absl::UnavailableError("the drive session ended") : s;
+  }
+  v1::DriveEvent event;
+  while (stream_->rw->Read(&event)) {
+    if (event.sequence() == request.sequence()) return event;
+  }
+  closed_ = true;
+  const absl::Status s = FromGrpc(stream_->rw->Finish());
+  return s.ok() ? absl::UnavailableError("the drive session ended before answering") : s;
+}
+
+absl::Status RemotePlanner::DriveSession::Report(const v1::DriveRequest& request) {
+  if (closed_) return absl::FailedPreconditionError("the drive session is closed");
+  if (!stream_->rw->Write(request)) return absl::UnavailableError("the drive session ended");
+  return absl::OkStatus();
+}
+
+absl::Status RemotePlanner::DriveSession::Close() {
+  if (closed_) return absl::OkStatus();
+  closed_ = true;
+  stream_->rw->WritesDone();
+  v1::DriveEvent event;
+  while (stream_->rw->Read(&event)) {
+  }
+  return FromGrpc(stream_->rw->Finish());
+}
+
 }  // namespace covplan

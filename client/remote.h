@@ -32,6 +32,30 @@ class RemotePlanner {
                                         std::optional<absl::Duration> timeout);
   absl::StatusOr<v1::ReplanResponse> Replan(const v1::ReplanRequest& request,
                                             std::optional<absl::Duration> timeout);
+  absl::StatusOr<v1::ReplanResponse> Resume(const v1::ResumeRequest& request,
+                                            std::optional<absl::Duration> timeout);
+
+  // A Drive session, driven synchronously: Open sends the first message and
+  // waits for the ready event; Observe sends an observation and waits for the
+  // event that answers it; Report sends progress only.
+  class DriveSession {
+   public:
+    ~DriveSession();  // cancels the call if Close was not called
+    const v1::DriveReady& ready() const { return ready_; }
+    absl::StatusOr<v1::DriveEvent> Observe(const v1::DriveRequest& request);
+    absl::Status Report(const v1::DriveRequest& request);
+    // Half-closes and returns the call's final status.
+    absl::Status Close();
+
+   private:
+    friend class RemotePlanner;
+    struct Stream;
+    explicit DriveSession(std::unique_ptr<Stream> stream);
+    std::unique_ptr<Stream> stream_;
+    v1::DriveReady ready_;
+    bool closed_ = false;
+  };
+  absl::StatusOr<std::unique_ptr<DriveSession>> Drive(const v1::DriveRequest& first);
 
  private:
   struct Impl;

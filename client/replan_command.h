@@ -18,6 +18,9 @@ namespace covplan {
 
 // Returns the process exit code; errors go to stderr.
 int RunReplanCommand(const std::vector<std::string>& args);
+// `covplan resume` (the Resume RPC): continue plan P from where the robot is
+// now, over what it had not covered.
+int RunResumeCommand(const std::vector<std::string>& args);
 
 // The human summary printed to stdout.
 std::string FormatReplanSummary(const v1::ReplanResponse& response);

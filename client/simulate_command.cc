@@ -27,7 +27,7 @@ constexpr char kUsage[] =
     "usage: covplan simulate --map KNOWN [--resolution M] [--tool-width M]\n"
     "                        (--true-map TRUE | --clutter PCT) [--seed N]\n"
     "                        [--method auto|ilp1|ilp2|greedy_detour|full] [--sensor-range M]\n"
-    "                        [--local] [--svg run.svg] [--time-limit S] [--step S]\n"
+    "                        [--local | --server HOST:PORT] [--svg run.svg] [--time-limit S] [--step S]\n"
     "                        [--replan-tour-limit S] [--clutter-may-disconnect]\n"
     "                        [--no-offline-bound]\n"
     "                        [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
@@ -50,10 +50,12 @@ constexpr char kUsage[] =
     "Maps are map_server .yaml files or bare .pgm/.png images (these need\n"
     "--resolution; --free-thresh, --occupied-thresh and --negate apply to them, a\n"
     "YAML names its own). Both maps must have the same size, resolution and origin.\n"
-    "Only --local (in-process, the default) is implemented: running against a server\n"
-    "needs the streaming replanning session, which does not exist yet, so --server\n"
-    "is refused. --svg draws the true map, the driven path, the replan points (blue)\n"
-    "and the obstacle cells found (red).\n";
+    "--local (the default) plans and replans in process. --server HOST:PORT asks that\n"
+    "server instead: PutMap and Plan for the known map, then one Drive session in which\n"
+    "every replan is an observation; the compute time charged then includes the network\n"
+    "and the server's queue (the offline bounds are still computed locally).\n"
+    "--svg draws the true map, the driven path, the replan points (blue) and the\n"
+    "obstacle cells found (red).\n";
 
 std::string JsonString(const std::string& s) {
   std::string out = "\"";
@@ -110,18 +112,16 @@ std::string RenderRunSvg(const OccupancyMap& truth, const Grid& grid, const Simu
 
 }  // namespace
 
-absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args) {
+absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
+                                                const RemotePlanSourceFactory& make_remote) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args,
                              {"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
                               "sensor-range", "svg", "time-limit", "step", "max-speed", "acceleration",
                               "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit"},
                              {"local", "negate", "clutter-may-disconnect", "no-offline-bound"}));
-  if (a.Get("server")) {
-    return absl::InvalidArgumentError(
-        "--server is not available yet: simulating against a server needs the streaming "
-        "replanning session, which does not exist yet; use --local");
-  }
+  if (a.Get("server") && a.Has("local")) return absl::InvalidArgumentError("give --local or --server, not both");
+  if (a.Get("server") && a.Get("server")->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
   if (!a.Get("map")) return absl::InvalidArgumentError("--map KNOWN is required");
   if (a.Get("true-map").has_value() == a.Get("clutter").has_value()) {
     return absl::InvalidArgumentError("give exactly one of --true-map TRUE and --clutter PCT");
@@ -177,7 +177,17 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     ASSIGN_OR_RETURN(truth, AddClutter(known, *percent, o.seed, clutter));
     truth_name = absl::StrFormat("clutter %g %% seed %d", *percent, o.seed);
   }
-  ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o));
+  std::unique_ptr<PlanSource> remote;
+  if (auto server = a.Get("server")) {
+    if (!make_remote) return absl::InvalidArgumentError("--server is not available in this build");
+    SimulateMapFlags flags;
+    flags.resolution = resolution;
+    flags.free_thresh = free_thresh;
+    flags.occupied_thresh = occupied_thresh;
+    flags.negate = load.negate;
+    ASSIGN_OR_RETURN(remote, make_remote(*server, *a.Get("map"), flags, o));
+  }
+  ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o, remote.get()));
   OfflineBound bound, cell_bound;
   bound.duration_s = bound.covered_free_area_ratio = cell_bound.duration_s = std::nan("");
   if (!a.Has("no-offline-bound")) {
@@ -208,6 +218,7 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     absl::StrAppend(&json, json.size() > 1 ? ", " : "", "\"", name, "\": ", value);
   };
   field("method", JsonString(ReplanMethodName(o.method)));
+  field("planner_at", JsonString(a.Get("server") ? absl::StrCat("server ", *a.Get("server")) : "local"));
   field("true_map", JsonString(truth_name));
   field("total_time_s", JsonNumber(r.total_time_s));
   field("drive_time_s", JsonNumber(r.drive_time_s));
@@ -235,16 +246,21 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
 
 namespace {
 
+const RemotePlanSourceFactory* g_remote = nullptr;
+
 absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(std::string json, SimulateCommandJson(args));
+  ASSIGN_OR_RETURN(std::string json, SimulateCommandJson(args, g_remote != nullptr ? *g_remote : nullptr));
   std::printf("%s\n", json.c_str());
   return absl::OkStatus();
 }
 
 }  // namespace
 
-int RunSimulateCommand(const std::vector<std::string>& args) {
-  return RunSubcommand("simulate", kUsage, args, &Run);
+int RunSimulateCommand(const std::vector<std::string>& args, const RemotePlanSourceFactory& remote) {
+  g_remote = &remote;
+  const int rc = RunSubcommand("simulate", kUsage, args, &Run);
+  g_remote = nullptr;
+  return rc;
 }
 
 }  // namespace covplan

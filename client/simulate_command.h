@@ -8,27 +8,44 @@
 //       --method auto --local --svg run.svg
 //   covplan simulate --map lab_ipa.png --resolution 0.05 --free-thresh 0.021 --clutter 10 --seed 3
 //
-// Only in-process simulation (--local) exists: a server-side run needs the
-// streaming replanning session, which the server does not offer yet.
-// This unit has no gRPC or protobuf dependency (the simulator tests build it).
+// --local (default) plans and replans in process; --server HOST:PORT runs the
+// same simulation against a server through a Drive session
+// (client/simulate_remote.h).
 // Thread-safety: not applicable (command entry points).
 #ifndef COVPLAN_CLIENT_SIMULATE_COMMAND_H_
 #define COVPLAN_CLIENT_SIMULATE_COMMAND_H_
 
+#include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "planner/sim/simulator.h"
 
 namespace covplan {
 
+// The map flags, as given (for a server that reads the map file itself).
+struct SimulateMapFlags {
+  std::optional<double> resolution, free_thresh, occupied_thresh;
+  bool negate = false;
+};
+// Makes the PlanSource of --server HOST:PORT for the known map file. The
+// covplan binary passes client/simulate_remote.h's; without one, --server is
+// refused. (This unit stays free of gRPC: the simulator tests compile it.)
+using RemotePlanSourceFactory = std::function<absl::StatusOr<std::unique_ptr<PlanSource>>(
+    const std::string& target, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const SimulationOptions& options)>;
+
 // Returns the process exit code; the JSON goes to stdout, errors to stderr.
-int RunSimulateCommand(const std::vector<std::string>& args);
+int RunSimulateCommand(const std::vector<std::string>& args, const RemotePlanSourceFactory& remote = nullptr);
 
 // Parses the flags, runs the simulation and the offline lower bound, writes
 // --svg if asked, and returns the JSON object RunSimulateCommand prints.
 // InvalidArgument for bad flags or maps.
-absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args);
+absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
+                                                const RemotePlanSourceFactory& remote = nullptr);
 
 }  // namespace covplan
 

@@ -180,7 +180,7 @@ void DriveSession::HandleMessage(Actions* a) {
     }
     first_ = in_;
     first_.clear_obstacles();
-    pending_ = Job{/*start=*/true, seq, "", {}, {}};
+    pending_ = Job{/*start=*/true, seq, "", {}, v1::REPLAN_METHOD_UNSPECIFIED, {}};
     StartJob(a);
     if (ObstacleItems(in_.obstacles()) == 0) return;
     // Obstacles in the first message: replanned once the plan is adopted.
@@ -219,9 +219,13 @@ void DriveSession::HandleMessage(Actions* a) {
     PushError(seq, s, a);
     return;
   }
+  if (absl::StatusOr<ReplanMethod> m = ReplanMethodFromProto(in_.method()); !m.ok()) {
+    PushError(seq, m.status(), a);
+    return;
+  }
   seen_.MergeFrom(in_.obstacles());
   seen_items_ += items;
-  Job job{/*start=*/false, seq, plan_id, in_.progress(), {}};
+  Job job{/*start=*/false, seq, plan_id, in_.progress(), in_.method(), {}};
   if (pending_.has_value() && !pending_->start) {
     job.superseded = std::move(pending_->superseded);
     job.superseded.push_back(pending_->sequence);
@@ -297,13 +301,15 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     request.set_plan_id(job.plan_id);
     *request.mutable_progress() = job.progress;
     *request.mutable_obstacles() = seen;
-    request.set_method(first.method());
+    request.set_method(job.method != v1::REPLAN_METHOD_UNSPECIFIED ? job.method : first.method());
     request.set_seed(first.seed());
     CallInfo call;
-    call.method = "Drive";
+    call.method = "Drive.Replan";
     call.start = absl::Now();
     call.request_id = absl::StrCat(session_id_, "/", job.sequence);
     status = service_->RunReplan(call, request, stop, event.mutable_replan());
+    service_->RecordCall(call, status,
+                         status.ok() ? ReplanDetail(event.replan()) : std::string(status.message()));
   }
   Actions a;
   {

@@ -80,6 +80,7 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
     uint64_t sequence = 0;
     std::string plan_id;             // the plan the progress refers to ("" = newest)
     v1::RobotProgress progress;
+    v1::ReplanMethod method = v1::REPLAN_METHOD_UNSPECIFIED;  // unset: the session's
     std::vector<uint64_t> superseded;
   };
   struct Actions;

@@ -149,6 +149,12 @@ CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
 
 void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
                                         const absl::Status& status, const std::string& detail) {
+  RecordCall(call, status, detail);
+  reactor->Finish(ToGrpc(status));
+}
+
+void CoveragePlannerService::RecordCall(const CallInfo& call, const absl::Status& status,
+                                        const std::string& detail) {
   const absl::Time now = absl::Now();
   const double seconds = absl::ToDoubleSeconds(now - call.start);
   metrics_->RecordRequest(call.method, CodeName(status), seconds);
@@ -160,7 +166,6 @@ void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const
            {"ms", absl::StrFormat("%.1f", seconds * 1e3)},
            {"late", late ? "true" : "false"},
            {"detail", status.ok() ? detail : std::string(status.message())}});
-  reactor->Finish(ToGrpc(status));
 }
 
 bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
@@ -643,13 +648,11 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
   return reactor;
 }
 
-namespace {
 std::string ReplanDetail(const v1::ReplanResponse& r) {
   return absl::StrFormat("plan=%s method=%s encounters=%d detours=%d new_ranks=%d", r.plan().plan_id(),
                          r.replan().method(), r.replan().num_encounters(), r.replan().greedy_detours_size(),
                          r.replan().new_ranks());
 }
-}  // namespace
 
 grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerContext* context,
                                                          const v1::ReplanRequest* request,

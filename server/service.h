@@ -84,6 +84,9 @@ struct CallInfo {
   absl::Time deadline = absl::InfiniteFuture();
 };
 
+// One log line's summary of a replan reply.
+std::string ReplanDetail(const v1::ReplanResponse& response);
+
 class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService {
  public:
   CoveragePlannerService(const ServiceOptions& options, MapStore* store, ServerMetrics* metrics);
@@ -127,6 +130,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
 
   const ArtifactLru& cache() const { return cache_; }
 
+  // Records a call's metrics and logs one line.
+  void RecordCall(const CallInfo& call, const absl::Status& status, const std::string& detail = "");
   // Finishes `reactor` with `status`, records metrics and logs one line.
   void FinishCall(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
                   const absl::Status& status, const std::string& detail = "");

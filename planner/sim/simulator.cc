@@ -82,8 +82,9 @@ bool TraverseCells(const Grid& g, Point2 a, Point2 b, F f) {
 class Simulation {
  public:
   Simulation(const OccupancyMap& truth, const Grid& true_grid, const SimulationOptions& options,
-             RetainedPlan plan, std::vector<uint8_t> candidate)
-      : truth_(truth),
+             RetainedPlan plan, std::vector<uint8_t> candidate, PlanSource* source)
+      : source_(source),
+        truth_(truth),
         grid_(true_grid),
         options_(options),
         robot_(options.plan.robot),
@@ -113,6 +114,7 @@ class Simulation {
   void PushDriven(const Waypoint& w);
   void IndexSweeps();
 
+  PlanSource* const source_;
   const OccupancyMap& truth_;
   const Grid& grid_;  // the true grid (same frame as the plan's grid)
   const SimulationOptions& options_;
@@ -133,7 +135,6 @@ class Simulation {
   bool junction_ = false;              // driven.back() is where a replan cut a segment
   double drive_s_ = 0.0;               // rough drive time, for the time bound
   int violations_ = 0;
-  ReplanEstimator estimator_;
   SimulationResult r_;
 };
 
@@ -295,7 +296,7 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
   ro.seed = options_.seed + r_.num_replans;
   ro.tour_time_limit_s = options_.replan_tour_time_limit_s;
   absl::Time t0 = absl::Now();
-  absl::StatusOr<ReplanResult> result = Replan(plan_, at, seen, ro, &estimator_);
+  absl::StatusOr<ReplanResult> result = source_->Replan(plan_, at, seen, ro);
   bool fell_back = false;
   if (!result.ok() && method != ReplanMethod::kGreedyDetour) {
     std::string cells;
@@ -306,7 +307,7 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
         r_.num_replans, ReplanMethodName(method), pos_.x, pos_.y, at.waypoint, path().size() - 1,
         cells, result.status().ToString()));
     ro.method = ReplanMethod::kGreedyDetour;
-    result = Replan(plan_, at, seen, ro, &estimator_);
+    result = source_->Replan(plan_, at, seen, ro);
     fell_back = true;
   }
   const double compute_s = absl::ToDoubleSeconds(absl::Now() - t0);
@@ -539,16 +540,45 @@ double LengthInObstacles(const OccupancyMap& map, const std::vector<Waypoint>& p
 
 }  // namespace
 
+namespace {
+// Plans and replans in process.
+class LocalPlanSource final : public PlanSource {
+ public:
+  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known, const PlanOptions& options) override {
+    ASSIGN_OR_RETURN(EngineResult planned, PlanCoverageWithArea(known, options));
+    RetainedPlan retained;
+    retained.plan_id = "simulation";
+    retained.map_id = "known";
+    retained.plan = std::move(planned.plan);
+    retained.request = options.ToRequest();
+    retained.area = std::move(planned.area);
+    return retained;
+  }
+  absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at, const Observations& seen,
+                                      const ReplanOptions& options) override {
+    return covplan::Replan(plan, at, seen, options, &estimator_);
+  }
+
+ private:
+  ReplanEstimator estimator_;
+};
+}  // namespace
+
 absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
-                                          const SimulationOptions& options) {
+                                          const SimulationOptions& options, PlanSource* source) {
   RETURN_IF_ERROR(options.Validate());
   RETURN_IF_ERROR(CheckSameFrame(known, truth));
-  ASSIGN_OR_RETURN(EngineResult planned, PlanCoverageWithArea(known, options.plan));
+  LocalPlanSource local;
+  if (source == nullptr) source = &local;
+  ASSIGN_OR_RETURN(RetainedPlan retained, source->InitialPlan(known, options.plan));
+  if (retained.plan.grid == nullptr || retained.plan.path.empty()) {
+    return absl::InternalError("the initial plan has no grid or no path");
+  }
   const GridOptions go = GridOf(options.plan);
   ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(truth, go));
   const std::vector<double> fractions = CellFreeFractions(truth, frame);
   ASSIGN_OR_RETURN(Grid true_grid, BuildGridFromFractions(truth, go, frame, fractions));
-  const Grid& drive = *planned.area->drive;
+  const Grid& drive = retained.area != nullptr ? *retained.area->drive : *retained.plan.grid;
   if (drive.rows() != true_grid.rows() || drive.cols() != true_grid.cols()) {
     return absl::InternalError("the plan's grid and the true grid differ in shape");
   }
@@ -556,13 +586,7 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
   for (int64_t i = 0; i < drive.size(); ++i) {
     candidate[i] = drive.free_flags()[i] && !true_grid.free_flags()[i];
   }
-  RetainedPlan retained;
-  retained.plan_id = "simulation";
-  retained.map_id = "known";
-  retained.plan = std::move(planned.plan);
-  retained.request = options.plan.ToRequest();
-  retained.area = std::move(planned.area);
-  Simulation sim(truth, true_grid, options, std::move(retained), std::move(candidate));
+  Simulation sim(truth, true_grid, options, std::move(retained), std::move(candidate), source);
   ASSIGN_OR_RETURN(SimulationResult result, sim.Run());
   // Coverage against the true map: its free area inside the swept cells.
   const int64_t true_free = truth.CountFree();

@@ -89,10 +89,29 @@ struct SimulationResult {
   std::string termination;
 };
 
+// Where the simulated robot's plans come from. The default plans and
+// replans in process (PlanCoverageWithArea, Replan with an estimator of its
+// own); `covplan simulate --server` supplies one that asks a server (the Plan
+// RPC, then a Drive session), so the run also exercises the service.
+// Thread-safety: used by one simulation at a time.
+class PlanSource {
+ public:
+  virtual ~PlanSource() = default;
+  // The plan of the known map. Its `area` may be null (a remote plan); the
+  // simulator needs the path, the sweeps and the grid.
+  virtual absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known, const PlanOptions& options) = 0;
+  // A replan of `plan` (the one being driven). Running out of time is not an
+  // error (the greedy detour answers); an error makes the simulator retry
+  // with options.method = kGreedyDetour.
+  virtual absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at,
+                                              const Observations& seen, const ReplanOptions& options) = 0;
+};
+
 // InvalidArgument when the options are bad or the maps differ in size,
-// resolution or origin; errors of the initial plan are passed on.
+// resolution or origin; errors of the initial plan are passed on. `source`
+// (optional, not owned): where plans come from; default in process.
 absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
-                                          const SimulationOptions& options);
+                                          const SimulationOptions& options, PlanSource* source = nullptr);
 
 // The offline lower bound of the evaluation: OARP planned on the true map,
 // as if the robot had known it from the start.

@@ -14,6 +14,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "api/convert.h"
+#include "client/simulate_command.h"
+#include "client/simulate_remote.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
@@ -431,6 +433,29 @@ TEST_F(DriveSessionTest, ResumeContinuesFromWhereTheRobotStopped) {
   bad.set_plan_id("p-nope");
   status = resume(bad, &out);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+// `covplan simulate --server`: the whole run through one Drive session.
+TEST_F(DriveSessionTest, TheSimulatorDrivesThroughASession) {
+  Start();
+  const std::vector<std::string> args = {
+      "--map", absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"), "--clutter", "5", "--seed", "3",
+      "--time-limit", "0.3", "--replan-tour-limit", "0.3", "--no-offline-bound", "--server",
+      absl::StrCat("127.0.0.1:", server_->port())};
+  absl::StatusOr<std::string> json = SimulateCommandJson(args, &ConnectServerPlanSource);
+  ASSERT_TRUE(json.ok()) << json.status();
+  EXPECT_THAT(*json, HasSubstr("\"planner_at\": \"server 127.0.0.1:"));
+  EXPECT_THAT(*json, HasSubstr("\"completed\": true"));
+  EXPECT_THAT(*json, HasSubstr("\"problems\": []"));
+  EXPECT_THAT(*json, ::testing::Not(HasSubstr("\"num_replans\": 0,")));
+  EXPECT_TRUE(WaitForSessions(0));
+  // Without a factory (the simulator tests' build) --server is refused clearly.
+  absl::StatusOr<std::string> refused = SimulateCommandJson(args);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  // A server that is not there: an error, not a hang or a crash.
+  std::vector<std::string> nowhere = args;
+  nowhere.back() = "127.0.0.1:1";
+  EXPECT_FALSE(SimulateCommandJson(nowhere, &ConnectServerPlanSource).ok());
 }
 
 }  // namespace

@@ -240,6 +240,27 @@ TEST_F(ReplanServiceTest, TheReplanCommandTalksToTheServer) {
             0);
 }
 
+TEST_F(ReplanServiceTest, TheResumeCommandTalksToTheServer) {
+  v1::PlanResponse plan;
+  ASSERT_TRUE(Plan(PlanRequestForOffice(), &plan).ok());
+  const std::string out = dir_ + "/resumed.json";
+  const std::string server = absl::StrCat("127.0.0.1:", server_->port());
+  const std::string dock = absl::StrCat(plan.path(0).x(), ",", plan.path(0).y(), ",0.5");
+  ASSERT_EQ(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", dock, "--distance", "25",
+                              "--out", out}),
+            0);
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_THAT(ss.str(), HasSubstr("\"sweeps\""));
+  EXPECT_THAT(ss.str(), HasSubstr(absl::StrCat("\"x\": ", plan.path(0).x())));
+  // Bad flags and server errors give a non-zero exit.
+  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id()}), 0);  // no --at
+  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", "1,2,3,4"}), 0);
+  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", dock, "--waypoint", "3"}), 0);
+  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", "p-unknown", "--at", dock}), 0);
+}
+
 // Hostile replans: every numeric field of progress and obstacles drawn from
 // NaN, +-inf, 0, -0, huge, tiny and plausible values. Every reply is OK with a
 // plan that sweeps what it claims, or INVALID_ARGUMENT / NOT_FOUND with a

@@ -1,0 +1,159 @@
+#include "client/simulate_remote.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "api/convert.h"
+#include "client/remote.h"
+#include "planner/common/status_macros.h"
+
+namespace covplan {
+namespace {
+
+v1::ReplanMethod MethodToProto(ReplanMethod m) {
+  switch (m) {
+    case ReplanMethod::kAuto:
+      return v1::AUTO;
+    case ReplanMethod::kIlp1:
+      return v1::ILP1;
+    case ReplanMethod::kIlp2:
+      return v1::ILP2;
+    case ReplanMethod::kGreedyDetour:
+      return v1::GREEDY_DETOUR;
+    case ReplanMethod::kFull:
+      return v1::FULL;
+  }
+  return v1::AUTO;
+}
+
+void ProgressToProto(const RobotProgress& at, v1::RobotProgress* out) {
+  if (at.waypoint >= 1) out->set_waypoint(at.waypoint);
+  if (at.distance_m) out->set_distance_m(*at.distance_m);
+  if (at.position) {
+    out->mutable_position()->set_x(at.position->x);
+    out->mutable_position()->set_y(at.position->y);
+  }
+  if (at.tolerance_m) out->set_tolerance_m(*at.tolerance_m);
+}
+
+ReplanStats StatsFromProto(const v1::ReplanStats& s) {
+  ReplanStats out;
+  out.method = s.method();
+  out.num_encounters = s.num_encounters();
+  out.greedy_detours.assign(s.greedy_detours().begin(), s.greedy_detours().end());
+  out.replanned_encounter = s.replanned_encounter();
+  out.time_to_encounter_s = s.time_to_encounter_s();
+  out.rank_budget = s.rank_budget();
+  out.new_ranks = s.new_ranks();
+  out.kept_ranks = s.kept_ranks();
+  out.kept_path_pieces = s.kept_path_pieces();
+  out.kept_path_m = s.kept_path_m();
+  out.newly_blocked_cells = s.newly_blocked_cells();
+  out.covered_cells_before = s.covered_cells_before();
+  out.remaining_cells = s.remaining_cells();
+  out.newly_unreachable_cells = s.newly_unreachable_cells();
+  out.remaining_free_area_m2 = s.remaining_free_area_m2();
+  out.rank_replan_ms = s.rank_replan_ms();
+  out.transitions_ms = s.transitions_ms();
+  out.tour_ms = s.tour_ms();
+  out.total_ms = s.total_ms();
+  out.end_moved = s.end_moved();
+  return out;
+}
+
+class ServerPlanSource final : public PlanSource {
+ public:
+  ServerPlanSource(std::unique_ptr<RemotePlanner> remote, v1::Map map, const SimulationOptions& options)
+      : remote_(std::move(remote)), map_(std::move(map)), method_(MethodToProto(options.method)),
+        seed_(static_cast<uint32_t>(options.seed)) {}
+  ~ServerPlanSource() override {
+    if (session_ != nullptr) session_->Close().IgnoreError();
+  }
+
+  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& /*known*/, const PlanOptions& options) override {
+    v1::PutMapRequest put;
+    *put.mutable_map() = map_;
+    ASSIGN_OR_RETURN(v1::PutMapResponse stored, remote_->PutMap(put, absl::Seconds(120)));
+    v1::PlanRequest request;
+    request.set_map_id(stored.info().map_id());
+    v1::RobotModel* robot = request.mutable_robot();
+    robot->set_tool_width_m(options.robot.tool_width_m);
+    robot->set_max_speed_mps(options.robot.max_speed_mps);
+    robot->set_acceleration_mps2(options.robot.acceleration_mps2);
+    robot->set_turn_rate_deg_s(options.robot.turn_rate_deg_s);
+    request.set_time_limit_s(options.time_limit_s);
+    request.set_seed(static_cast<uint32_t>(options.seed));
+    request.set_min_free_fraction(options.min_free_fraction);
+    ASSIGN_OR_RETURN(v1::PlanResponse planned,
+                     remote_->Plan(request, absl::Seconds(options.time_limit_s + 300.0)));
+    ASSIGN_OR_RETURN(CoveragePlan plan, PlanFromProto(planned));
+    v1::DriveRequest first;
+    first.set_plan_id(planned.plan_id());
+    first.set_method(method_);
+    first.set_seed(seed_);
+    first.set_sequence(next_sequence_++);
+    ASSIGN_OR_RETURN(session_, remote_->Drive(first));
+    current_plan_id_ = planned.plan_id();
+    RetainedPlan retained;
+    retained.plan_id = planned.plan_id();
+    retained.map_id = planned.map_id();
+    retained.plan = std::move(plan);
+    retained.request = options.ToRequest();
+    return retained;
+  }
+
+  absl::StatusOr<ReplanResult> Replan(const RetainedPlan& /*plan*/, const RobotProgress& at,
+                                      const Observations& seen, const ReplanOptions& options) override {
+    if (session_ == nullptr) return absl::FailedPreconditionError("no drive session");
+    v1::DriveRequest request;
+    request.set_sequence(next_sequence_++);
+    request.set_plan_id(current_plan_id_);
+    ProgressToProto(at, request.mutable_progress());
+    for (const CellIndex& c : seen.cells) {
+      v1::CellRef* cell = request.mutable_obstacles()->add_cells();
+      cell->set_row(c.row);
+      cell->set_col(c.col);
+    }
+    const v1::ReplanMethod method = MethodToProto(options.method);
+    if (method != method_) request.set_method(method);
+    ASSIGN_OR_RETURN(v1::DriveEvent event, session_->Observe(request));
+    if (event.has_error()) {
+      return absl::Status(static_cast<absl::StatusCode>(event.error().code()),
+                          absl::StrCat("server: ", event.error().message()));
+    }
+    if (!event.has_replan()) return absl::InternalError("the session answered without a plan");
+    ReplanResult out;
+    ASSIGN_OR_RETURN(out.plan, PlanFromProto(event.replan().plan()));
+    out.stats = StatsFromProto(event.replan().replan());
+    for (const v1::CellRef& c : event.replan().unreachable()) out.unreachable.push_back({c.row(), c.col()});
+    current_plan_id_ = event.replan().plan().plan_id();
+    return out;
+  }
+
+ private:
+  std::unique_ptr<RemotePlanner> remote_;
+  const v1::Map map_;
+  const v1::ReplanMethod method_;
+  const uint32_t seed_;
+  std::unique_ptr<RemotePlanner::DriveSession> session_;
+  std::string current_plan_id_;
+  uint64_t next_sequence_ = 1;
+};
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const std::string& target,
+                                                                    const std::string& known_map_path,
+                                                                    const SimulateMapFlags& flags,
+                                                                    const SimulationOptions& options) {
+  MapFileOverrides overrides;
+  overrides.resolution = flags.resolution;
+  overrides.free_thresh = flags.free_thresh;
+  overrides.occupied_thresh = flags.occupied_thresh;
+  if (flags.negate) overrides.negate = true;
+  ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(known_map_path, overrides, InputLimits()));
+  return std::unique_ptr<PlanSource>(
+      new ServerPlanSource(RemotePlanner::Connect(target), std::move(map), options));
+}
+
+}  // namespace covplan
