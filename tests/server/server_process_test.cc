@@ -132,7 +132,7 @@ TEST_F(ServerProcessTest, MapsSurviveARestart) {
 
 // A server killed with SIGKILL mid-mission: after the restart the robot goes
 // on replanning with the plan_id it holds, twice over (the replanned plan is
-// persisted too).
+// persisted too), and resumes from the progress it reported before a third kill.
 TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   StartServer();
   const std::string map_id = PutMap(OfficeMap());
@@ -182,6 +182,51 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   std::set<int> swept;
   for (const v1::CoverageSweep& s : second.plan().sweeps()) swept.insert(s.cells().begin(), s.cells().end());
   EXPECT_EQ(static_cast<int>(swept.size()), second.replan().remaining_cells());
+
+  // The robot reports its progress in a Drive session, is interrupted with
+  // the server (SIGKILL again), and resumes from its dock where it stopped.
+  const v1::PlanResponse& driving = second.plan();
+  const int k = driving.path_size() / 2;
+  {
+    grpc::ClientContext context;
+    auto stream = stub_->Drive(&context);
+    v1::DriveRequest first;
+    first.set_plan_id(driving.plan_id());
+    ASSERT_TRUE(stream->Write(first));
+    v1::DriveEvent ready;
+    ASSERT_TRUE(stream->Read(&ready));
+    v1::DriveRequest report;
+    report.mutable_progress()->set_waypoint(k);
+    report.mutable_progress()->mutable_position()->set_x(driving.path(k - 1).x());
+    report.mutable_progress()->mutable_position()->set_y(driving.path(k - 1).y());
+    ASSERT_TRUE(stream->Write(report));
+    stream->WritesDone();
+    ASSERT_TRUE(stream->Finish().ok());
+  }
+  const std::string progress_file = store_ + "/plans/" + driving.plan_id() + ".progress";
+  for (int i = 0; i < 250 && !std::filesystem::exists(progress_file); ++i) absl::SleepFor(absl::Milliseconds(20));
+  ASSERT_TRUE(std::filesystem::exists(progress_file));
+  ASSERT_EQ(::kill(server_->pid(), SIGKILL), 0);
+  EXPECT_EQ(server_->Wait(absl::Seconds(10)), 128 + SIGKILL);
+  stub_.reset();
+  channel_.reset();
+  StartServer();
+  v1::ResumeRequest resume;
+  resume.set_plan_id(driving.plan_id());
+  resume.mutable_pose()->set_x(plan.path(0).x());
+  resume.mutable_pose()->set_y(plan.path(0).y());
+  v1::ReplanResponse resumed;
+  {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    status = stub_->Resume(&context, resume, &resumed);
+  }
+  ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << server_->log();
+  EXPECT_EQ(resumed.replan().progress_source(), "recorded");
+  EXPECT_GT(resumed.replan().covered_cells_before(), 0);
+  EXPECT_EQ(resumed.replan().covered_cells_before() + resumed.replan().remaining_cells(),
+            second.replan().remaining_cells());
+  EXPECT_NEAR(resumed.plan().path(0).x(), plan.path(0).x(), 1e-9);
 }
 
 TEST_F(ServerProcessTest, CorruptedMapFileIsReportedNotServed) {
