@@ -164,6 +164,9 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_unreachable_free_cells(static_cast<int32_t>(s.unreachable_free_cells));
   o->set_covered_cells(static_cast<int32_t>(s.covered_cells));
   o->set_no_go_cells(static_cast<int32_t>(s.no_go_cells));
+  o->set_mission_covered_cells(static_cast<int32_t>(s.mission_covered_cells));
+  o->set_mission_cut_off_cells(static_cast<int32_t>(s.mission_cut_off_cells));
+  o->set_mission_obstructed_cells(static_cast<int32_t>(s.mission_obstructed_cells));
 }
 
 void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
@@ -291,6 +294,9 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   o.unreachable_free_cells = s.unreachable_free_cells();
   o.covered_cells = s.covered_cells();
   o.no_go_cells = s.no_go_cells();
+  o.mission_covered_cells = s.mission_covered_cells();
+  o.mission_cut_off_cells = s.mission_cut_off_cells();
+  o.mission_obstructed_cells = s.mission_obstructed_cells();
   return plan;
 }
 

@@ -66,6 +66,7 @@ void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1:
   o->set_covered_cells_before(static_cast<int32_t>(s.covered_cells_before));
   o->set_remaining_cells(static_cast<int32_t>(s.remaining_cells));
   o->set_newly_unreachable_cells(static_cast<int32_t>(s.newly_unreachable_cells));
+  o->set_newly_obstructed_cells(static_cast<int32_t>(s.newly_obstructed_cells));
   o->set_remaining_free_area_m2(s.remaining_free_area_m2);
   o->set_rank_replan_ms(s.rank_replan_ms);
   o->set_transitions_ms(s.transitions_ms);
@@ -109,8 +110,13 @@ absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& inline
     }
   }
   auto derived = std::make_shared<CoverageArea>(*area);
+  int64_t cover_cells = 0;
+  for (uint8_t c : cover) cover_cells += c;
   derived->drive = std::make_shared<const Grid>(drive.WithFreeFlags(std::move(free)));
   derived->cover = std::make_shared<const Grid>(drive.WithFreeFlags(std::move(cover)));
+  derived->cover_cells = cover_cells;
+  // Cells earlier replans cut off stay counted (the plan says how many).
+  derived->unreachable_cells = std::max<int64_t>(area->unreachable_cells, plan.stats.unreachable_free_cells);
   plan.grid = derived->drive;
   RetainedPlan out;
   out.plan_id = inline_plan.plan().plan_id();

@@ -227,6 +227,7 @@ std::string FormatReplanSummary(const v1::ReplanResponse& r) {
       "%d unchanged path pieces (%.1f m)\n"
       "coverage   %d cells swept before, %d left and swept by the new plan, %d cut off%s\n"
       "%s"
+      "mission    %d cells swept by earlier plans, %d to sweep now, %d cut off and %d occupied by new obstacles%s\n"
       "duration   %.1f s estimated for the rest\n"
       "timings    %.1f ms: ranks %.1f, transitions %.1f, tour %.1f ms\n",
       r.plan().plan_id(), s.method(), s.newly_blocked_cells(), s.num_encounters(), detours,
@@ -238,6 +239,10 @@ std::string FormatReplanSummary(const v1::ReplanResponse& r) {
           ? std::string()
           : absl::StrFormat("resumed    from where it stopped (%s), %.1f m back to it\n", s.progress_source(),
                             s.rejoin_m()),
+      r.plan().stats().mission_covered_cells(),
+      r.plan().stats().free_cells(), r.plan().stats().mission_cut_off_cells(),
+      r.plan().stats().mission_obstructed_cells(),
+      r.plan().stats().mission_cut_off_cells() > 0 ? " (the job cannot be completed as mapped)" : "",
       r.plan().stats().estimated_duration_s(),
       s.total_ms(), s.rank_replan_ms(), s.transitions_ms(), s.tour_ms());
 }

@@ -52,6 +52,7 @@ ReplanStats StatsFromProto(const v1::ReplanStats& s) {
   out.covered_cells_before = s.covered_cells_before();
   out.remaining_cells = s.remaining_cells();
   out.newly_unreachable_cells = s.newly_unreachable_cells();
+  out.newly_obstructed_cells = s.newly_obstructed_cells();
   out.remaining_free_area_m2 = s.remaining_free_area_m2();
   out.rank_replan_ms = s.rank_replan_ms();
   out.transitions_ms = s.transitions_ms();

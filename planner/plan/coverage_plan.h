@@ -87,6 +87,13 @@ struct PlanStats {
   int64_t covered_cells = 0;           // distinct cells swept by the path
   int64_t unreachable_free_cells = 0;  // cells to cover that the robot cannot reach
   int64_t no_go_cells = 0;             // free cells closed by no-go zones
+  // Replanned plans continue a mission: the cells its earlier plans swept
+  // before this one started, those new obstacles cut off, and those new
+  // obstacles now occupy (0 for a first plan). free_cells + these three =
+  // the mission's cells.
+  int64_t mission_covered_cells = 0;
+  int64_t mission_cut_off_cells = 0;
+  int64_t mission_obstructed_cells = 0;
   double map_free_area_m2 = 0.0;
   // Timing (wall clock, milliseconds).
   double planning_ms = 0.0;

@@ -315,7 +315,11 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   for (size_t i = 0; i < free.size(); ++i) {
     const bool was = old.area->cover->free_flags()[i] && !covered[i];
     st.covered_cells_before += old.area->cover->free_flags()[i] && covered[i];
-    if (!was || blocked[i]) continue;
+    if (!was) continue;
+    if (blocked[i]) {
+      ++st.newly_obstructed_cells;
+      continue;
+    }
     if (free[i]) {
       to_cover[i] = 1;
       ++st.remaining_cells;
@@ -494,6 +498,9 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   }
   s.num_ranks = st.new_ranks + st.kept_ranks;
   s.unreachable_free_cells = area->unreachable_cells;
+  s.mission_covered_cells = old.plan.stats.mission_covered_cells + st.covered_cells_before;
+  s.mission_cut_off_cells = old.plan.stats.mission_cut_off_cells + st.newly_unreachable_cells;
+  s.mission_obstructed_cells = old.plan.stats.mission_obstructed_cells + st.newly_obstructed_cells;
   s.map_free_area_m2 = old.plan.stats.map_free_area_m2;
   s.partition_ms = st.rank_replan_ms;
   s.transitions_ms = st.transitions_ms;

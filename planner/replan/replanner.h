@@ -85,6 +85,7 @@ struct ReplanStats {
   int64_t covered_cells_before = 0;      // swept before the robot's position
   int64_t remaining_cells = 0;           // still to cover, reachable
   int64_t newly_unreachable_cells = 0;   // to cover but cut off by the new obstacles
+  int64_t newly_obstructed_cells = 0;    // to cover but occupied by the new obstacles
   double remaining_free_area_m2 = 0.0;   // free area of the remaining cells
   double rank_replan_ms = 0.0;
   double transitions_ms = 0.0;

@@ -130,6 +130,32 @@ TEST_F(ReplanServiceTest, ReplansByPlanIdAndInlineAndChains) {
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(Swept(second.plan()), second.replan().remaining_cells());
   EXPECT_LT(second.replan().remaining_cells(), s.remaining_cells());
+  // The mission's account adds up over the chain: what this plan covers, what
+  // earlier plans swept, and what obstacles cut off are the first plan's cells.
+  EXPECT_EQ(by_id.plan().stats().mission_covered_cells(), s.covered_cells_before());
+  EXPECT_EQ(second.plan().stats().mission_covered_cells(),
+            s.covered_cells_before() + second.replan().covered_cells_before());
+  EXPECT_EQ(second.plan().stats().mission_cut_off_cells(),
+            s.newly_unreachable_cells() + second.replan().newly_unreachable_cells());
+  EXPECT_EQ(second.plan().stats().mission_obstructed_cells(),
+            s.newly_obstructed_cells() + second.replan().newly_obstructed_cells());
+  EXPECT_GT(s.newly_obstructed_cells(), 0);  // the box stands on cells still to cover
+  EXPECT_EQ(second.plan().stats().free_cells() + second.plan().stats().mission_covered_cells() +
+                second.plan().stats().mission_cut_off_cells() + second.plan().stats().mission_obstructed_cells(),
+            plan.stats().free_cells());
+  // The same chain from the client's inline copy of the replanned plan.
+  {
+    v1::ReplanRequest inline_again = again;
+    inline_again.clear_plan_id();
+    *inline_again.mutable_plan()->mutable_request() = PlanRequestForOffice();
+    *inline_again.mutable_plan()->mutable_plan() = by_id.plan();
+    v1::ReplanResponse from_inline;
+    status = Replan(inline_again, &from_inline);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(from_inline.replan().remaining_cells(), second.replan().remaining_cells());
+    EXPECT_EQ(from_inline.plan().stats().mission_covered_cells(), second.plan().stats().mission_covered_cells());
+    EXPECT_EQ(from_inline.plan().stats().unreachable_free_cells(), second.plan().stats().unreachable_free_cells());
+  }
 
   // Inline: the client's copy of the plan and its request.
   v1::ReplanRequest inline_request = request;

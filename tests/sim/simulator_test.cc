@@ -340,7 +340,8 @@ TEST(SimulateCommand, BadFlagsAreInvalidArgument) {
     const char* message;
   };
   const std::vector<Case> cases = {
-      {{"--map", office, "--clutter", "10", "--server", "127.0.0.1:50051"}, "not available yet"},
+      {{"--map", office, "--clutter", "10", "--server", "127.0.0.1:50051"}, "not available in this build"},
+      {{"--map", office, "--clutter", "10", "--server", "127.0.0.1:50051", "--local"}, "not both"},
       {{"--map", office}, "exactly one of --true-map"},
       {{"--map", office, "--true-map", office, "--clutter", "5"}, "exactly one of --true-map"},
       {{"--map", office, "--clutter", "60"}, "[0, 50]"},
