@@ -64,6 +64,12 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
   health->SetServingStatus(true);
   health->SetServingStatus(v1::CoveragePlanner::service_full_name(), true);
+  const bool writable = server->store_->ProbeWritable().ok();
+  health->SetServingStatus(kStoreHealthService, writable);
+  server->metrics_->store_writable().Set(writable ? 1 : 0);
+  if (!writable) LogLine("error", "map store is not writable; PutMap and DeleteMap will fail");
+  server->probe_thread_ = std::thread(&CovplanServer::ProbeStoreLoop, server.get(),
+                                      config.store_probe_interval);
   LogLine("info", "covplan-server started",
           {{"address", absl::StrCat(config.address, ":", server->port_)},
            {"metrics_port", absl::StrCat(server->metrics_port_)},
@@ -74,10 +80,34 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   return server;
 }
 
+void CovplanServer::ProbeStoreLoop(absl::Duration interval) {
+  bool was_writable = store_->writable();
+  absl::MutexLock lock(&probe_mu_);
+  while (!probe_mu_.AwaitWithTimeout(absl::Condition(&probe_stop_), interval)) {
+    probe_mu_.Unlock();
+    const absl::Status probe = store_->ProbeWritable();
+    // A write that failed since the last probe counts too.
+    const bool writable = probe.ok() && store_->writable();
+    if (writable != was_writable) {
+      LogLine(writable ? "info" : "error", writable ? "map store writable again" : "map store is not writable",
+              {{"detail", probe.ok() ? "" : std::string(probe.message())}});
+      server_->GetHealthCheckService()->SetServingStatus(kStoreHealthService, writable);
+      metrics_->store_writable().Set(writable ? 1 : 0);
+      was_writable = writable;
+    }
+    probe_mu_.Lock();
+  }
+}
+
 void CovplanServer::Drain(absl::Duration grace) {
   absl::MutexLock lock(&drain_mu_);
   if (drained_) return;
   drained_ = true;
+  {
+    absl::MutexLock probe_lock(&probe_mu_);
+    probe_stop_ = true;
+  }
+  if (probe_thread_.joinable()) probe_thread_.join();
   if (server_ != nullptr) {
     server_->GetHealthCheckService()->SetServingStatus(false);
     service_->StartDraining();

@@ -15,6 +15,7 @@
 
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
@@ -40,8 +41,16 @@ struct ServerConfig {
   // On Drain, how long health reports NOT_SERVING (and new work is refused)
   // before the listener closes, so load balancers see it.
   absl::Duration drain_notice = absl::ZeroDuration();
+  // How often the store is probed for writes; the result is the health of
+  // kStoreHealthService and the covplan_store_writable gauge.
+  absl::Duration store_probe_interval = absl::Seconds(2);
   ServiceOptions service;
 };
+
+// The gRPC health service name that reports whether the map store accepts
+// writes (NOT_SERVING when it is full or read-only; plans on stored maps
+// still work, so the server as a whole ("") stays SERVING).
+inline constexpr char kStoreHealthService[] = "covplan.v1.MapStore";
 
 class CovplanServer {
  public:
@@ -60,6 +69,8 @@ class CovplanServer {
 
  private:
   CovplanServer() = default;
+  // Probes the store every `interval` until Drain.
+  void ProbeStoreLoop(absl::Duration interval);
 
   std::unique_ptr<MapStore> store_;
   std::unique_ptr<ServerMetrics> metrics_;
@@ -71,6 +82,9 @@ class CovplanServer {
   int metrics_port_ = -1;
   absl::Mutex drain_mu_;
   bool drained_ = false;
+  absl::Mutex probe_mu_;
+  bool probe_stop_ ABSL_GUARDED_BY(probe_mu_) = false;
+  std::thread probe_thread_;
 };
 
 }  // namespace covplan

@@ -49,6 +49,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge& cache_budget_bytes() { return *cache_budget_bytes_; }
   prometheus::Gauge& maps_stored() { return *maps_stored_; }
   prometheus::Gauge& plans_retained() { return *plans_retained_; }
+  prometheus::Gauge& store_writable() { return *store_writable_; }
 
   // CacheObserver.
   void OnCacheHit() override { cache_hits_->Increment(); }
@@ -74,6 +75,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge* cache_budget_bytes_;
   prometheus::Gauge* maps_stored_;
   prometheus::Gauge* plans_retained_;
+  prometheus::Gauge* store_writable_;
   prometheus::Family<prometheus::Counter>* replans_;
   prometheus::Histogram* replan_duration_;
   prometheus::Counter* greedy_detours_;

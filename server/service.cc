@@ -1,5 +1,7 @@
 #include "server/service.h"
 
+#include <sys/random.h>
+
 #include <algorithm>
 #include <random>
 #include <utility>
@@ -9,16 +11,29 @@
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "server/log.h"
+#include "server/request_limits.h"
 
 namespace covplan {
 namespace {
 
 constexpr char kEstimatorFile[] = "replan_estimator.txt";
 
+// Status messages are bounded (they travel in trailing metadata, whose size
+// the client limits; an over-long one would turn the real error into
+// RESOURCE_EXHAUSTED on the client).
+std::string BoundedMessage(absl::string_view message) {
+  if (message.size() <= kMaxMessageBytes) return std::string(message);
+  return absl::StrCat(message.substr(0, kMaxMessageBytes - 24), "...(truncated)");
+}
+
 grpc::Status ToGrpc(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), BoundedMessage(status.message()));
 }
+
+// Page sizes of ListMaps (AIP-158).
+constexpr int kDefaultPageSize = 100;
+constexpr int kMaxPageSize = 1000;
 
 std::string CodeName(const absl::Status& status) { return absl::StatusCodeToString(status.code()); }
 
@@ -93,6 +108,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       plans_(options.plan_ttl, options.max_retained_plans),
       id_salt_(std::random_device{}()),
       io_pool_(/*threads=*/2, /*max_queue=*/64),
+      read_pool_(/*threads=*/1, /*max_queue=*/256),
       // Admission is bounded by TryAdmitSolve; the pool's own bound is slack
       // for solves that have released their slot but not yet returned.
       pool_(options.worker_threads, 2 * (options.worker_threads + options.max_queue)),
@@ -120,6 +136,7 @@ void CoveragePlannerService::Shutdown() {
   warm_pool_.Shutdown();
   pool_.Shutdown();
   io_pool_.Shutdown();
+  read_pool_.Shutdown();
 }
 
 CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
@@ -155,12 +172,23 @@ void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const
            {"code", CodeName(status)},
            {"ms", absl::StrFormat("%.1f", seconds * 1e3)},
            {"late", late ? "true" : "false"},
-           {"detail", status.ok() ? detail : std::string(status.message())}});
+           {"detail", BoundedMessage(status.ok() ? detail : std::string(status.message()))}});
   reactor->Finish(ToGrpc(status));
 }
 
 bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
   return io_pool_.TrySubmit(std::move(work));
+}
+
+absl::Status CoveragePlannerService::QueuedTooLong(const CallInfo& call, const StopToken& cancel) const {
+  if (cancel.cancelled()) return absl::CancelledError("call cancelled while it waited for a worker");
+  const absl::Time now = absl::Now();
+  if (now >= call.deadline) {
+    return absl::DeadlineExceededError(absl::StrFormat(
+        "deadline passed while the call waited %d ms for a worker; not started",
+        absl::ToInt64Milliseconds(now - call.start)));
+  }
+  return absl::OkStatus();
 }
 
 bool CoveragePlannerService::TryAdmitSolve() {
@@ -177,8 +205,24 @@ void CoveragePlannerService::ReleaseSolve() { admitted_.fetch_sub(1); }
 void CoveragePlannerService::UpdateQueueGauges() { metrics_->queue_depth().Set(pool_.queued()); }
 
 std::string CoveragePlannerService::NewPlanId() {
-  return absl::StrFormat("p-%08x-%08x", static_cast<uint32_t>(id_salt_ >> 8),
-                         next_id_.fetch_add(1, std::memory_order_relaxed));
+  // 128 bits from the kernel's CSPRNG: a plan id cannot be guessed from
+  // another one.
+  unsigned char bytes[16];
+  size_t got = 0;
+  while (got < sizeof(bytes)) {
+    const ssize_t n = ::getrandom(bytes + got, sizeof(bytes) - got, 0);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      // getrandom cannot fail on Linux >= 3.17 once the pool is seeded; if it
+      // ever does, refuse to hand out a guessable id.
+      LogLine("error", "getrandom failed", {{"errno", absl::StrCat(errno)}});
+      std::abort();
+    }
+    got += static_cast<size_t>(n);
+  }
+  std::string id = "p-";
+  for (unsigned char b : bytes) absl::StrAppendFormat(&id, "%02x", b);
+  return id;
 }
 
 // ---------------------------------------------------------------- maps
@@ -186,10 +230,14 @@ std::string CoveragePlannerService::NewPlanId() {
 absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
                                                v1::PutMapResponse* response) {
   ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), options_.limits));
+  RETURN_IF_ERROR(CheckSiteGeometry(site));
   const std::string map_id = ComputeMapId(request.map());
   v1::MapInfo info = MapInfoFor(site, map_id);
   info.set_name(request.name());
   ASSIGN_OR_RETURN(bool created, store_->Put(info, request.map()));
+  // A rewritten (repaired) map must not be planned from artifacts of the
+  // damaged copy; the content is the same, but be safe and cheap: drop them.
+  if (created) cache_.EraseWithPrefix(map_id + "/");
   if (!created) {
     ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
     info = stored.info();
@@ -204,14 +252,20 @@ absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
 grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerContext* context,
                                                          const v1::PutMapRequest* request,
                                                          v1::PutMapResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "PutMap");
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
   }
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
   if (!SubmitIo([this, reactor, call, request, response] {
-        const absl::Status status = RunPutMap(*request, response);
+        // Work whose caller gave up while it was queued is dropped unstarted.
+        absl::Status status = QueuedTooLong(call, reactor->cancel());
+        if (status.ok()) status = RunPutMap(*request, response);
         FinishCall(reactor, call, status, response->map_id());
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
@@ -222,16 +276,26 @@ grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerCon
 grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerContext* context,
                                                          const v1::GetMapRequest* request,
                                                          v1::GetMapResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "GetMap");
-  if (!SubmitIo([this, reactor, call, request, response] {
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
+  // On the read pool: never behind PutMap's decoding.
+  if (!read_pool_.TrySubmit([this, reactor, call, request, response] {
+        if (absl::Status s = QueuedTooLong(call, reactor->cancel()); !s.ok()) {
+          FinishCall(reactor, call, s);
+          return;
+        }
         absl::StatusOr<v1::GetMapResponse> stored = store_->Get(request->map_id());
+        if (absl::IsDataLoss(stored.status())) cache_.EraseWithPrefix(request->map_id() + "/");
         if (stored.ok()) {
           *response->mutable_info() = stored->info();
           if (request->include_content())
             *response->mutable_map() = std::move(*stored->mutable_map());
         }
-        FinishCall(reactor, call, stored.status(), request->map_id());
+        FinishCall(reactor, call, stored.status(), QuotePrefix(request->map_id()));
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
@@ -239,13 +303,44 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerCon
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerContext* context,
-                                                           const v1::ListMapsRequest*,
+                                                           const v1::ListMapsRequest* request,
                                                            v1::ListMapsResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "ListMaps");
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
+  if (request->page_size() < 0) {
+    FinishCall(reactor, call,
+               absl::InvalidArgumentError(absl::StrCat("page_size must be >= 0 (got ",
+                                                       request->page_size(), ")")));
+    return reactor;
+  }
+  // The token is the last map_id of the previous page (ids are sorted).
+  const std::string& token = request->page_token();
+  if (!token.empty() && !ValidateMapId(token).ok()) {
+    FinishCall(reactor, call,
+               absl::InvalidArgumentError(absl::StrCat("page_token '", QuotePrefix(token),
+                                                       "' is not a next_page_token of ListMaps")));
+    return reactor;
+  }
+  const int page_size = request->page_size() == 0 ? kDefaultPageSize
+                                                  : std::min(request->page_size(), kMaxPageSize);
   std::vector<std::string> corrupted;  // in-memory index only: cheap
-  for (v1::MapInfo& info : store_->List(&corrupted)) *response->add_maps() = std::move(info);
+  bool more = false;
+  std::vector<v1::MapInfo> page = store_->ListPage(token, page_size, &more,
+                                                    token.empty() ? &corrupted : nullptr);
+  for (v1::MapInfo& info : page) {
+    // Names are bounded at PutMap; older stores may hold longer ones.
+    if (info.name().size() > kMapNameLimit) info.mutable_name()->resize(kMapNameLimit);
+    *response->add_maps() = std::move(info);
+  }
+  if (corrupted.size() > static_cast<size_t>(kMaxPageSize)) corrupted.resize(kMaxPageSize);
   for (std::string& id : corrupted) response->add_corrupted(std::move(id));
+  if (more && response->maps_size() > 0) {
+    response->set_next_page_token(response->maps(response->maps_size() - 1).map_id());
+  }
   FinishCall(reactor, call, absl::OkStatus());
   return reactor;
 }
@@ -253,16 +348,24 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
 grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServerContext* context,
                                                             const v1::DeleteMapRequest* request,
                                                             v1::DeleteMapResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "DeleteMap");
-  if (!SubmitIo([this, reactor, call, request, response] {
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
+  if (!read_pool_.TrySubmit([this, reactor, call, request, response] {
+        if (absl::Status s = QueuedTooLong(call, reactor->cancel()); !s.ok()) {
+          FinishCall(reactor, call, s);
+          return;
+        }
         absl::StatusOr<bool> deleted = store_->Delete(request->map_id());
         if (deleted.ok()) {
           response->set_deleted(*deleted);
           cache_.EraseWithPrefix(request->map_id() + "/");
           metrics_->maps_stored().Set(static_cast<double>(store_->size()));
         }
-        FinishCall(reactor, call, deleted.status(), request->map_id());
+        FinishCall(reactor, call, deleted.status(), QuotePrefix(request->map_id()));
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
@@ -276,9 +379,14 @@ MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
   MapSource source;
   source.map_id = map_id;
   source.load = [this, map_id, inline_map]() -> absl::StatusOr<SiteMap> {
-    if (inline_map != nullptr) return SiteFromProto(*inline_map, options_.limits);
-    ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
-    return SiteFromProto(stored.map(), options_.limits);
+    v1::GetMapResponse stored;
+    if (inline_map == nullptr) {
+      ASSIGN_OR_RETURN(stored, store_->Get(map_id));
+    }
+    ASSIGN_OR_RETURN(SiteMap site,
+                     SiteFromProto(inline_map != nullptr ? *inline_map : stored.map(), options_.limits));
+    RETURN_IF_ERROR(CheckSiteGeometry(site));
+    return site;
   };
   return source;
 }
@@ -338,6 +446,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     case v1::PlanRequest::kMapId:
       RETURN_IF_ERROR(ValidateMapId(request.map_id()));
       map_id = request.map_id();
+      // A deleted map, or one found damaged, is not planned from the cache.
+      RETURN_IF_ERROR(store_->Check(map_id));
       break;
     case v1::PlanRequest::kMap:
       map_id = ComputeMapId(request.map());
@@ -384,6 +494,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   CallInfo call = StartCall(context, "Plan");
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
     return reactor;
   }
   const auto reject = [&] {
@@ -446,16 +560,21 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
                                                           v1::PlanResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "GetPlan");
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
   std::shared_ptr<const RetainedPlan> plan = plans_.Get(request->plan_id());
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   if (plan == nullptr) {
     FinishCall(
         reactor, call,
-        absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", request->plan_id(), "'")));
+        absl::NotFoundError(
+            absl::StrCat("unknown or expired plan_id '", QuotePrefix(request->plan_id()), "'")));
     return reactor;
   }
   RetainedPlanToProto(*plan, response);  // in memory, no blocking
-  FinishCall(reactor, call, absl::OkStatus(), request->plan_id());
+  FinishCall(reactor, call, absl::OkStatus(), QuotePrefix(request->plan_id()));
   return reactor;
 }
 
@@ -610,6 +729,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerCon
   CallInfo call = StartCall(context, "Replan");
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
     return reactor;
   }
   if (!TryAdmitSolve()) {

@@ -1,7 +1,8 @@
 // The covplan.v1.CoveragePlanner service on gRPC's callback API.
 //
 // Handlers never block gRPC threads: solves run on a bounded WorkerPool,
-// map-registry work (decoding, disk) on a small separate one, and the reply
+// PutMap's decoding on a small separate one, GetMap / DeleteMap on a third
+// (so cheap reads never wait behind decoding), and the reply
 // is sent with Finish() from the worker. Beyond worker_threads + max_queue
 // admitted solves, Plan answers RESOURCE_EXHAUSTED at once.
 // A Plan's gRPC deadline (minus ServiceOptions::deadline_margin) is its
@@ -128,6 +129,9 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   CallInfo StartCall(grpc::CallbackServerContext* context, const char* method);
   // Runs map-registry work (decode, disk) on the I/O pool; false if full.
   bool SubmitIo(std::function<void()> work);
+  // Non-OK when a queued call should not start: it was cancelled, or its
+  // deadline passed while it waited.
+  absl::Status QueuedTooLong(const CallInfo& call, const StopToken& cancel) const;
   // Admission control for solves: at most worker_threads + max_queue
   // admitted at once. A solve releases its slot just before it replies, so a
   // client that sends its next request on receiving a reply finds the slot
@@ -174,7 +178,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   uint64_t id_salt_;
   StopToken background_stop_;  // cancelled when draining or shutting down
   // Last: their threads stop before the rest is destroyed.
-  WorkerPool io_pool_;    // PutMap / GetMap / DeleteMap
+  WorkerPool io_pool_;    // PutMap (decoding) and plan/estimator writes
+  WorkerPool read_pool_;  // GetMap / DeleteMap: never behind decoding
   WorkerPool pool_;       // Plan solves
   WorkerPool warm_pool_;  // artifacts cut off by a caller's deadline
 };
