@@ -14,6 +14,14 @@
 #include "server/log.h"
 
 namespace covplan {
+namespace {
+
+// After the grace: how long cut-short solves get to reply, then how long
+// gRPC gets to send what is written before it cancels the rest.
+constexpr absl::Duration kDrainReplyBound = absl::Milliseconds(500);
+constexpr absl::Duration kDrainFlushBound = absl::Milliseconds(200);
+
+}  // namespace
 
 absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const ServerConfig& config) {
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
@@ -108,22 +116,37 @@ void CovplanServer::Drain(absl::Duration grace) {
     probe_stop_ = true;
   }
   if (probe_thread_.joinable()) probe_thread_.join();
+  const absl::Time start = absl::Now();
+  const absl::Time give_up = start + grace;
   if (server_ != nullptr) {
     server_->GetHealthCheckService()->SetServingStatus(false);
     service_->StartDraining();
     LogLine("info", "draining", {{"grace_ms", absl::StrCat(absl::ToInt64Milliseconds(grace))}});
-    const absl::Time give_up = absl::Now() + grace;
     absl::SleepFor(std::min(drain_notice_, grace));
-    // Waits for in-flight calls until the deadline, then cancels the rest;
-    // their StopTokens fire and the workers finish them quickly.
-    server_->Shutdown(absl::ToChronoTime(give_up));
-    LogLine("info", "gRPC server shut down");
+    // Our own calls decide how long the grace lasts, not gRPC's count of
+    // open streams: a health Watch stream or an idle connection never ends
+    // by itself and would hold Shutdown for the whole deadline.
+    while (service_->active_calls() > 0 && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(10));
+    if (service_->active_calls() > 0) {
+      // Grace over: running solves stop and answer with their best plan.
+      service_->CutShortInFlight();
+      const absl::Time replies_by = absl::Now() + kDrainReplyBound;
+      while (service_->active_calls() > 0 && absl::Now() < replies_by) {
+        absl::SleepFor(absl::Milliseconds(5));
+      }
+    }
+    // Cancels what is left (streams, calls that did not reply in time), after
+    // a moment for the replies just sent to leave.
+    server_->Shutdown(absl::ToChronoTime(absl::Now() + kDrainFlushBound));
+    LogLine("info", "gRPC server shut down",
+            {{"ms", absl::StrCat(absl::ToInt64Milliseconds(absl::Now() - start))}});
   }
   if (service_ != nullptr) service_->Shutdown();
   exposer_.reset();
   if (server_ != nullptr) {
     server_->Wait();
-    LogLine("info", "covplan-server stopped");
+    LogLine("info", "covplan-server stopped",
+            {{"ms", absl::StrCat(absl::ToInt64Milliseconds(absl::Now() - start))}});
   }
 }
 

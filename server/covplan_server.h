@@ -63,8 +63,10 @@ class CovplanServer {
   CoveragePlannerService& service() { return *service_; }
 
   // Reports NOT_SERVING and refuses new work (for the configured drain
-  // notice), lets in-flight calls finish for up to `grace` in all (then
-  // cancels them), and stops.
+  // notice), lets in-flight unary calls finish for up to `grace` in all,
+  // then cuts running solves short (they answer with their best plan,
+  // marked in termination.detail), gives replies 0.5 s + 0.2 s to leave,
+  // cancels what is left (health Watch streams included) and stops.
   void Drain(absl::Duration grace);
 
  private:

@@ -54,7 +54,7 @@ bool IsStop(const absl::Status& status) {
 // otherwise the deadline was too short for even a first plan.
 absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
                            const CallInfo& call, absl::Duration max_request_time) {
-  if (cancel.cancelled()) return absl::CancelledError("call cancelled by the client");
+  if (cancel.cancelled()) return absl::CancelledError("call cancelled (by the client, or by the server's drain)");
   if (call.deadline == absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
     return absl::DeadlineExceededError(absl::StrFormat(
         "no plan within the server's limit of %g s per call without a deadline "
@@ -145,6 +145,7 @@ CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
   call.method = method;
   call.start = absl::Now();
   call.deadline = DeadlineOf(*context);
+  active_calls_.fetch_add(1);
   const auto& metadata = context->client_metadata();
   if (auto it = metadata.find("x-request-id"); it != metadata.end() && it->second.size() <= 64) {
     call.request_id.assign(it->second.data(), it->second.size());
@@ -174,6 +175,29 @@ void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const
            {"late", late ? "true" : "false"},
            {"detail", BoundedMessage(status.ok() ? detail : std::string(status.message()))}});
   reactor->Finish(ToGrpc(status));
+  active_calls_.fetch_sub(1);
+}
+
+uint64_t CoveragePlannerService::TrackSolve(const StopToken& token) {
+  absl::MutexLock lock(&solves_mu_);
+  const uint64_t id = next_solve_++;
+  solves_.emplace(id, token);
+  if (drain_cut_.load()) token.Cancel();
+  return id;
+}
+
+void CoveragePlannerService::UntrackSolve(uint64_t id) {
+  absl::MutexLock lock(&solves_mu_);
+  solves_.erase(id);
+}
+
+void CoveragePlannerService::CutShortInFlight() {
+  absl::MutexLock lock(&solves_mu_);
+  drain_cut_.store(true);
+  for (const auto& [id, token] : solves_) token.Cancel();
+  if (!solves_.empty()) {
+    LogLine("warn", "drain grace over: cutting running solves short", {{"solves", absl::StrCat(solves_.size())}});
+  }
 }
 
 bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
@@ -465,6 +489,9 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       // deadline that hit --max_request_s already had that long.)
       WarmInBackground(source, plan_request);
     }
+    if (IsStop(result.status()) && drain_cut_.load()) {
+      return absl::UnavailableError("server shut down before a first plan was found; retry on another");
+    }
     return IsStop(result.status())
                ? StoppedStatus(result.status(), cancel, call, options_.max_request_time)
                : result.status();
@@ -477,6 +504,11 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   retained->request = std::move(plan_request);
   retained->request.common.stop = StopToken();  // the call's token ends with the call
   RetainedPlanToProto(*retained, response);
+  if (drain_cut_.load() && response->termination().limit() == v1::LIMIT_CANCELLED) {
+    response->mutable_termination()->set_detail(
+        absl::StrCat("cut short by the server's drain (shutting down); ",
+                     response->termination().detail()));
+  }
   if (request.map_ref_case() == v1::PlanRequest::kMapId) PersistPlan(request, *response);
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, retained->plan.stats.tour_cut_short);
@@ -533,7 +565,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
     UpdateQueueGauges();
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    const uint64_t solve = TrackSolve(reactor->cancel());
     const absl::Status status = RunPlan(call, *request, reactor->cancel(), response);
+    UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     ReleaseSolve();
     std::string detail;
@@ -744,7 +778,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerCon
   }
   const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    const uint64_t solve = TrackSolve(reactor->cancel());
     const absl::Status status = RunReplan(call, *request, reactor->cancel(), response);
+    UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     ReleaseSolve();
     std::string detail;

@@ -29,6 +29,7 @@
 
 #include <atomic>
 #include <deque>
+#include <map>
 #include <utility>
 #include <cstdint>
 #include <memory>
@@ -108,6 +109,13 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
     background_stop_.Cancel();
   }
   bool draining() const { return draining_.load(); }
+  // Unary calls between arrival and Finish (health and reflection streams
+  // are not counted, so they never hold a drain).
+  int active_calls() const { return active_calls_.load(); }
+  // The end of the drain's grace: every running Plan/Replan is stopped and
+  // answers with its best plan so far, its termination detail saying the
+  // drain cut it short.
+  void CutShortInFlight();
   // Runs what is queued (cancelled calls finish quickly) and joins workers.
   void Shutdown();
 
@@ -162,6 +170,14 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // Learns replan runtimes from this server's solves; kept in the store dir.
   ReplanEstimator estimator_;
   std::atomic<bool> draining_{false};
+  std::atomic<bool> drain_cut_{false};
+  std::atomic<int> active_calls_{0};
+  // The stop tokens of running solves, so the drain can cut them short.
+  absl::Mutex solves_mu_;
+  std::map<uint64_t, StopToken> solves_ ABSL_GUARDED_BY(solves_mu_);
+  uint64_t next_solve_ ABSL_GUARDED_BY(solves_mu_) = 0;
+  uint64_t TrackSolve(const StopToken& token);
+  void UntrackSolve(uint64_t id);
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};
   std::atomic<int> admitted_{0};
