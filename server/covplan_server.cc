@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "prometheus/exposer.h"
 #include "server/log.h"
+#include "server/malformed_request_interceptor.h"
 
 namespace covplan {
 namespace {
@@ -63,6 +64,7 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   const std::string address = absl::StrCat(config.address, ":", config.port);
   builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &server->port_);
   builder.RegisterService(server->service_.get());
+  builder.experimental().SetInterceptorCreators(MalformedRequestInterceptors(server->metrics_.get()));
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || server->port_ == 0) {
     server->server_.reset();
