@@ -31,6 +31,11 @@ grpc::Status ToGrpc(const absl::Status& status) {
   return grpc::Status(static_cast<grpc::StatusCode>(status.code()), BoundedMessage(status.message()));
 }
 
+// A Plan stopped by its deadline before a first plan is overload
+// (RESOURCE_EXHAUSTED), not a too-short deadline, when it spent more than this
+// share of its deadline in the queue.
+constexpr double kQueueShareForOverload = 0.1;
+
 // Page sizes of ListMaps (AIP-158).
 constexpr int kDefaultPageSize = 100;
 constexpr int kMaxPageSize = 1000;
@@ -53,8 +58,20 @@ bool IsStop(const absl::Status& status) {
 // The status for work that stopped early: the client's cancellation wins,
 // otherwise the deadline was too short for even a first plan.
 absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
-                           const CallInfo& call, absl::Duration max_request_time) {
+                           const CallInfo& call, absl::Time started, absl::Duration max_request_time) {
   if (cancel.cancelled()) return absl::CancelledError("call cancelled (by the client, or by the server's drain)");
+  // A call that spent a real share of its deadline waiting for a worker was
+  // refused by overload, not by its own deadline: say so with the code a
+  // client retries on (elsewhere).
+  if (call.deadline != absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
+    const absl::Duration waited = started - call.start;
+    if (waited > kQueueShareForOverload * (call.deadline - call.start)) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "server busy: the call waited %d ms of its %d ms deadline for a worker and had no time "
+          "left for a first plan; retry later or elsewhere",
+          absl::ToInt64Milliseconds(waited), absl::ToInt64Milliseconds(call.deadline - call.start)));
+    }
+  }
   if (call.deadline == absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
     return absl::DeadlineExceededError(absl::StrFormat(
         "no plan within the server's limit of %g s per call without a deadline "
@@ -493,7 +510,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       return absl::UnavailableError("server shut down before a first plan was found; retry on another");
     }
     return IsStop(result.status())
-               ? StoppedStatus(result.status(), cancel, call, options_.max_request_time)
+               ? StoppedStatus(result.status(), cancel, call, start, options_.max_request_time)
                : result.status();
   }
   auto retained = std::make_shared<RetainedPlan>();

@@ -396,6 +396,35 @@ TEST_F(ServerHardeningTest, MalformedRequestsAreInvalidArgumentLoggedAndCounted)
   EXPECT_THAT(*metrics, HasSubstr("covplan_requests_total{code=\"INVALID_ARGUMENT\",method=\"PutMap\"} 1"));
 }
 
+// Defect 9: a call admitted behind a long solve that starts with too little
+// of its deadline left is refused as overload, not DEADLINE_EXCEEDED.
+TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExceeded) {
+  StartServer({"--threads=1"});
+  const std::string busy_map = PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
+  const std::string fresh_map = PutMapOk(RasterMap(AsciiToPgm(PillarField(240, 180, 600, 5), 4), 0.025));
+  v1::PlanResponse warm;
+  ASSERT_TRUE(Plan(busy_map, 0.3, &warm).ok());
+  std::thread busy([&] {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    v1::PlanRequest request = testing::PlanRequestFor(busy_map, 0.3);
+    request.set_time_limit_s(2.0);
+    v1::PlanResponse response;
+    EXPECT_TRUE(stub_->Plan(&context, request, &response).ok());
+  });
+  absl::SleepFor(absl::Milliseconds(100));
+  // Waits ~1.9 s for the worker, then has ~0.6 s for a map whose artifacts
+  // take longer than that to build.
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(2500));
+  v1::PlanRequest request = testing::PlanRequestFor(fresh_map, 0.2);
+  v1::PlanResponse response;
+  const grpc::Status status = stub_->Plan(&context, request, &response);
+  busy.join();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("server busy"));
+}
+
 // Defect 14.
 TEST_F(ServerHardeningTest, FullDiskIsResourceExhaustedAndReportedInHealthAndMetrics) {
   mount_ = root_ + "/small";
