@@ -222,13 +222,14 @@ bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
 }
 
 absl::Status CoveragePlannerService::QueuedTooLong(const CallInfo& call, const StopToken& cancel) const {
-  if (cancel.cancelled()) return absl::CancelledError("call cancelled while it waited for a worker");
+  // gRPC also cancels a call whose deadline passed: say which it was.
   const absl::Time now = absl::Now();
   if (now >= call.deadline) {
     return absl::DeadlineExceededError(absl::StrFormat(
         "deadline passed while the call waited %d ms for a worker; not started",
         absl::ToInt64Milliseconds(now - call.start)));
   }
+  if (cancel.cancelled()) return absl::CancelledError("call cancelled while it waited for a worker; not started");
   return absl::OkStatus();
 }
 

@@ -31,6 +31,8 @@
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "png.h"
+#include "tests/grid/png_writer.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
 #include "tests/server/test_maps.h"
@@ -423,6 +425,55 @@ TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExce
   busy.join();
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
   EXPECT_THAT(status.error_message(), HasSubstr("server busy"));
+}
+
+// Defect 2: PutMaps whose deadline passed while they waited are not
+// decoded, and GetMap does not wait behind decoding.
+TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNotWait) {
+  StartServer();
+  testing::PngSpec spec{.width = 3000, .height = 3000, .color_type = PNG_COLOR_TYPE_GRAY, .bit_depth = 16};
+  spec.samples.assign(static_cast<size_t>(spec.width) * spec.height, 65535);
+  const v1::Map big = RasterMap(testing::EncodePng(spec), 0.05);
+  const std::string small_id = PutMapOk(Variant(0));
+  const absl::Time one_start = absl::Now();
+  PutMapOk(big);
+  const absl::Duration one = absl::Now() - one_start;  // one decode, uncontended
+  // Enough PutMaps that decoding them all would take >= 4 s on the 2 I/O
+  // threads; each may wait 0.5 s.
+  const int n = std::clamp(static_cast<int>(8 * absl::Seconds(1) / std::max(one, absl::Milliseconds(10))), 8, 60);
+  std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+  std::vector<v1::PutMapRequest> requests(n);
+  std::vector<v1::PutMapResponse> responses(n);
+  std::atomic<int> done{0};
+  const absl::Time fired = absl::Now();
+  for (int i = 0; i < n; ++i) {
+    contexts.push_back(std::make_unique<grpc::ClientContext>());
+    contexts.back()->set_deadline(absl::ToChronoTime(fired + absl::Milliseconds(500)));
+    *requests[i].mutable_map() = big;
+    stub_->async()->PutMap(contexts.back().get(), &requests[i], &responses[i],
+                           [&done](grpc::Status) { done.fetch_add(1); });
+  }
+  absl::SleepFor(absl::Milliseconds(100));
+  const absl::Time read_start = absl::Now();
+  {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(300));
+    v1::GetMapRequest request;
+    request.set_map_id(small_id);
+    v1::GetMapResponse response;
+    const grpc::Status status = stub_->GetMap(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+  }
+  EXPECT_LT(absl::Now() - read_start, absl::Milliseconds(300));
+  while (done.load() < n && absl::Now() < fired + absl::Seconds(60)) absl::SleepFor(absl::Milliseconds(10));
+  ASSERT_EQ(done.load(), n);
+  // The server stops working on them soon after their deadline: a small
+  // PutMap right after is answered at once, not behind the queue.
+  const absl::Time after = absl::Now();
+  EXPECT_FALSE(PutMapOk(Variant(1)).empty());
+  EXPECT_LT(absl::Now() - after, 2 * one + absl::Milliseconds(300))
+      << "one decode takes " << absl::FormatDuration(one) << ", " << n << " PutMaps";
+  EXPECT_THAT(server_->log(), HasSubstr("not started"));
 }
 
 // Defect 14.
