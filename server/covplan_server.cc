@@ -28,14 +28,11 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
   std::unique_ptr<CovplanServer> server(new CovplanServer());
   server->drain_notice_ = config.drain_notice;
-  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(config.store_dir);
+  absl::StatusOr<std::unique_ptr<MapStore>> store =
+      MapStore::OpenLocked(config.store_dir, /*index=*/!config.index_in_background);
   if (!store.ok()) return store.status();
   server->store_ = std::move(*store);
-  std::vector<std::string> corrupted;
-  server->store_->List(&corrupted);
-  for (const std::string& id : corrupted) {
-    LogLine("error", "corrupted map file in store, not served", {{"map_id", id}});
-  }
+  if (!config.index_in_background) server->LogIndexed(absl::ZeroDuration());
   server->metrics_ = std::make_unique<ServerMetrics>();
   server->service_ = std::make_unique<CoveragePlannerService>(
       config.service, server->store_.get(), server->metrics_.get());
@@ -72,14 +69,33 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
         absl::StrCat("cannot listen on ", address, " (port in use or bad address)"));
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
-  health->SetServingStatus(true);
-  health->SetServingStatus(v1::CoveragePlanner::service_full_name(), true);
+  const bool indexed = !server->store_->loading();
+  health->SetServingStatus(indexed);
+  health->SetServingStatus(v1::CoveragePlanner::service_full_name(), indexed);
   const bool writable = server->store_->ProbeWritable().ok();
   health->SetServingStatus(kStoreHealthService, writable);
   server->metrics_->store_writable().Set(writable ? 1 : 0);
   if (!writable) LogLine("error", "map store is not writable; PutMap and DeleteMap will fail");
   server->probe_thread_ = std::thread(&CovplanServer::ProbeStoreLoop, server.get(),
                                       config.store_probe_interval);
+  if (!indexed) {
+    server->index_thread_ = std::thread([raw = server.get()] {
+      const absl::Time start = absl::Now();
+      const absl::Status loaded = raw->store_->LoadIndex(&raw->index_stop_);
+      if (!loaded.ok()) {
+        LogLine(raw->index_stop_.load() ? "info" : "error", "map store not indexed",
+                {{"detail", std::string(loaded.message())}});
+        return;
+      }
+      raw->LogIndexed(absl::Now() - start);
+      raw->metrics_->maps_stored().Set(static_cast<double>(raw->store_->size()));
+      if (!raw->service_->draining()) {
+        grpc::HealthCheckServiceInterface* health = raw->server_->GetHealthCheckService();
+        health->SetServingStatus(true);
+        health->SetServingStatus(v1::CoveragePlanner::service_full_name(), true);
+      }
+    });
+  }
   LogLine("info", "covplan-server started",
           {{"address", absl::StrCat(config.address, ":", server->port_)},
            {"metrics_port", absl::StrCat(server->metrics_port_)},
@@ -88,6 +104,18 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
            {"workers", absl::StrCat(config.service.worker_threads)},
            {"queue", absl::StrCat(config.service.max_queue)}});
   return server;
+}
+
+void CovplanServer::LogIndexed(absl::Duration took) {
+  std::vector<std::string> corrupted;
+  store_->List(&corrupted);
+  for (const std::string& id : corrupted) {
+    LogLine("error", "corrupted map file in store, not served", {{"map_id", id}});
+  }
+  LogLine("info", "map store indexed",
+          {{"maps", absl::StrCat(store_->size())},
+           {"corrupted", absl::StrCat(corrupted.size())},
+           {"ms", absl::StrCat(absl::ToInt64Milliseconds(took))}});
 }
 
 void CovplanServer::ProbeStoreLoop(absl::Duration interval) {
@@ -118,6 +146,8 @@ void CovplanServer::Drain(absl::Duration grace) {
     probe_stop_ = true;
   }
   if (probe_thread_.joinable()) probe_thread_.join();
+  index_stop_.store(true);
+  if (index_thread_.joinable()) index_thread_.join();
   const absl::Time start = absl::Now();
   const absl::Time give_up = start + grace;
   if (server_ != nullptr) {

@@ -13,6 +13,7 @@
 #ifndef COVPLAN_SERVER_COVPLAN_SERVER_H_
 #define COVPLAN_SERVER_COVPLAN_SERVER_H_
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <thread>
@@ -44,6 +45,10 @@ struct ServerConfig {
   // How often the store is probed for writes; the result is the health of
   // kStoreHealthService and the covplan_store_writable gauge.
   absl::Duration store_probe_interval = absl::Seconds(2);
+  // Index the store on a background thread after the port is open, with
+  // health NOT_SERVING (and map calls UNAVAILABLE) until it is done, so a
+  // large store does not keep the port closed. Off: Start indexes first.
+  bool index_in_background = false;
   ServiceOptions service;
 };
 
@@ -71,6 +76,8 @@ class CovplanServer {
 
  private:
   CovplanServer() = default;
+  // Logs the corrupted maps and the size of the index.
+  void LogIndexed(absl::Duration took);
   // Probes the store every `interval` until Drain.
   void ProbeStoreLoop(absl::Duration interval);
 
@@ -84,6 +91,8 @@ class CovplanServer {
   int metrics_port_ = -1;
   absl::Mutex drain_mu_;
   bool drained_ = false;
+  std::atomic<bool> index_stop_{false};
+  std::thread index_thread_;
   absl::Mutex probe_mu_;
   bool probe_stop_ ABSL_GUARDED_BY(probe_mu_) = false;
   std::thread probe_thread_;

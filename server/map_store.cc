@@ -28,6 +28,10 @@ constexpr char kSuffix[] = ".map";
 constexpr char kLockName[] = ".lock";
 constexpr char kProbeName[] = "write_probe.txt";
 
+absl::Status LoadingError() {
+  return absl::UnavailableError("the map store is still being indexed after a restart; retry shortly");
+}
+
 // A failed file operation as the client sees it: what failed and why, never
 // the server's paths (those go to the log). A full disk is
 // RESOURCE_EXHAUSTED, a store that may not be written UNAVAILABLE.
@@ -92,7 +96,7 @@ bool IsMapFileName(const std::string& name, std::string* map_id) {
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const std::string& dir) {
+absl::StatusOr<std::unique_ptr<MapStore>> MapStore::OpenLocked(const std::string& dir, bool index) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return absl::InternalError(absl::StrCat("cannot create store directory ", dir, ": ", ec.message()));
@@ -117,28 +121,58 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const std::string& dir)
   }
   std::unique_ptr<MapStore> store(new MapStore(dir));
   store->lock_fd_ = lock_fd;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+  if (!index) {
+    absl::MutexLock lock(&store->mu_);
+    store->loading_ = true;
+    return store;
+  }
+  if (absl::Status s = store->LoadIndex(nullptr); !s.ok()) return s;
+  return store;
+}
+
+absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const std::string& dir) {
+  return OpenLocked(dir, /*index=*/true);
+}
+
+absl::Status MapStore::LoadIndex(const std::atomic<bool>* stop) {
+  {
+    absl::MutexLock lock(&mu_);
+    loading_ = true;
+  }
+  std::error_code ec;
+  std::map<std::string, v1::MapInfo> index;
+  std::set<std::string> corrupted;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    if (stop != nullptr && stop->load()) return absl::CancelledError("index load stopped");
     const std::string name = entry.path().filename().string();
     // Only regular files (not symlinks, FIFOs, devices: a FIFO would block
     // the open forever).
     std::error_code type_ec;
     if (entry.symlink_status(type_ec).type() != std::filesystem::file_type::regular) continue;
     if (name.find(".tmp.") != std::string::npos) {  // left over by a crash mid-write
-      std::filesystem::remove(entry.path(), ec);
+      std::filesystem::remove(entry.path(), type_ec);
       continue;
     }
     std::string map_id;
     if (!IsMapFileName(name, &map_id)) continue;
-    absl::StatusOr<v1::GetMapResponse> stored = store->ReadVerified(entry.path().string());
-    absl::MutexLock lock(&store->mu_);
+    absl::StatusOr<v1::GetMapResponse> stored = ReadVerified(entry.path().string());
     if (stored.ok() && stored->info().map_id() == map_id) {
-      store->index_[map_id] = stored->info();
+      index[map_id] = stored->info();
     } else {
-      store->corrupted_.insert(map_id);
+      corrupted.insert(map_id);
     }
   }
-  if (ec) return absl::InternalError(absl::StrCat("cannot list ", dir, ": ", ec.message()));
-  return store;
+  if (ec) return absl::InternalError(absl::StrCat("cannot list ", dir_, ": ", ec.message()));
+  absl::MutexLock lock(&mu_);
+  index_ = std::move(index);
+  corrupted_ = std::move(corrupted);
+  loading_ = false;
+  return absl::OkStatus();
+}
+
+bool MapStore::loading() const {
+  absl::MutexLock lock(&mu_);
+  return loading_;
 }
 
 MapStore::~MapStore() {
@@ -147,6 +181,7 @@ MapStore::~MapStore() {
 
 absl::Status MapStore::Check(const std::string& map_id) const {
   absl::MutexLock lock(&mu_);
+  if (loading_) return LoadingError();
   if (corrupted_.count(map_id) != 0) {
     return absl::DataLossError(absl::StrCat("map ", map_id, " is corrupted on disk; PutMap it again"));
   }
@@ -231,6 +266,7 @@ absl::StatusOr<bool> MapStore::Put(const v1::MapInfo& info, const v1::Map& map) 
   bool indexed = false;
   {
     absl::MutexLock lock(&mu_);
+    if (loading_) return LoadingError();
     indexed = index_.count(map_id) != 0;
   }
   if (indexed) {
@@ -284,9 +320,10 @@ std::vector<v1::MapInfo> MapStore::List(std::vector<std::string>* corrupted) con
   return maps;
 }
 
-std::vector<v1::MapInfo> MapStore::ListPage(const std::string& after, int limit, bool* more,
-                                            std::vector<std::string>* corrupted) const {
+absl::StatusOr<std::vector<v1::MapInfo>> MapStore::ListPage(const std::string& after, int limit, bool* more,
+                                                            std::vector<std::string>* corrupted) const {
   absl::MutexLock lock(&mu_);
+  if (loading_) return LoadingError();
   std::vector<v1::MapInfo> maps;
   auto it = after.empty() ? index_.begin() : index_.upper_bound(after);
   for (; it != index_.end() && static_cast<int>(maps.size()) < limit; ++it) maps.push_back(it->second);
@@ -300,6 +337,7 @@ absl::StatusOr<bool> MapStore::Delete(const std::string& map_id) {
   absl::MutexLock write_lock(&write_mu_);
   {
     absl::MutexLock lock(&mu_);
+    if (loading_) return LoadingError();
     if (index_.count(map_id) == 0 && corrupted_.count(map_id) == 0) return false;
   }
   // The index changes only once the file is gone: a failed unlink (e.g. a

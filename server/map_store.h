@@ -42,6 +42,13 @@ class MapStore {
   // Creates `dir` if needed, locks it and indexes (and verifies) the maps in
   // it. FailedPrecondition if another process holds the lock.
   static absl::StatusOr<std::unique_ptr<MapStore>> Open(const std::string& dir);
+  // Locks `dir`; with index=false, leaves the index to LoadIndex (e.g. on a
+  // background thread while the server already answers health). Until it
+  // has run, the map methods return Unavailable.
+  static absl::StatusOr<std::unique_ptr<MapStore>> OpenLocked(const std::string& dir, bool index);
+  // Reads and verifies every map file; `stop` (optional) ends it early.
+  absl::Status LoadIndex(const std::atomic<bool>* stop);
+  bool loading() const;
   ~MapStore();
   MapStore(const MapStore&) = delete;
   MapStore& operator=(const MapStore&) = delete;
@@ -59,8 +66,8 @@ class MapStore {
   std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const;
   // At most `limit` maps with ids after `after` ("" = from the start);
   // `more` says whether any follow.
-  std::vector<v1::MapInfo> ListPage(const std::string& after, int limit, bool* more,
-                                    std::vector<std::string>* corrupted) const;
+  absl::StatusOr<std::vector<v1::MapInfo>> ListPage(const std::string& after, int limit, bool* more,
+                                                    std::vector<std::string>* corrupted) const;
 
   // Returns false if there was no such map. The map stays indexed when the
   // file cannot be removed.
@@ -105,6 +112,7 @@ class MapStore {
   absl::Mutex write_mu_ ABSL_ACQUIRED_BEFORE(mu_);
   mutable std::map<std::string, v1::MapInfo> index_ ABSL_GUARDED_BY(mu_);
   mutable std::set<std::string> corrupted_ ABSL_GUARDED_BY(mu_);
+  bool loading_ ABSL_GUARDED_BY(mu_) = false;
 };
 
 }  // namespace covplan

@@ -151,6 +151,8 @@ int main(int argc, char** argv) {
   config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   config.store_dir = absl::GetFlag(FLAGS_store_dir);
   config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
+  // The port opens at once; health says NOT_SERVING until the store is indexed.
+  config.index_in_background = true;
   covplan::ServiceOptions& service = config.service;
   service.worker_threads = absl::GetFlag(FLAGS_threads);
   service.max_queue = absl::GetFlag(FLAGS_max_queue);

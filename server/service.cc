@@ -371,9 +371,13 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
                                                   : std::min(request->page_size(), kMaxPageSize);
   std::vector<std::string> corrupted;  // in-memory index only: cheap
   bool more = false;
-  std::vector<v1::MapInfo> page = store_->ListPage(token, page_size, &more,
-                                                    token.empty() ? &corrupted : nullptr);
-  for (v1::MapInfo& info : page) {
+  absl::StatusOr<std::vector<v1::MapInfo>> page =
+      store_->ListPage(token, page_size, &more, token.empty() ? &corrupted : nullptr);
+  if (!page.ok()) {
+    FinishCall(reactor, call, page.status());
+    return reactor;
+  }
+  for (v1::MapInfo& info : *page) {
     // Names are bounded at PutMap; older stores may hold longer ones.
     if (info.name().size() > kMapNameLimit) info.mutable_name()->resize(kMapNameLimit);
     *response->add_maps() = std::move(info);

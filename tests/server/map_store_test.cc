@@ -118,6 +118,23 @@ TEST_F(MapStoreTest, ASecondOpenOfALockedStoreFails) {
   EXPECT_TRUE(MapStore::Open(dir_).ok());
 }
 
+TEST_F(MapStoreTest, MapCallsAreUnavailableUntilTheIndexIsLoaded) {
+  {
+    absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+    ASSERT_TRUE(store.ok());
+    ASSERT_TRUE((*store)->Put(info_, map_).ok());
+  }
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::OpenLocked(dir_, /*index=*/false);
+  ASSERT_TRUE(store.ok());
+  EXPECT_TRUE((*store)->loading());
+  EXPECT_EQ((*store)->Get(info_.map_id()).status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_EQ((*store)->Put(info_, map_).status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_EQ((*store)->Delete(info_.map_id()).status().code(), absl::StatusCode::kUnavailable);
+  ASSERT_TRUE((*store)->LoadIndex(nullptr).ok());
+  EXPECT_FALSE((*store)->loading());
+  EXPECT_TRUE((*store)->Get(info_.map_id()).ok());
+}
+
 TEST_F(MapStoreTest, ListPageContinuesAfterTheGivenId) {
   absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
   ASSERT_TRUE(store.ok());
@@ -129,11 +146,11 @@ TEST_F(MapStoreTest, ListPageContinuesAfterTheGivenId) {
     ids.push_back(info.map_id());
   }
   bool more = false;
-  std::vector<v1::MapInfo> page = (*store)->ListPage("", 2, &more, nullptr);
+  std::vector<v1::MapInfo> page = *(*store)->ListPage("", 2, &more, nullptr);
   ASSERT_EQ(page.size(), 2u);
   EXPECT_EQ(page[1].map_id(), ids[1]);
   EXPECT_TRUE(more);
-  page = (*store)->ListPage(ids[1], 2, &more, nullptr);
+  page = *(*store)->ListPage(ids[1], 2, &more, nullptr);
   ASSERT_EQ(page.size(), 1u);
   EXPECT_EQ(page[0].map_id(), ids[2]);
   EXPECT_FALSE(more);

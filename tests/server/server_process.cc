@@ -76,6 +76,10 @@ absl::Status ServerProcess::Start(const std::string& store_dir,
           !absl::SimpleAtoi(Field(line, "metrics_port"), &metrics_port_)) {
         return absl::InternalError(absl::StrCat("cannot parse start-up line: ", line));
       }
+      // The store is indexed after the port opens; tests start once it is.
+      for (int j = 0; j < 600 && log().find("msg=\"map store indexed\"") == std::string::npos; ++j) {
+        absl::SleepFor(absl::Milliseconds(20));
+      }
       return absl::OkStatus();
     }
     int status = 0;

@@ -1,6 +1,7 @@
 // Test-only: runs a real covplan-server process on loopback with a chosen
-// store directory, learns its ports from its start-up log line, and stops it
-// with SIGTERM (SIGKILL if it does not exit in time).
+// store directory, learns its ports from its start-up log line (and waits
+// for the store to be indexed), and stops it with SIGTERM (SIGKILL if it
+// does not exit in time).
 //
 //   ServerProcess server;
 //   ASSERT_TRUE(server.Start(store_dir, {"--threads=1"}).ok());
