@@ -1,5 +1,6 @@
 #include "server/service.h"
 
+#include <malloc.h>
 #include <sys/random.h>
 
 #include <algorithm>
@@ -35,6 +36,9 @@ grpc::Status ToGrpc(const absl::Status& status) {
 // (RESOURCE_EXHAUSTED), not a too-short deadline, when it spent more than this
 // share of its deadline in the queue.
 constexpr double kQueueShareForOverload = 0.1;
+
+// Calls that worked this long are followed by a malloc_trim.
+constexpr absl::Duration kTrimAfterWork = absl::Milliseconds(50);
 
 // Page sizes of ListMaps (AIP-158).
 constexpr int kDefaultPageSize = 100;
@@ -195,6 +199,17 @@ void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const
   active_calls_.fetch_sub(1);
 }
 
+void CoveragePlannerService::MaybeTrimMemory(absl::Duration work) {
+  // Large solves and decodes leave freed pages in glibc's arenas; give them
+  // back (off the reply's path, at most every 100 ms) so resident memory
+  // follows the budgets instead of the high-water mark.
+  if (work < kTrimAfterWork) return;
+  const int64_t now_ms = absl::ToUnixMillis(absl::Now());
+  int64_t last = last_trim_ms_.load();
+  if (now_ms - last < 100 || !last_trim_ms_.compare_exchange_strong(last, now_ms)) return;
+  ::malloc_trim(0);
+}
+
 uint64_t CoveragePlannerService::TrackSolve(const StopToken& token) {
   absl::MutexLock lock(&solves_mu_);
   const uint64_t id = next_solve_++;
@@ -309,6 +324,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerCon
         absl::Status status = QueuedTooLong(call, reactor->cancel());
         if (status.ok()) status = RunPutMap(*request, response);
         FinishCall(reactor, call, status, response->map_id());
+        MaybeTrimMemory(absl::Now() - call.start);
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
@@ -602,6 +618,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
                                response->stats().decomposition_cached());
     }
     FinishCall(reactor, call, status, detail);
+    MaybeTrimMemory(absl::Now() - call.start);
   });
   UpdateQueueGauges();
   if (!queued) {
@@ -813,6 +830,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerCon
                                response->replan().greedy_detours_size(), response->replan().new_ranks());
     }
     FinishCall(reactor, call, status, detail);
+    MaybeTrimMemory(absl::Now() - call.start);
   });
   if (!queued) {
     ReleaseSolve();

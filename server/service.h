@@ -177,6 +177,9 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   std::map<uint64_t, StopToken> solves_ ABSL_GUARDED_BY(solves_mu_);
   uint64_t next_solve_ ABSL_GUARDED_BY(solves_mu_) = 0;
   uint64_t TrackSolve(const StopToken& token);
+  // malloc_trim after a call that worked for a while (rate-limited).
+  void MaybeTrimMemory(absl::Duration work);
+  std::atomic<int64_t> last_trim_ms_{0};
   void UntrackSolve(uint64_t id);
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};
