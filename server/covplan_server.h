@@ -49,6 +49,12 @@ struct ServerConfig {
   // health NOT_SERVING (and map calls UNAVAILABLE) until it is done, so a
   // large store does not keep the port closed. Off: Start indexes first.
   bool index_in_background = false;
+  // TLS on the gRPC port: PEM files of the server's certificate chain and
+  // key (both or neither; neither = plaintext). With a client CA, clients
+  // must present a certificate it signed (mutual TLS).
+  std::string tls_cert_file;
+  std::string tls_key_file;
+  std::string tls_client_ca_file;
   ServiceOptions service;
 };
 

@@ -51,6 +51,10 @@ ABSL_FLAG(int64_t, max_ranks, 1000,
 ABSL_FLAG(double, max_request_s, 120.0,
           "Calls without a deadline stop after this long with DEADLINE_EXCEEDED");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");
+ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain for TLS on the gRPC port (with --tls_key); empty = plaintext");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_client_ca, "",
+          "PEM CA that client certificates must chain to (mutual TLS); empty = no client certificates");
 ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
@@ -93,6 +97,12 @@ std::vector<std::string> ValidateFlags() {
   CheckRange("max_request_s", absl::GetFlag(FLAGS_max_request_s), 1e-3, 24 * 3600.0, &errors);
   CheckRange("drain_grace_s", absl::GetFlag(FLAGS_drain_grace_s), 0.0, 3600.0, &errors);
   CheckRange("drain_notice_s", absl::GetFlag(FLAGS_drain_notice_s), 0.0, 3600.0, &errors);
+  if (absl::GetFlag(FLAGS_tls_cert).empty() != absl::GetFlag(FLAGS_tls_key).empty()) {
+    errors.push_back("--tls_cert and --tls_key: give both or neither");
+  }
+  if (!absl::GetFlag(FLAGS_tls_client_ca).empty() && absl::GetFlag(FLAGS_tls_cert).empty()) {
+    errors.push_back("--tls_client_ca: needs --tls_cert and --tls_key");
+  }
   return errors;
 }
 
@@ -156,6 +166,9 @@ int main(int argc, char** argv) {
   config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   config.store_dir = absl::GetFlag(FLAGS_store_dir);
   config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
+  config.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  config.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  config.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
   // The port opens at once; health says NOT_SERVING until the store is indexed.
   config.index_in_background = true;
   covplan::ServiceOptions& service = config.service;
