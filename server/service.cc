@@ -473,6 +473,7 @@ void CoveragePlannerService::WarmInBackground(const MapSource& source, PlanReque
 absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                                              const StopToken& cancel, v1::PlanResponse* response) {
   const absl::Time start = absl::Now();
+  if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
   ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
   CommonOptions& options = plan_request.common;
@@ -712,6 +713,7 @@ std::shared_ptr<const RetainedPlan> CoveragePlannerService::FindPlan(const std::
 absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
                                                const StopToken& cancel, v1::ReplanResponse* response) {
   const absl::Time start = absl::Now();
+  if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
   if (call.deadline != absl::InfiniteFuture() && call.deadline - options_.deadline_margin <= start) {
     return absl::DeadlineExceededError(absl::StrFormat(
