@@ -9,6 +9,7 @@ PKGS=(
   libabsl-dev libglpk-dev glpk-utils libeigen3-dev libboost-graph-dev
   libyaml-cpp-dev libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
   prometheus-cpp-dev curl python3
+  openssl  # test certificates for server_tls_test
 )
 # Optional tools for fuzzing / sanitizer builds (clang + libFuzzer runtime).
 OPTIONAL=(clang libclang-rt-14-dev)

@@ -8,25 +8,71 @@
 
 #include <algorithm>
 #include <exception>
+#include <fstream>
+#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "prometheus/exposer.h"
 #include "server/log.h"
+#include "server/malformed_request_interceptor.h"
 
 namespace covplan {
+namespace {
+
+// After the grace: how long cut-short solves get to reply, then how long
+// gRPC gets to send what is written before it cancels the rest.
+constexpr absl::Duration kDrainReplyBound = absl::Milliseconds(500);
+constexpr absl::Duration kDrainFlushBound = absl::Milliseconds(200);
+
+absl::StatusOr<std::string> ReadPem(const std::string& path, const char* flag) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || text.str().find("-----BEGIN ") == std::string::npos) {
+    return absl::InvalidArgumentError(absl::StrCat(flag, " ", path, ": not a readable PEM file"));
+  }
+  return text.str();
+}
+
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(const ServerConfig& config) {
+  if (config.tls_cert_file.empty() != config.tls_key_file.empty()) {
+    return absl::InvalidArgumentError("--tls_cert and --tls_key go together");
+  }
+  if (config.tls_cert_file.empty()) {
+    if (!config.tls_client_ca_file.empty()) {
+      return absl::InvalidArgumentError("--tls_client_ca needs --tls_cert and --tls_key");
+    }
+    return grpc::InsecureServerCredentials();
+  }
+  grpc::SslServerCredentialsOptions options;
+  grpc::SslServerCredentialsOptions::PemKeyCertPair pair;
+  absl::StatusOr<std::string> cert = ReadPem(config.tls_cert_file, "--tls_cert");
+  if (!cert.ok()) return cert.status();
+  absl::StatusOr<std::string> key = ReadPem(config.tls_key_file, "--tls_key");
+  if (!key.ok()) return key.status();
+  pair.cert_chain = *cert;
+  pair.private_key = *key;
+  options.pem_key_cert_pairs.push_back(pair);
+  if (!config.tls_client_ca_file.empty()) {
+    absl::StatusOr<std::string> ca = ReadPem(config.tls_client_ca_file, "--tls_client_ca");
+    if (!ca.ok()) return ca.status();
+    options.pem_root_certs = *ca;
+    options.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  return grpc::SslServerCredentials(options);
+}
+
+}  // namespace
 
 absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const ServerConfig& config) {
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
   std::unique_ptr<CovplanServer> server(new CovplanServer());
   server->drain_notice_ = config.drain_notice;
-  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(config.store_dir);
+  absl::StatusOr<std::unique_ptr<MapStore>> store =
+      MapStore::OpenLocked(config.store_dir, /*index=*/!config.index_in_background);
   if (!store.ok()) return store.status();
   server->store_ = std::move(*store);
-  std::vector<std::string> corrupted;
-  server->store_->List(&corrupted);
-  for (const std::string& id : corrupted) {
-    LogLine("error", "corrupted map file in store, not served", {{"map_id", id}});
-  }
+  if (!config.index_in_background) server->LogIndexed(absl::ZeroDuration());
   server->metrics_ = std::make_unique<ServerMetrics>();
   server->service_ = std::make_unique<CoveragePlannerService>(
       config.service, server->store_.get(), server->metrics_.get());
@@ -53,8 +99,11 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
   builder.SetMaxSendMessageSize(config.max_message_bytes);
   const std::string address = absl::StrCat(config.address, ":", config.port);
-  builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &server->port_);
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials = CredentialsFor(config);
+  if (!credentials.ok()) return credentials.status();
+  builder.AddListeningPort(address, *credentials, &server->port_);
   builder.RegisterService(server->service_.get());
+  builder.experimental().SetInterceptorCreators(MalformedRequestInterceptors(server->metrics_.get()));
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || server->port_ == 0) {
     server->server_.reset();
@@ -62,8 +111,33 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
         absl::StrCat("cannot listen on ", address, " (port in use or bad address)"));
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
-  health->SetServingStatus(true);
-  health->SetServingStatus(v1::CoveragePlanner::service_full_name(), true);
+  const bool indexed = !server->store_->loading();
+  health->SetServingStatus(indexed);
+  health->SetServingStatus(v1::CoveragePlanner::service_full_name(), indexed);
+  const bool writable = server->store_->ProbeWritable().ok();
+  health->SetServingStatus(kStoreHealthService, writable);
+  server->metrics_->store_writable().Set(writable ? 1 : 0);
+  if (!writable) LogLine("error", "map store is not writable; PutMap and DeleteMap will fail");
+  server->probe_thread_ = std::thread(&CovplanServer::ProbeStoreLoop, server.get(),
+                                      config.store_probe_interval);
+  if (!indexed) {
+    server->index_thread_ = std::thread([raw = server.get()] {
+      const absl::Time start = absl::Now();
+      const absl::Status loaded = raw->store_->LoadIndex(&raw->index_stop_);
+      if (!loaded.ok()) {
+        LogLine(raw->index_stop_.load() ? "info" : "error", "map store not indexed",
+                {{"detail", std::string(loaded.message())}});
+        return;
+      }
+      raw->LogIndexed(absl::Now() - start);
+      raw->metrics_->maps_stored().Set(static_cast<double>(raw->store_->size()));
+      if (!raw->service_->draining()) {
+        grpc::HealthCheckServiceInterface* health = raw->server_->GetHealthCheckService();
+        health->SetServingStatus(true);
+        health->SetServingStatus(v1::CoveragePlanner::service_full_name(), true);
+      }
+    });
+  }
   LogLine("info", "covplan-server started",
           {{"address", absl::StrCat(config.address, ":", server->port_)},
            {"metrics_port", absl::StrCat(server->metrics_port_)},
@@ -74,26 +148,79 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   return server;
 }
 
+void CovplanServer::LogIndexed(absl::Duration took) {
+  std::vector<std::string> corrupted;
+  store_->List(&corrupted);
+  for (const std::string& id : corrupted) {
+    LogLine("error", "corrupted map file in store, not served", {{"map_id", id}});
+  }
+  LogLine("info", "map store indexed",
+          {{"maps", absl::StrCat(store_->size())},
+           {"corrupted", absl::StrCat(corrupted.size())},
+           {"ms", absl::StrCat(absl::ToInt64Milliseconds(took))}});
+}
+
+void CovplanServer::ProbeStoreLoop(absl::Duration interval) {
+  bool was_writable = store_->writable();
+  absl::MutexLock lock(&probe_mu_);
+  while (!probe_mu_.AwaitWithTimeout(absl::Condition(&probe_stop_), interval)) {
+    probe_mu_.Unlock();
+    const absl::Status probe = store_->ProbeWritable();
+    // A write that failed since the last probe counts too.
+    const bool writable = probe.ok() && store_->writable();
+    if (writable != was_writable) {
+      LogLine(writable ? "info" : "error", writable ? "map store writable again" : "map store is not writable",
+              {{"detail", probe.ok() ? "" : std::string(probe.message())}});
+      server_->GetHealthCheckService()->SetServingStatus(kStoreHealthService, writable);
+      metrics_->store_writable().Set(writable ? 1 : 0);
+      was_writable = writable;
+    }
+    probe_mu_.Lock();
+  }
+}
+
 void CovplanServer::Drain(absl::Duration grace) {
   absl::MutexLock lock(&drain_mu_);
   if (drained_) return;
   drained_ = true;
+  {
+    absl::MutexLock probe_lock(&probe_mu_);
+    probe_stop_ = true;
+  }
+  if (probe_thread_.joinable()) probe_thread_.join();
+  index_stop_.store(true);
+  if (index_thread_.joinable()) index_thread_.join();
+  const absl::Time start = absl::Now();
+  const absl::Time give_up = start + grace;
   if (server_ != nullptr) {
     server_->GetHealthCheckService()->SetServingStatus(false);
     service_->StartDraining();
     LogLine("info", "draining", {{"grace_ms", absl::StrCat(absl::ToInt64Milliseconds(grace))}});
-    const absl::Time give_up = absl::Now() + grace;
     absl::SleepFor(std::min(drain_notice_, grace));
-    // Waits for in-flight calls until the deadline, then cancels the rest;
-    // their StopTokens fire and the workers finish them quickly.
-    server_->Shutdown(absl::ToChronoTime(give_up));
-    LogLine("info", "gRPC server shut down");
+    // Our own calls decide how long the grace lasts, not gRPC's count of
+    // open streams: a health Watch stream or an idle connection never ends
+    // by itself and would hold Shutdown for the whole deadline.
+    while (service_->active_calls() > 0 && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(10));
+    if (service_->active_calls() > 0) {
+      // Grace over: running solves stop and answer with their best plan.
+      service_->CutShortInFlight();
+      const absl::Time replies_by = absl::Now() + kDrainReplyBound;
+      while (service_->active_calls() > 0 && absl::Now() < replies_by) {
+        absl::SleepFor(absl::Milliseconds(5));
+      }
+    }
+    // Cancels what is left (streams, calls that did not reply in time), after
+    // a moment for the replies just sent to leave.
+    server_->Shutdown(absl::ToChronoTime(absl::Now() + kDrainFlushBound));
+    LogLine("info", "gRPC server shut down",
+            {{"ms", absl::StrCat(absl::ToInt64Milliseconds(absl::Now() - start))}});
   }
   if (service_ != nullptr) service_->Shutdown();
   exposer_.reset();
   if (server_ != nullptr) {
     server_->Wait();
-    LogLine("info", "covplan-server stopped");
+    LogLine("info", "covplan-server stopped",
+            {{"ms", absl::StrCat(absl::ToInt64Milliseconds(absl::Now() - start))}});
   }
 }
 

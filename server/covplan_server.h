@@ -13,8 +13,10 @@
 #ifndef COVPLAN_SERVER_COVPLAN_SERVER_H_
 #define COVPLAN_SERVER_COVPLAN_SERVER_H_
 
+#include <atomic>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
@@ -40,8 +42,26 @@ struct ServerConfig {
   // On Drain, how long health reports NOT_SERVING (and new work is refused)
   // before the listener closes, so load balancers see it.
   absl::Duration drain_notice = absl::ZeroDuration();
+  // How often the store is probed for writes; the result is the health of
+  // kStoreHealthService and the covplan_store_writable gauge.
+  absl::Duration store_probe_interval = absl::Seconds(2);
+  // Index the store on a background thread after the port is open, with
+  // health NOT_SERVING (and map calls UNAVAILABLE) until it is done, so a
+  // large store does not keep the port closed. Off: Start indexes first.
+  bool index_in_background = false;
+  // TLS on the gRPC port: PEM files of the server's certificate chain and
+  // key (both or neither; neither = plaintext). With a client CA, clients
+  // must present a certificate it signed (mutual TLS).
+  std::string tls_cert_file;
+  std::string tls_key_file;
+  std::string tls_client_ca_file;
   ServiceOptions service;
 };
+
+// The gRPC health service name that reports whether the map store accepts
+// writes (NOT_SERVING when it is full or read-only; plans on stored maps
+// still work, so the server as a whole ("") stays SERVING).
+inline constexpr char kStoreHealthService[] = "covplan.v1.MapStore";
 
 class CovplanServer {
  public:
@@ -54,12 +74,18 @@ class CovplanServer {
   CoveragePlannerService& service() { return *service_; }
 
   // Reports NOT_SERVING and refuses new work (for the configured drain
-  // notice), lets in-flight calls finish for up to `grace` in all (then
-  // cancels them), and stops.
+  // notice), lets in-flight unary calls finish for up to `grace` in all,
+  // then cuts running solves short (they answer with their best plan,
+  // marked in termination.detail), gives replies 0.5 s + 0.2 s to leave,
+  // cancels what is left (health Watch streams included) and stops.
   void Drain(absl::Duration grace);
 
  private:
   CovplanServer() = default;
+  // Logs the corrupted maps and the size of the index.
+  void LogIndexed(absl::Duration took);
+  // Probes the store every `interval` until Drain.
+  void ProbeStoreLoop(absl::Duration interval);
 
   std::unique_ptr<MapStore> store_;
   std::unique_ptr<ServerMetrics> metrics_;
@@ -71,6 +97,11 @@ class CovplanServer {
   int metrics_port_ = -1;
   absl::Mutex drain_mu_;
   bool drained_ = false;
+  std::atomic<bool> index_stop_{false};
+  std::thread index_thread_;
+  absl::Mutex probe_mu_;
+  bool probe_stop_ ABSL_GUARDED_BY(probe_mu_) = false;
+  std::thread probe_thread_;
 };
 
 }  // namespace covplan

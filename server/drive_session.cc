@@ -7,6 +7,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "server/log.h"
+#include "server/request_limits.h"
 #include "server/service.h"
 
 namespace covplan {
@@ -167,6 +168,15 @@ bool DriveSession::KnowsPlan(const std::string& plan_id) const {
 
 void DriveSession::HandleMessage(Actions* a) {
   const uint64_t seq = in_.sequence();
+  if (absl::Status s = CheckRequestStrings(in_); !s.ok()) {
+    if (!started_) {
+      started_ = true;
+      EndLocked(ToGrpcStatus(s));
+    } else {
+      PushError(seq, s, a);
+    }
+    return;
+  }
   if (!started_) {
     started_ = true;
     if (in_.plan_ref_case() == v1::DriveRequest::PLAN_REF_NOT_SET) {

@@ -1,6 +1,8 @@
 #include "server/map_store.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,15 +18,34 @@
 #include "absl/time/clock.h"
 #include "api/convert.h"
 #include "api/digest.h"
+#include "server/log.h"
 
 namespace covplan {
 namespace {
 
 constexpr char kMagic[] = "covplan-map 1";
 constexpr char kSuffix[] = ".map";
+constexpr char kLockName[] = ".lock";
+constexpr char kProbeName[] = "write_probe.txt";
 
+absl::Status LoadingError() {
+  return absl::UnavailableError("the map store is still being indexed after a restart; retry shortly");
+}
+
+// A failed file operation as the client sees it: what failed and why, never
+// the server's paths (those go to the log). A full disk is
+// RESOURCE_EXHAUSTED, a store that may not be written UNAVAILABLE.
 absl::Status ErrnoError(absl::string_view what, const std::string& path) {
-  return absl::InternalError(absl::StrCat(what, " ", path, ": ", std::strerror(errno)));
+  const int err = errno;
+  LogLine("error", "map store file operation failed",
+          {{"op", std::string(what)}, {"path", path}, {"errno", std::strerror(err)}});
+  if (err == ENOSPC || err == EDQUOT) {
+    return absl::ResourceExhaustedError("map store is full (no space left on the server's disk)");
+  }
+  if (err == EROFS || err == EACCES || err == EPERM) {
+    return absl::UnavailableError(absl::StrCat("map store is not writable (", std::strerror(err), ")"));
+  }
+  return absl::InternalError(absl::StrCat("map store: ", what, ": ", std::strerror(err)));
 }
 
 absl::Status WriteAll(int fd, absl::string_view data, const std::string& path) {
@@ -75,29 +96,106 @@ bool IsMapFileName(const std::string& name, std::string* map_id) {
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const std::string& dir) {
+absl::StatusOr<std::unique_ptr<MapStore>> MapStore::OpenLocked(const std::string& dir, bool index) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return absl::InternalError(absl::StrCat("cannot create store directory ", dir, ": ", ec.message()));
+  // One server per store: a second one would index a different state and
+  // the two would disagree about what exists.
+  const std::string lock_path = dir + "/" + kLockName;
+  const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (lock_fd < 0) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("cannot open the store lock file ", lock_path, ": ", std::strerror(errno)));
+  }
+  if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    ::close(lock_fd);
+    if (err == EWOULDBLOCK) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "store directory ", dir, " is in use by another covplan-server (", lock_path,
+          " is locked); stop it or choose another --store_dir"));
+    }
+    return absl::FailedPreconditionError(
+        absl::StrCat("cannot lock ", lock_path, ": ", std::strerror(err)));
+  }
   std::unique_ptr<MapStore> store(new MapStore(dir));
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+  store->lock_fd_ = lock_fd;
+  if (!index) {
+    absl::MutexLock lock(&store->mu_);
+    store->loading_ = true;
+    return store;
+  }
+  if (absl::Status s = store->LoadIndex(nullptr); !s.ok()) return s;
+  return store;
+}
+
+absl::StatusOr<std::unique_ptr<MapStore>> MapStore::Open(const std::string& dir) {
+  return OpenLocked(dir, /*index=*/true);
+}
+
+absl::Status MapStore::LoadIndex(const std::atomic<bool>* stop) {
+  {
+    absl::MutexLock lock(&mu_);
+    loading_ = true;
+  }
+  std::error_code ec;
+  std::map<std::string, v1::MapInfo> index;
+  std::set<std::string> corrupted;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    if (stop != nullptr && stop->load()) return absl::CancelledError("index load stopped");
     const std::string name = entry.path().filename().string();
+    // Only regular files (not symlinks, FIFOs, devices: a FIFO would block
+    // the open forever).
+    std::error_code type_ec;
+    if (entry.symlink_status(type_ec).type() != std::filesystem::file_type::regular) continue;
     if (name.find(".tmp.") != std::string::npos) {  // left over by a crash mid-write
-      std::filesystem::remove(entry.path(), ec);
+      std::filesystem::remove(entry.path(), type_ec);
       continue;
     }
     std::string map_id;
     if (!IsMapFileName(name, &map_id)) continue;
-    absl::StatusOr<v1::GetMapResponse> stored = store->ReadVerified(entry.path().string());
-    absl::MutexLock lock(&store->mu_);
+    absl::StatusOr<v1::GetMapResponse> stored = ReadVerified(entry.path().string());
     if (stored.ok() && stored->info().map_id() == map_id) {
-      store->index_[map_id] = stored->info();
+      index[map_id] = stored->info();
     } else {
-      store->corrupted_.insert(map_id);
+      corrupted.insert(map_id);
     }
   }
-  if (ec) return absl::InternalError(absl::StrCat("cannot list ", dir, ": ", ec.message()));
-  return store;
+  if (ec) return absl::InternalError(absl::StrCat("cannot list ", dir_, ": ", ec.message()));
+  absl::MutexLock lock(&mu_);
+  index_ = std::move(index);
+  corrupted_ = std::move(corrupted);
+  loading_ = false;
+  return absl::OkStatus();
+}
+
+bool MapStore::loading() const {
+  absl::MutexLock lock(&mu_);
+  return loading_;
+}
+
+MapStore::~MapStore() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the flock
+}
+
+absl::Status MapStore::Check(const std::string& map_id) const {
+  absl::MutexLock lock(&mu_);
+  if (loading_) return LoadingError();
+  if (corrupted_.count(map_id) != 0) {
+    return absl::DataLossError(absl::StrCat("map ", map_id, " is corrupted on disk; PutMap it again"));
+  }
+  if (index_.count(map_id) == 0) {
+    return absl::NotFoundError(absl::StrCat("unknown map_id ", map_id, "; PutMap it first"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status MapStore::ProbeWritable() {
+  absl::MutexLock write_lock(&write_mu_);
+  absl::Status status = AtomicWrite(dir_, dir_ + "/" + kProbeName, "probe\n");
+  writable_.store(status.ok());
+  return status;
 }
 
 std::string MapStore::PathFor(const std::string& map_id) const {
@@ -105,35 +203,52 @@ std::string MapStore::PathFor(const std::string& map_id) const {
 }
 
 absl::StatusOr<v1::GetMapResponse> MapStore::ReadVerified(const std::string& path) const {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrCat("cannot open ", path));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  const std::string contents = buffer.str();
+  // O_NONBLOCK: a FIFO or device planted under a map's name must not hang
+  // the server; only a regular file is read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOFOLLOW);
+  if (fd < 0) {
+    if (errno == ENOENT) return absl::NotFoundError("map file is missing");
+    return absl::DataLossError(absl::StrCat("map file cannot be opened: ", std::strerror(errno)));
+  }
+  struct stat st;
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return absl::DataLossError("map file is not a regular file");
+  }
+  std::string contents(static_cast<size_t>(st.st_size), '\0');
+  size_t got = 0;
+  while (got < contents.size()) {
+    const ssize_t n = ::read(fd, contents.data() + got, contents.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    got += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  contents.resize(got);
   // Three header lines, then the payload.
   size_t pos = 0;
   absl::string_view lines[3];
   for (absl::string_view& line : lines) {
     const size_t end = contents.find('\n', pos);
-    if (end == std::string::npos) return absl::DataLossError(absl::StrCat(path, ": truncated header"));
+    if (end == std::string::npos) return absl::DataLossError("truncated header");
     line = absl::string_view(contents).substr(pos, end - pos);
     pos = end + 1;
   }
   uint64_t size = 0;
   if (lines[0] != kMagic || lines[1].size() != 64 || !absl::SimpleAtoi(lines[2], &size)) {
-    return absl::DataLossError(absl::StrCat(path, ": bad header"));
+    return absl::DataLossError("bad header");
   }
   const absl::string_view payload = absl::string_view(contents).substr(pos);
   if (payload.size() != size) {
-    return absl::DataLossError(absl::StrCat(path, ": payload is ", payload.size(),
+    return absl::DataLossError(absl::StrCat("payload is ", payload.size(),
                                             " bytes, header says ", size, " (truncated?)"));
   }
   if (Sha256Hex(payload) != lines[1]) {
-    return absl::DataLossError(absl::StrCat(path, ": checksum mismatch"));
+    return absl::DataLossError("checksum mismatch");
   }
   v1::GetMapResponse stored;
   if (!stored.ParseFromArray(payload.data(), static_cast<int>(payload.size()))) {
-    return absl::DataLossError(absl::StrCat(path, ": payload does not parse"));
+    return absl::DataLossError("payload does not parse");
   }
   return stored;
 }
@@ -148,9 +263,20 @@ absl::StatusOr<bool> MapStore::Put(const v1::MapInfo& info, const v1::Map& map) 
   const std::string& map_id = info.map_id();
   if (absl::Status s = ValidateMapId(map_id); !s.ok()) return s;
   absl::MutexLock write_lock(&write_mu_);
+  bool indexed = false;
   {
     absl::MutexLock lock(&mu_);
-    if (index_.count(map_id) != 0) return false;
+    if (loading_) return LoadingError();
+    indexed = index_.count(map_id) != 0;
+  }
+  if (indexed) {
+    // Idempotent only if the copy on disk is still intact: a file damaged
+    // since it was indexed is rewritten by this one Put.
+    absl::StatusOr<v1::GetMapResponse> on_disk = ReadVerified(PathFor(map_id));
+    if (on_disk.ok() && on_disk->info().map_id() == map_id) return false;
+    LogLine("warn", "stored map damaged, rewritten by PutMap",
+            {{"map_id", map_id},
+             {"detail", on_disk.ok() ? "id mismatch" : std::string(on_disk.status().message())}});
   }
   v1::GetMapResponse stored;
   *stored.mutable_info() = info;
@@ -161,7 +287,11 @@ absl::StatusOr<bool> MapStore::Put(const v1::MapInfo& info, const v1::Map& map) 
   if (!stored.SerializeToString(&payload)) return absl::InternalError("cannot serialise map");
   const std::string contents =
       absl::StrCat(kMagic, "\n", Sha256Hex(payload), "\n", payload.size(), "\n", payload);
-  if (absl::Status s = AtomicWrite(dir_, PathFor(map_id), contents); !s.ok()) return s;
+  if (absl::Status s = AtomicWrite(dir_, PathFor(map_id), contents); !s.ok()) {
+    if (!absl::IsInternal(s)) writable_.store(false);
+    return s;
+  }
+  writable_.store(true);
   absl::MutexLock lock(&mu_);
   index_[map_id] = stored.info();
   corrupted_.erase(map_id);
@@ -170,16 +300,7 @@ absl::StatusOr<bool> MapStore::Put(const v1::MapInfo& info, const v1::Map& map) 
 
 absl::StatusOr<v1::GetMapResponse> MapStore::Get(const std::string& map_id) const {
   if (absl::Status s = ValidateMapId(map_id); !s.ok()) return s;
-  {
-    absl::MutexLock lock(&mu_);
-    if (corrupted_.count(map_id) != 0) {
-      return absl::DataLossError(absl::StrCat("map ", map_id,
-                                              " is corrupted on disk; PutMap it again"));
-    }
-    if (index_.count(map_id) == 0) {
-      return absl::NotFoundError(absl::StrCat("unknown map_id ", map_id, "; PutMap it first"));
-    }
-  }
+  if (absl::Status s = Check(map_id); !s.ok()) return s;
   absl::StatusOr<v1::GetMapResponse> stored = ReadVerified(PathFor(map_id));
   if (!stored.ok() || stored->info().map_id() != map_id) {
     MarkCorrupted(map_id);
@@ -199,18 +320,40 @@ std::vector<v1::MapInfo> MapStore::List(std::vector<std::string>* corrupted) con
   return maps;
 }
 
+absl::StatusOr<std::vector<v1::MapInfo>> MapStore::ListPage(const std::string& after, int limit, bool* more,
+                                                            std::vector<std::string>* corrupted) const {
+  absl::MutexLock lock(&mu_);
+  if (loading_) return LoadingError();
+  std::vector<v1::MapInfo> maps;
+  auto it = after.empty() ? index_.begin() : index_.upper_bound(after);
+  for (; it != index_.end() && static_cast<int>(maps.size()) < limit; ++it) maps.push_back(it->second);
+  *more = it != index_.end();
+  if (corrupted != nullptr) corrupted->assign(corrupted_.begin(), corrupted_.end());
+  return maps;
+}
+
 absl::StatusOr<bool> MapStore::Delete(const std::string& map_id) {
   if (absl::Status s = ValidateMapId(map_id); !s.ok()) return s;
   absl::MutexLock write_lock(&write_mu_);
-  bool known = false;
   {
     absl::MutexLock lock(&mu_);
-    known = index_.erase(map_id) > 0;
-    known = corrupted_.erase(map_id) > 0 || known;
+    if (loading_) return LoadingError();
+    if (index_.count(map_id) == 0 && corrupted_.count(map_id) == 0) return false;
   }
-  if (!known) return false;
+  // The index changes only once the file is gone: a failed unlink (e.g. a
+  // read-only store) leaves the map listed and served, as it will be after a
+  // restart.
   const std::string path = PathFor(map_id);
-  if (::unlink(path.c_str()) != 0 && errno != ENOENT) return ErrnoError("cannot delete", path);
+  if (::unlink(path.c_str()) != 0 && errno != ENOENT) {
+    absl::Status s = ErrnoError("delete", path);
+    if (!absl::IsInternal(s)) writable_.store(false);
+    return s;
+  }
+  {
+    absl::MutexLock lock(&mu_);
+    index_.erase(map_id);
+    corrupted_.erase(map_id);
+  }
   if (absl::Status s = FsyncDir(dir_); !s.ok()) return s;
   return true;
 }

@@ -10,6 +10,10 @@
 // name (then the directory is fsync'ed), so a crash leaves either the old
 // state or the complete new file. Every read verifies the checksum: a
 // damaged file is reported (DataLoss, listed as corrupted), never served.
+// Open takes an exclusive flock on `<dir>/.lock` for the store's lifetime, so
+// a second server on the same directory fails to start. Only regular files
+// are read. Errors returned to callers name no server paths (they are
+// logged); a full disk is ResourceExhausted, an unwritable store Unavailable.
 //
 //   ASSIGN_OR_RETURN(std::unique_ptr<MapStore> store, MapStore::Open("./covplan-data/maps"));
 //   ASSIGN_OR_RETURN(bool created, store->Put(info, map));
@@ -19,6 +23,7 @@
 #ifndef COVPLAN_SERVER_MAP_STORE_H_
 #define COVPLAN_SERVER_MAP_STORE_H_
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <set>
@@ -34,11 +39,23 @@ namespace covplan {
 
 class MapStore {
  public:
-  // Creates `dir` if needed and indexes (and verifies) the maps in it.
+  // Creates `dir` if needed, locks it and indexes (and verifies) the maps in
+  // it. FailedPrecondition if another process holds the lock.
   static absl::StatusOr<std::unique_ptr<MapStore>> Open(const std::string& dir);
+  // Locks `dir`; with index=false, leaves the index to LoadIndex (e.g. on a
+  // background thread while the server already answers health). Until it
+  // has run, the map methods return Unavailable.
+  static absl::StatusOr<std::unique_ptr<MapStore>> OpenLocked(const std::string& dir, bool index);
+  // Reads and verifies every map file; `stop` (optional) ends it early.
+  absl::Status LoadIndex(const std::atomic<bool>* stop);
+  bool loading() const;
+  ~MapStore();
+  MapStore(const MapStore&) = delete;
+  MapStore& operator=(const MapStore&) = delete;
 
   // Stores the map under info.map_id(). Returns false when an intact copy was
-  // already stored (idempotent); a corrupted copy is replaced.
+  // already stored (idempotent); a corrupted or missing copy is replaced,
+  // even one that was intact when indexed.
   absl::StatusOr<bool> Put(const v1::MapInfo& info, const v1::Map& map);
 
   // NotFound for an unknown id, DataLoss for a damaged file.
@@ -47,9 +64,24 @@ class MapStore {
   // Metadata of every intact map (sorted by id); `corrupted` (optional)
   // receives the ids of damaged files.
   std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const;
+  // At most `limit` maps with ids after `after` ("" = from the start);
+  // `more` says whether any follow.
+  absl::StatusOr<std::vector<v1::MapInfo>> ListPage(const std::string& after, int limit, bool* more,
+                                                    std::vector<std::string>* corrupted) const;
 
-  // Returns false if there was no such map.
+  // Returns false if there was no such map. The map stays indexed when the
+  // file cannot be removed.
   absl::StatusOr<bool> Delete(const std::string& map_id);
+
+  // From the in-memory index only (no disk access): OK if the map is
+  // indexed and not known to be damaged, else NotFound / DataLoss.
+  absl::Status Check(const std::string& map_id) const;
+
+  // Writes and renames a small probe file; updates writable().
+  absl::Status ProbeWritable();
+  // False after a write failed for lack of space or permission, until one
+  // succeeds again.
+  bool writable() const { return writable_.load(); }
 
   int64_t size() const;
   const std::string& dir() const { return dir_; }
@@ -77,11 +109,14 @@ class MapStore {
   void MarkCorrupted(const std::string& map_id) const;
 
   const std::string dir_;
+  int lock_fd_ = -1;
+  std::atomic<bool> writable_{true};
   mutable absl::Mutex mu_;
   // Serialises writers of the same directory so Put/Delete races stay ordered.
   absl::Mutex write_mu_ ABSL_ACQUIRED_BEFORE(mu_);
   mutable std::map<std::string, v1::MapInfo> index_ ABSL_GUARDED_BY(mu_);
   mutable std::set<std::string> corrupted_ ABSL_GUARDED_BY(mu_);
+  bool loading_ ABSL_GUARDED_BY(mu_) = false;
 };
 
 }  // namespace covplan

@@ -52,6 +52,9 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                                  "Memory budget of the cache");
   maps_stored_ = NewGauge(r, "covplan_maps_stored", "Maps in the registry");
   plans_retained_ = NewGauge(r, "covplan_plans_retained", "Plans addressable by plan_id");
+  store_writable_ = NewGauge(r, "covplan_store_writable",
+                             "1 while the map store accepts writes, 0 when it is full or read-only");
+  store_writable_->Set(1);
   replans_ = &prometheus::BuildCounter()
                   .Name("covplan_replans_total")
                   .Help("Replans answered, by the method that produced the plan")

@@ -53,6 +53,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge& plans_retained() { return *plans_retained_; }
   prometheus::Gauge& drive_sessions() { return *drive_sessions_; }
   prometheus::Counter& drive_superseded() { return *drive_superseded_; }
+  prometheus::Gauge& store_writable() { return *store_writable_; }
 
   // CacheObserver.
   void OnCacheHit() override { cache_hits_->Increment(); }
@@ -78,6 +79,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge* cache_budget_bytes_;
   prometheus::Gauge* maps_stored_;
   prometheus::Gauge* plans_retained_;
+  prometheus::Gauge* store_writable_;
   prometheus::Family<prometheus::Counter>* replans_;
   prometheus::Histogram* replan_duration_;
   prometheus::Counter* greedy_detours_;

@@ -4,11 +4,22 @@
 //                  --store_dir=./covplan-data/maps --threads=2
 //
 // SIGTERM / SIGINT: health goes NOT_SERVING, new work is refused, in-flight
-// calls get --drain_grace_s to finish, then the process exits 0.
+// calls get --drain_grace_s to finish (then running plans answer with their
+// best so far), and the process exits 0 within the grace plus 1.5 s. A signal
+// during start-up (e.g. while the store is indexed) exits at once.
+// Every flag is range-checked first; a bad value exits 2 with a message
+// naming the flag (absl's own parse errors, such as an unknown flag or a
+// non-number, exit 1).
+#include <malloc.h>
 #include <signal.h>
 
+#include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <thread>
+#include <type_traits>
+#include <vector>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
@@ -16,6 +27,7 @@
 #include "absl/flags/usage_config.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
 #include "server/covplan_server.h"
 #include "server/log.h"
 
@@ -39,10 +51,90 @@ ABSL_FLAG(int64_t, max_ranks, 1000,
 ABSL_FLAG(double, max_request_s, 120.0,
           "Calls without a deadline stop after this long with DEADLINE_EXCEEDED");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");
+ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain for TLS on the gRPC port (with --tls_key); empty = plaintext");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_client_ca, "",
+          "PEM CA that client certificates must chain to (mutual TLS); empty = no client certificates");
 ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
+namespace {
+
+// How far past --drain_grace_s the process may run before it exits anyway.
+constexpr absl::Duration kDrainOverrun = absl::Milliseconds(1500);
+
+// The range every numeric flag must lie in, checked before anything starts.
+template <typename T>
+void CheckRange(const char* name, T value, T lo, T hi, std::vector<std::string>* errors) {
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!std::isfinite(value) || value < lo || value > hi) {
+      errors->push_back(absl::StrCat("--", name, "=", value, ": must be a number in [", lo, ", ", hi, "]"));
+    }
+  } else if (value < lo || value > hi) {
+    errors->push_back(absl::StrCat("--", name, "=", value, ": must be an integer in [", lo, ", ", hi, "]"));
+  }
+}
+
+std::vector<std::string> ValidateFlags() {
+  std::vector<std::string> errors;
+  if (absl::GetFlag(FLAGS_address).empty()) errors.push_back("--address: must not be empty");
+  if (absl::GetFlag(FLAGS_metrics_address).empty()) errors.push_back("--metrics_address: must not be empty");
+  if (absl::GetFlag(FLAGS_store_dir).empty()) errors.push_back("--store_dir: must not be empty");
+  CheckRange("port", absl::GetFlag(FLAGS_port), 0, 65535, &errors);
+  CheckRange("metrics_port", absl::GetFlag(FLAGS_metrics_port), -1, 65535, &errors);
+  CheckRange("threads", absl::GetFlag(FLAGS_threads), 1, 256, &errors);
+  CheckRange("max_queue", absl::GetFlag(FLAGS_max_queue), 0, 100000, &errors);
+  CheckRange<int64_t>("cache_mb", absl::GetFlag(FLAGS_cache_mb), 1, 1 << 20, &errors);
+  CheckRange("default_budget_s", absl::GetFlag(FLAGS_default_budget_s), 1e-3, 3600.0, &errors);
+  CheckRange("deadline_margin_ms", absl::GetFlag(FLAGS_deadline_margin_ms), 0, 60000, &errors);
+  CheckRange("plan_ttl_s", absl::GetFlag(FLAGS_plan_ttl_s), 1, 30 * 24 * 3600, &errors);
+  CheckRange("max_retained_plans", absl::GetFlag(FLAGS_max_retained_plans), 1, 1000000, &errors);
+  // The largest gRPC message is the image plus 4 MiB and must fit an int.
+  CheckRange<int64_t>("max_image_mb", absl::GetFlag(FLAGS_max_image_mb), 1, 2000, &errors);
+  CheckRange<int64_t>("max_map_pixels", absl::GetFlag(FLAGS_max_map_pixels), 1, int64_t{1} << 36, &errors);
+  CheckRange<int64_t>("max_grid_cells", absl::GetFlag(FLAGS_max_grid_cells), 1, int64_t{1} << 32, &errors);
+  CheckRange<int64_t>("max_ranks", absl::GetFlag(FLAGS_max_ranks), 1, 100000, &errors);
+  CheckRange("max_request_s", absl::GetFlag(FLAGS_max_request_s), 1e-3, 24 * 3600.0, &errors);
+  CheckRange("drain_grace_s", absl::GetFlag(FLAGS_drain_grace_s), 0.0, 3600.0, &errors);
+  CheckRange("drain_notice_s", absl::GetFlag(FLAGS_drain_notice_s), 0.0, 3600.0, &errors);
+  if (absl::GetFlag(FLAGS_tls_cert).empty() != absl::GetFlag(FLAGS_tls_key).empty()) {
+    errors.push_back("--tls_cert and --tls_key: give both or neither");
+  }
+  if (!absl::GetFlag(FLAGS_tls_client_ca).empty() && absl::GetFlag(FLAGS_tls_cert).empty()) {
+    errors.push_back("--tls_client_ca: needs --tls_cert and --tls_key");
+  }
+  return errors;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  // Block the signals in every thread before any is created; one thread
+  // waits for them from here on, so SIGTERM works during start-up too.
+  static sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // 0 until a signal arrives; -1 once the server runs (the main thread then
+  // owns the drain).
+  static std::atomic<int> received{0};
+  static std::atomic<bool> started{false};
+  static absl::Mutex signal_mu;
+  std::thread([] {
+    int signal_number = 0;
+    sigwait(&signals, &signal_number);
+    absl::MutexLock lock(&signal_mu);
+    received.store(signal_number);
+    if (!started.load()) {
+      // Nothing to drain yet: start-up only reads the store.
+      covplan::LogLine("info", "signal during start-up, exiting",
+                       {{"signal", absl::StrCat(signal_number)}});
+      std::fflush(stderr);
+      std::_Exit(0);
+    }
+  }).detach();
+
   absl::SetProgramUsageMessage("coverage path planning gRPC service");
   // --help lists this file's flags (absl looks for a file named after the
   // binary by default and would show none).
@@ -51,14 +143,21 @@ int main(int argc, char** argv) {
     return absl::StrContains(path, "server/server_main.cc");
   };
   absl::SetFlagsUsageConfig(usage);
-  absl::ParseCommandLine(argc, argv);
+  const std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
+  std::vector<std::string> errors = ValidateFlags();
+  for (size_t i = 1; i < positional.size(); ++i) {
+    errors.push_back(absl::StrCat("unexpected argument '", std::string(positional[i]).substr(0, 64),
+                                  "' (flags are --name=value)"));
+  }
+  if (!errors.empty()) {
+    for (const std::string& e : errors) std::fprintf(stderr, "covplan-server: %s\n", e.c_str());
+    std::fprintf(stderr, "covplan-server: see --help\n");
+    return 2;
+  }
 
-  // Block the signals in every thread; this one waits for them below.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // One glibc arena per worker (plus the I/O and gRPC threads' few) instead
+  // of up to 8 per core: each arena keeps its own high-water mark.
+  mallopt(M_ARENA_MAX, absl::GetFlag(FLAGS_threads) + 4);
 
   covplan::ServerConfig config;
   config.address = absl::GetFlag(FLAGS_address);
@@ -67,6 +166,11 @@ int main(int argc, char** argv) {
   config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   config.store_dir = absl::GetFlag(FLAGS_store_dir);
   config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
+  config.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  config.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  config.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
+  // The port opens at once; health says NOT_SERVING until the store is indexed.
+  config.index_in_background = true;
   covplan::ServiceOptions& service = config.service;
   service.worker_threads = absl::GetFlag(FLAGS_threads);
   service.max_queue = absl::GetFlag(FLAGS_max_queue);
@@ -74,17 +178,12 @@ int main(int argc, char** argv) {
   service.default_budget_s = absl::GetFlag(FLAGS_default_budget_s);
   service.deadline_margin = absl::Milliseconds(absl::GetFlag(FLAGS_deadline_margin_ms));
   service.plan_ttl = absl::Seconds(absl::GetFlag(FLAGS_plan_ttl_s));
-  service.max_retained_plans = static_cast<size_t>(std::max(0, absl::GetFlag(FLAGS_max_retained_plans)));
+  service.max_retained_plans = static_cast<size_t>(absl::GetFlag(FLAGS_max_retained_plans));
   service.limits.max_image_bytes = absl::GetFlag(FLAGS_max_image_mb) << 20;
   service.limits.max_map_pixels = absl::GetFlag(FLAGS_max_map_pixels);
   service.limits.max_grid_cells = absl::GetFlag(FLAGS_max_grid_cells);
   service.limits.max_ranks = absl::GetFlag(FLAGS_max_ranks);
-  const double max_request_s = absl::GetFlag(FLAGS_max_request_s);
-  if (!(max_request_s > 0)) {
-    std::fprintf(stderr, "covplan-server: --max_request_s must be a positive number of seconds\n");
-    return 1;
-  }
-  service.max_request_time = absl::Seconds(max_request_s);
+  service.max_request_time = absl::Seconds(absl::GetFlag(FLAGS_max_request_s));
   // Room for the image plus YAML and the rest of the request.
   config.max_message_bytes =
       static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));
@@ -94,10 +193,28 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "covplan-server: %s\n", std::string(server.status().message()).c_str());
     return 1;
   }
-  int signal_number = 0;
-  sigwait(&signals, &signal_number);
+  {
+    absl::MutexLock lock(&signal_mu);
+    started.store(true);
+  }
+  // Wait for the signal thread to record a signal.
+  {
+    absl::MutexLock lock(&signal_mu);
+    signal_mu.Await(absl::Condition(
+        +[](std::atomic<int>* r) { return r->load() != 0; }, &received));
+  }
   covplan::LogLine("info", "signal received, shutting down",
-                   {{"signal", absl::StrCat(signal_number)}});
-  (*server)->Drain(absl::Seconds(absl::GetFlag(FLAGS_drain_grace_s)));
+                   {{"signal", absl::StrCat(received.load())}});
+  const absl::Duration grace = absl::Seconds(absl::GetFlag(FLAGS_drain_grace_s));
+  // The drain is bounded by our own timing; should gRPC's transport
+  // teardown (or the /metrics server's) still hang, exit anyway.
+  std::thread([grace] {
+    absl::SleepFor(grace + kDrainOverrun);
+    covplan::LogLine("warn", "drain overran its bound; exiting",
+                     {{"bound_ms", absl::StrCat(absl::ToInt64Milliseconds(grace + kDrainOverrun))}});
+    std::fflush(stderr);
+    std::_Exit(0);
+  }).detach();
+  (*server)->Drain(grace);
   return 0;
 }

@@ -1,5 +1,8 @@
 #include "server/service.h"
 
+#include <malloc.h>
+#include <sys/random.h>
+
 #include <algorithm>
 #include <random>
 #include <utility>
@@ -10,16 +13,37 @@
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "server/log.h"
+#include "server/request_limits.h"
 
 namespace covplan {
 namespace {
 
 constexpr char kEstimatorFile[] = "replan_estimator.txt";
 
+// Status messages are bounded (they travel in trailing metadata, whose size
+// the client limits; an over-long one would turn the real error into
+// RESOURCE_EXHAUSTED on the client).
+std::string BoundedMessage(absl::string_view message) {
+  if (message.size() <= kMaxMessageBytes) return std::string(message);
+  return absl::StrCat(message.substr(0, kMaxMessageBytes - 24), "...(truncated)");
+}
+
 grpc::Status ToGrpc(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), BoundedMessage(status.message()));
 }
+
+// A Plan stopped by its deadline before a first plan is overload
+// (RESOURCE_EXHAUSTED), not a too-short deadline, when it spent more than this
+// share of its deadline in the queue.
+constexpr double kQueueShareForOverload = 0.1;
+
+// Calls that worked this long are followed by a malloc_trim.
+constexpr absl::Duration kTrimAfterWork = absl::Milliseconds(50);
+
+// Page sizes of ListMaps (AIP-158).
+constexpr int kDefaultPageSize = 100;
+constexpr int kMaxPageSize = 1000;
 
 std::string CodeName(const absl::Status& status) { return absl::StatusCodeToString(status.code()); }
 
@@ -39,8 +63,20 @@ bool IsStop(const absl::Status& status) {
 // The status for work that stopped early: the client's cancellation wins,
 // otherwise the deadline was too short for even a first plan.
 absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
-                           const CallInfo& call, absl::Duration max_request_time) {
-  if (cancel.cancelled()) return absl::CancelledError("call cancelled by the client");
+                           const CallInfo& call, absl::Time started, absl::Duration max_request_time) {
+  if (cancel.cancelled()) return absl::CancelledError("call cancelled (by the client, or by the server's drain)");
+  // A call that spent a real share of its deadline waiting for a worker was
+  // refused by overload, not by its own deadline: say so with the code a
+  // client retries on (elsewhere).
+  if (call.deadline != absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
+    const absl::Duration waited = started - call.start;
+    if (waited > kQueueShareForOverload * (call.deadline - call.start)) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "server busy: the call waited %d ms of its %d ms deadline for a worker and had no time "
+          "left for a first plan; retry later or elsewhere",
+          absl::ToInt64Milliseconds(waited), absl::ToInt64Milliseconds(call.deadline - call.start)));
+    }
+  }
   if (call.deadline == absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
     return absl::DeadlineExceededError(absl::StrFormat(
         "no plan within the server's limit of %g s per call without a deadline "
@@ -97,6 +133,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       sessions_(options.max_sessions, options.session_idle),
       id_salt_(std::random_device{}()),
       io_pool_(/*threads=*/2, /*max_queue=*/64),
+      read_pool_(/*threads=*/1, /*max_queue=*/256),
       // Admission is bounded by TryAdmitSolve; the pool's own bound is slack
       // for solves that have released their slot but not yet returned.
       pool_(options.worker_threads, 2 * (options.worker_threads + options.max_queue)),
@@ -124,6 +161,7 @@ void CoveragePlannerService::Shutdown() {
   warm_pool_.Shutdown();
   pool_.Shutdown();
   io_pool_.Shutdown();
+  read_pool_.Shutdown();
 }
 
 CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
@@ -132,6 +170,7 @@ CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
   call.method = method;
   call.start = absl::Now();
   call.deadline = DeadlineOf(*context);
+  active_calls_.fetch_add(1);
   const auto& metadata = context->client_metadata();
   if (auto it = metadata.find("x-request-id"); it != metadata.end() && it->second.size() <= 64) {
     call.request_id.assign(it->second.data(), it->second.size());
@@ -151,6 +190,7 @@ void CoveragePlannerService::FinishCall(grpc::ServerUnaryReactor* reactor, const
                                         const absl::Status& status, const std::string& detail) {
   RecordCall(call, status, detail);
   reactor->Finish(ToGrpc(status));
+  active_calls_.fetch_sub(1);
 }
 
 void CoveragePlannerService::RecordCall(const CallInfo& call, const absl::Status& status,
@@ -165,11 +205,56 @@ void CoveragePlannerService::RecordCall(const CallInfo& call, const absl::Status
            {"code", CodeName(status)},
            {"ms", absl::StrFormat("%.1f", seconds * 1e3)},
            {"late", late ? "true" : "false"},
-           {"detail", status.ok() ? detail : std::string(status.message())}});
+           {"detail", BoundedMessage(status.ok() ? detail : std::string(status.message()))}});
+}
+
+void CoveragePlannerService::MaybeTrimMemory(absl::Duration work) {
+  // Large solves and decodes leave freed pages in glibc's arenas; give them
+  // back (off the reply's path, at most every 100 ms) so resident memory
+  // follows the budgets instead of the high-water mark.
+  if (work < kTrimAfterWork) return;
+  const int64_t now_ms = absl::ToUnixMillis(absl::Now());
+  int64_t last = last_trim_ms_.load();
+  if (now_ms - last < 100 || !last_trim_ms_.compare_exchange_strong(last, now_ms)) return;
+  ::malloc_trim(0);
+}
+
+uint64_t CoveragePlannerService::TrackSolve(const StopToken& token) {
+  absl::MutexLock lock(&solves_mu_);
+  const uint64_t id = next_solve_++;
+  solves_.emplace(id, token);
+  if (drain_cut_.load()) token.Cancel();
+  return id;
+}
+
+void CoveragePlannerService::UntrackSolve(uint64_t id) {
+  absl::MutexLock lock(&solves_mu_);
+  solves_.erase(id);
+}
+
+void CoveragePlannerService::CutShortInFlight() {
+  absl::MutexLock lock(&solves_mu_);
+  drain_cut_.store(true);
+  for (const auto& [id, token] : solves_) token.Cancel();
+  if (!solves_.empty()) {
+    LogLine("warn", "drain grace over: cutting running solves short", {{"solves", absl::StrCat(solves_.size())}});
+  }
 }
 
 bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
   return io_pool_.TrySubmit(std::move(work));
+}
+
+absl::Status CoveragePlannerService::QueuedTooLong(const CallInfo& call, const StopToken& cancel) const {
+  // gRPC also cancels a call whose deadline passed: say which it was.
+  const absl::Time now = absl::Now();
+  if (now >= call.deadline) {
+    return absl::DeadlineExceededError(absl::StrFormat(
+        "deadline passed while the call waited %d ms for a worker; not started",
+        absl::ToInt64Milliseconds(now - call.start)));
+  }
+  if (cancel.cancelled()) return absl::CancelledError("call cancelled while it waited for a worker; not started");
+  return absl::OkStatus();
 }
 
 bool CoveragePlannerService::TryAdmitSolve() {
@@ -186,8 +271,24 @@ void CoveragePlannerService::ReleaseSolve() { admitted_.fetch_sub(1); }
 void CoveragePlannerService::UpdateQueueGauges() { metrics_->queue_depth().Set(pool_.queued()); }
 
 std::string CoveragePlannerService::NewPlanId() {
-  return absl::StrFormat("p-%08x-%08x", static_cast<uint32_t>(id_salt_ >> 8),
-                         next_id_.fetch_add(1, std::memory_order_relaxed));
+  // 128 bits from the kernel's CSPRNG: a plan id cannot be guessed from
+  // another one.
+  unsigned char bytes[16];
+  size_t got = 0;
+  while (got < sizeof(bytes)) {
+    const ssize_t n = ::getrandom(bytes + got, sizeof(bytes) - got, 0);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      // getrandom cannot fail on Linux >= 3.17 once the pool is seeded; if it
+      // ever does, refuse to hand out a guessable id.
+      LogLine("error", "getrandom failed", {{"errno", absl::StrCat(errno)}});
+      std::abort();
+    }
+    got += static_cast<size_t>(n);
+  }
+  std::string id = "p-";
+  for (unsigned char b : bytes) absl::StrAppendFormat(&id, "%02x", b);
+  return id;
 }
 
 // ---------------------------------------------------------------- maps
@@ -195,10 +296,14 @@ std::string CoveragePlannerService::NewPlanId() {
 absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
                                                v1::PutMapResponse* response) {
   ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), options_.limits));
+  RETURN_IF_ERROR(CheckSiteGeometry(site));
   const std::string map_id = ComputeMapId(request.map());
   v1::MapInfo info = MapInfoFor(site, map_id);
   info.set_name(request.name());
   ASSIGN_OR_RETURN(bool created, store_->Put(info, request.map()));
+  // A rewritten (repaired) map must not be planned from artifacts of the
+  // damaged copy; the content is the same, but be safe and cheap: drop them.
+  if (created) cache_.EraseWithPrefix(map_id + "/");
   if (!created) {
     ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
     info = stored.info();
@@ -213,15 +318,22 @@ absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
 grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerContext* context,
                                                          const v1::PutMapRequest* request,
                                                          v1::PutMapResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "PutMap");
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
   }
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
   if (!SubmitIo([this, reactor, call, request, response] {
-        const absl::Status status = RunPutMap(*request, response);
+        // Work whose caller gave up while it was queued is dropped unstarted.
+        absl::Status status = QueuedTooLong(call, reactor->cancel());
+        if (status.ok()) status = RunPutMap(*request, response);
         FinishCall(reactor, call, status, response->map_id());
+        MaybeTrimMemory(absl::Now() - call.start);
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
@@ -231,16 +343,26 @@ grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerCon
 grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerContext* context,
                                                          const v1::GetMapRequest* request,
                                                          v1::GetMapResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "GetMap");
-  if (!SubmitIo([this, reactor, call, request, response] {
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
+  // On the read pool: never behind PutMap's decoding.
+  if (!read_pool_.TrySubmit([this, reactor, call, request, response] {
+        if (absl::Status s = QueuedTooLong(call, reactor->cancel()); !s.ok()) {
+          FinishCall(reactor, call, s);
+          return;
+        }
         absl::StatusOr<v1::GetMapResponse> stored = store_->Get(request->map_id());
+        if (absl::IsDataLoss(stored.status())) cache_.EraseWithPrefix(request->map_id() + "/");
         if (stored.ok()) {
           *response->mutable_info() = stored->info();
           if (request->include_content())
             *response->mutable_map() = std::move(*stored->mutable_map());
         }
-        FinishCall(reactor, call, stored.status(), request->map_id());
+        FinishCall(reactor, call, stored.status(), QuotePrefix(request->map_id()));
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
@@ -248,13 +370,48 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerCon
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerContext* context,
-                                                           const v1::ListMapsRequest*,
+                                                           const v1::ListMapsRequest* request,
                                                            v1::ListMapsResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "ListMaps");
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
+  if (request->page_size() < 0) {
+    FinishCall(reactor, call,
+               absl::InvalidArgumentError(absl::StrCat("page_size must be >= 0 (got ",
+                                                       request->page_size(), ")")));
+    return reactor;
+  }
+  // The token is the last map_id of the previous page (ids are sorted).
+  const std::string& token = request->page_token();
+  if (!token.empty() && !ValidateMapId(token).ok()) {
+    FinishCall(reactor, call,
+               absl::InvalidArgumentError(absl::StrCat("page_token '", QuotePrefix(token),
+                                                       "' is not a next_page_token of ListMaps")));
+    return reactor;
+  }
+  const int page_size = request->page_size() == 0 ? kDefaultPageSize
+                                                  : std::min(request->page_size(), kMaxPageSize);
   std::vector<std::string> corrupted;  // in-memory index only: cheap
-  for (v1::MapInfo& info : store_->List(&corrupted)) *response->add_maps() = std::move(info);
+  bool more = false;
+  absl::StatusOr<std::vector<v1::MapInfo>> page =
+      store_->ListPage(token, page_size, &more, token.empty() ? &corrupted : nullptr);
+  if (!page.ok()) {
+    FinishCall(reactor, call, page.status());
+    return reactor;
+  }
+  for (v1::MapInfo& info : *page) {
+    // Names are bounded at PutMap; older stores may hold longer ones.
+    if (info.name().size() > kMapNameLimit) info.mutable_name()->resize(kMapNameLimit);
+    *response->add_maps() = std::move(info);
+  }
+  if (corrupted.size() > static_cast<size_t>(kMaxPageSize)) corrupted.resize(kMaxPageSize);
   for (std::string& id : corrupted) response->add_corrupted(std::move(id));
+  if (more && response->maps_size() > 0) {
+    response->set_next_page_token(response->maps(response->maps_size() - 1).map_id());
+  }
   FinishCall(reactor, call, absl::OkStatus());
   return reactor;
 }
@@ -262,16 +419,24 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
 grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServerContext* context,
                                                             const v1::DeleteMapRequest* request,
                                                             v1::DeleteMapResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "DeleteMap");
-  if (!SubmitIo([this, reactor, call, request, response] {
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
+  if (!read_pool_.TrySubmit([this, reactor, call, request, response] {
+        if (absl::Status s = QueuedTooLong(call, reactor->cancel()); !s.ok()) {
+          FinishCall(reactor, call, s);
+          return;
+        }
         absl::StatusOr<bool> deleted = store_->Delete(request->map_id());
         if (deleted.ok()) {
           response->set_deleted(*deleted);
           cache_.EraseWithPrefix(request->map_id() + "/");
           metrics_->maps_stored().Set(static_cast<double>(store_->size()));
         }
-        FinishCall(reactor, call, deleted.status(), request->map_id());
+        FinishCall(reactor, call, deleted.status(), QuotePrefix(request->map_id()));
       })) {
     FinishCall(reactor, call, absl::ResourceExhaustedError("server busy: work queue is full"));
   }
@@ -285,9 +450,14 @@ MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
   MapSource source;
   source.map_id = map_id;
   source.load = [this, map_id, inline_map]() -> absl::StatusOr<SiteMap> {
-    if (inline_map != nullptr) return SiteFromProto(*inline_map, options_.limits);
-    ASSIGN_OR_RETURN(v1::GetMapResponse stored, store_->Get(map_id));
-    return SiteFromProto(stored.map(), options_.limits);
+    v1::GetMapResponse stored;
+    if (inline_map == nullptr) {
+      ASSIGN_OR_RETURN(stored, store_->Get(map_id));
+    }
+    ASSIGN_OR_RETURN(SiteMap site,
+                     SiteFromProto(inline_map != nullptr ? *inline_map : stored.map(), options_.limits));
+    RETURN_IF_ERROR(CheckSiteGeometry(site));
+    return site;
   };
   return source;
 }
@@ -312,6 +482,7 @@ void CoveragePlannerService::WarmInBackground(const MapSource& source, PlanReque
 absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                                              const StopToken& cancel, v1::PlanResponse* response) {
   const absl::Time start = absl::Now();
+  if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
   ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
   CommonOptions& options = plan_request.common;
@@ -347,6 +518,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     case v1::PlanRequest::kMapId:
       RETURN_IF_ERROR(ValidateMapId(request.map_id()));
       map_id = request.map_id();
+      // A deleted map, or one found damaged, is not planned from the cache.
+      RETURN_IF_ERROR(store_->Check(map_id));
       break;
     case v1::PlanRequest::kMap:
       map_id = ComputeMapId(request.map());
@@ -364,8 +537,11 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       // deadline that hit --max_request_s already had that long.)
       WarmInBackground(source, plan_request);
     }
+    if (IsStop(result.status()) && drain_cut_.load()) {
+      return absl::UnavailableError("server shut down before a first plan was found; retry on another");
+    }
     return IsStop(result.status())
-               ? StoppedStatus(result.status(), cancel, call, options_.max_request_time)
+               ? StoppedStatus(result.status(), cancel, call, start, options_.max_request_time)
                : result.status();
   }
   auto retained = std::make_shared<RetainedPlan>();
@@ -376,6 +552,11 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   retained->request = std::move(plan_request);
   retained->request.common.stop = StopToken();  // the call's token ends with the call
   RetainedPlanToProto(*retained, response);
+  if (drain_cut_.load() && response->termination().limit() == v1::LIMIT_CANCELLED) {
+    response->mutable_termination()->set_detail(
+        absl::StrCat("cut short by the server's drain (shutting down); ",
+                     response->termination().detail()));
+  }
   if (request.map_ref_case() == v1::PlanRequest::kMapId) PersistPlan(request, *response);
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, retained->plan.stats.tour_cut_short);
@@ -393,6 +574,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   CallInfo call = StartCall(context, "Plan");
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
     return reactor;
   }
   const auto reject = [&] {
@@ -428,7 +613,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
     UpdateQueueGauges();
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    const uint64_t solve = TrackSolve(reactor->cancel());
     const absl::Status status = RunPlan(call, *request, reactor->cancel(), response);
+    UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     ReleaseSolve();
     std::string detail;
@@ -441,6 +628,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
                                response->stats().decomposition_cached());
     }
     FinishCall(reactor, call, status, detail);
+    MaybeTrimMemory(absl::Now() - call.start);
   });
   UpdateQueueGauges();
   if (!queued) {
@@ -455,16 +643,21 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
                                                           v1::PlanResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "GetPlan");
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
+    return reactor;
+  }
   std::shared_ptr<const RetainedPlan> plan = plans_.Get(request->plan_id());
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   if (plan == nullptr) {
     FinishCall(
         reactor, call,
-        absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", request->plan_id(), "'")));
+        absl::NotFoundError(
+            absl::StrCat("unknown or expired plan_id '", QuotePrefix(request->plan_id()), "'")));
     return reactor;
   }
   RetainedPlanToProto(*plan, response);  // in memory, no blocking
-  FinishCall(reactor, call, absl::OkStatus(), request->plan_id());
+  FinishCall(reactor, call, absl::OkStatus(), QuotePrefix(request->plan_id()));
   return reactor;
 }
 
@@ -529,6 +722,7 @@ std::shared_ptr<const RetainedPlan> CoveragePlannerService::FindPlan(const std::
 absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
                                                const StopToken& cancel, v1::ReplanResponse* response) {
   const absl::Time start = absl::Now();
+  if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
   if (call.deadline != absl::InfiniteFuture() && call.deadline - options_.deadline_margin <= start) {
     return absl::DeadlineExceededError(absl::StrFormat(
@@ -618,12 +812,16 @@ void CoveragePlannerService::KeepReplan(ReplanResult result, const ResolvedPlan&
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
-    grpc::CallbackServerContext* context, const char* method,
+    grpc::CallbackServerContext* context, const char* method, const google::protobuf::Message* request,
     std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, method);
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
+  }
+  if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
+    FinishCall(reactor, call, s);
     return reactor;
   }
   if (!TryAdmitSolve()) {
@@ -635,11 +833,14 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
   }
   const bool queued = pool_.TrySubmit([this, reactor, call, work = std::move(work)] {
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+    const uint64_t solve = TrackSolve(reactor->cancel());
     std::string detail;
     const absl::Status status = work(call, reactor->cancel(), &detail);
+    UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     ReleaseSolve();
     FinishCall(reactor, call, status, status.ok() ? detail : "");
+    MaybeTrimMemory(absl::Now() - call.start);
   });
   if (!queued) {
     ReleaseSolve();
@@ -657,7 +858,7 @@ std::string ReplanDetail(const v1::ReplanResponse& r) {
 grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerContext* context,
                                                          const v1::ReplanRequest* request,
                                                          v1::ReplanResponse* response) {
-  return ServeSolve(context, "Replan",
+  return ServeSolve(context, "Replan", request,
                     [this, request, response](const CallInfo& call, const StopToken& cancel, std::string* detail) {
                       absl::Status status = RunReplan(call, *request, cancel, response);
                       if (status.ok()) *detail = ReplanDetail(*response);
@@ -668,7 +869,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerCon
 grpc::ServerUnaryReactor* CoveragePlannerService::Resume(grpc::CallbackServerContext* context,
                                                          const v1::ResumeRequest* request,
                                                          v1::ReplanResponse* response) {
-  return ServeSolve(context, "Resume",
+  return ServeSolve(context, "Resume", request,
                     [this, request, response](const CallInfo& call, const StopToken& cancel, std::string* detail) {
                       absl::Status status = RunResume(call, *request, cancel, response);
                       if (status.ok()) {
@@ -744,6 +945,8 @@ class RefusedDrive final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
 grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* CoveragePlannerService::Drive(
     grpc::CallbackServerContext* context) {
   const CallInfo call = StartCall(context, "Drive");
+  // A session is not a unary call the drain waits for: StartDraining ends it.
+  active_calls_.fetch_sub(1);
   if (draining()) {
     metrics_->RecordRequest("Drive", "UNAVAILABLE", 0.0);
     return new RefusedDrive(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));

@@ -1,7 +1,8 @@
 // The covplan.v1.CoveragePlanner service on gRPC's callback API.
 //
 // Handlers never block gRPC threads: solves run on a bounded WorkerPool,
-// map-registry work (decoding, disk) on a small separate one, and the reply
+// PutMap's decoding on a small separate one, GetMap / DeleteMap on a third
+// (so cheap reads never wait behind decoding), and the reply
 // is sent with Finish() from the worker. Beyond worker_threads + max_queue
 // admitted solves, Plan answers RESOURCE_EXHAUSTED at once.
 // A Plan's gRPC deadline (minus ServiceOptions::deadline_margin) is its
@@ -125,6 +126,13 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
     sessions_.EndAll();
   }
   bool draining() const { return draining_.load(); }
+  // Unary calls between arrival and Finish (health and reflection streams
+  // are not counted, so they never hold a drain).
+  int active_calls() const { return active_calls_.load(); }
+  // The end of the drain's grace: every running Plan/Replan is stopped and
+  // answers with its best plan so far, its termination detail saying the
+  // drain cut it short.
+  void CutShortInFlight();
   // Runs what is queued (cancelled calls finish quickly) and joins workers.
   void Shutdown();
 
@@ -170,6 +178,9 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   CallInfo StartCall(grpc::CallbackServerContext* context, const char* method);
   // Runs map-registry work (decode, disk) on the I/O pool; false if full.
   bool SubmitIo(std::function<void()> work);
+  // Non-OK when a queued call should not start: it was cancelled, or its
+  // deadline passed while it waited.
+  absl::Status QueuedTooLong(const CallInfo& call, const StopToken& cancel) const;
   // Admission control for solves: at most worker_threads + max_queue
   // admitted at once. A solve releases its slot just before it replies, so a
   // client that sends its next request on receiving a reply finds the slot
@@ -202,7 +213,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   void KeepReplan(ReplanResult result, const ResolvedPlan& old, v1::ReplanResponse* response);
   // A unary solve (Replan, Resume): admission, the pool, the reply.
   grpc::ServerUnaryReactor* ServeSolve(
-      grpc::CallbackServerContext* context, const char* method,
+      grpc::CallbackServerContext* context, const char* method, const google::protobuf::Message* request,
       std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work);
   void FlushProgress();
 
@@ -216,6 +227,17 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // Learns replan runtimes from this server's solves; kept in the store dir.
   ReplanEstimator estimator_;
   std::atomic<bool> draining_{false};
+  std::atomic<bool> drain_cut_{false};
+  std::atomic<int> active_calls_{0};
+  // The stop tokens of running solves, so the drain can cut them short.
+  absl::Mutex solves_mu_;
+  std::map<uint64_t, StopToken> solves_ ABSL_GUARDED_BY(solves_mu_);
+  uint64_t next_solve_ ABSL_GUARDED_BY(solves_mu_) = 0;
+  uint64_t TrackSolve(const StopToken& token);
+  // malloc_trim after a call that worked for a while (rate-limited).
+  void MaybeTrimMemory(absl::Duration work);
+  std::atomic<int64_t> last_trim_ms_{0};
+  void UntrackSolve(uint64_t id);
   std::atomic<uint64_t> next_id_{1};
   std::atomic<int> in_flight_{0};
   std::atomic<int> admitted_{0};
@@ -239,7 +261,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   uint64_t id_salt_;
   StopToken background_stop_;  // cancelled when draining or shutting down
   // Last: their threads stop before the rest is destroyed.
-  WorkerPool io_pool_;    // PutMap / GetMap / DeleteMap
+  WorkerPool io_pool_;    // PutMap (decoding) and plan/estimator writes
+  WorkerPool read_pool_;  // GetMap / DeleteMap: never behind decoding
   WorkerPool pool_;       // Plan solves
   WorkerPool warm_pool_;  // artifacts cut off by a caller's deadline
 };

@@ -47,9 +47,10 @@ TEST_F(MapStoreTest, PutIsIdempotentAndSurvivesReopen) {
     ASSERT_TRUE(created.ok());
     EXPECT_FALSE(*created);
   }
-  // No temporary files left behind.
+  // No temporary files left behind (only the map and the lock file).
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+    if (entry.path().filename() == ".lock") continue;
     EXPECT_EQ(entry.path().extension(), ".map");
     ++files;
   }
@@ -78,7 +79,9 @@ TEST_F(MapStoreTest, DamagedFileIsDetectedAndNotServed) {
   absl::StatusOr<v1::GetMapResponse> got = (*store)->Get(info_.map_id());
   EXPECT_EQ(got.status().code(), absl::StatusCode::kDataLoss);
   EXPECT_NE(got.status().message().find("corrupted"), std::string::npos);
+  EXPECT_EQ(got.status().message().find(dir_), std::string::npos);  // no server paths
 
+  store->reset();  // a restart: the lock is released
   absl::StatusOr<std::unique_ptr<MapStore>> reopened = MapStore::Open(dir_);
   ASSERT_TRUE(reopened.ok());
   std::vector<std::string> corrupted;
@@ -99,9 +102,58 @@ TEST_F(MapStoreTest, TruncatedFileIsDetected) {
   ASSERT_TRUE((*store)->Put(info_, map_).ok());
   const std::string path = dir_ + "/" + info_.map_id() + ".map";
   std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+  store->reset();
   absl::StatusOr<std::unique_ptr<MapStore>> reopened = MapStore::Open(dir_);
   ASSERT_TRUE(reopened.ok());
   EXPECT_EQ((*reopened)->Get(info_.map_id()).status().code(), absl::StatusCode::kDataLoss);
+}
+
+TEST_F(MapStoreTest, ASecondOpenOfALockedStoreFails) {
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+  ASSERT_TRUE(store.ok());
+  absl::StatusOr<std::unique_ptr<MapStore>> second = MapStore::Open(dir_);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_NE(second.status().message().find("in use by another covplan-server"), std::string::npos);
+  store->reset();
+  EXPECT_TRUE(MapStore::Open(dir_).ok());
+}
+
+TEST_F(MapStoreTest, MapCallsAreUnavailableUntilTheIndexIsLoaded) {
+  {
+    absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+    ASSERT_TRUE(store.ok());
+    ASSERT_TRUE((*store)->Put(info_, map_).ok());
+  }
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::OpenLocked(dir_, /*index=*/false);
+  ASSERT_TRUE(store.ok());
+  EXPECT_TRUE((*store)->loading());
+  EXPECT_EQ((*store)->Get(info_.map_id()).status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_EQ((*store)->Put(info_, map_).status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_EQ((*store)->Delete(info_.map_id()).status().code(), absl::StatusCode::kUnavailable);
+  ASSERT_TRUE((*store)->LoadIndex(nullptr).ok());
+  EXPECT_FALSE((*store)->loading());
+  EXPECT_TRUE((*store)->Get(info_.map_id()).ok());
+}
+
+TEST_F(MapStoreTest, ListPageContinuesAfterTheGivenId) {
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+  ASSERT_TRUE(store.ok());
+  std::vector<std::string> ids;
+  for (char c : {'1', '2', '3'}) {
+    v1::MapInfo info = info_;
+    info.set_map_id(std::string(64, c));
+    ASSERT_TRUE((*store)->Put(info, map_).ok());
+    ids.push_back(info.map_id());
+  }
+  bool more = false;
+  std::vector<v1::MapInfo> page = *(*store)->ListPage("", 2, &more, nullptr);
+  ASSERT_EQ(page.size(), 2u);
+  EXPECT_EQ(page[1].map_id(), ids[1]);
+  EXPECT_TRUE(more);
+  page = *(*store)->ListPage(ids[1], 2, &more, nullptr);
+  ASSERT_EQ(page.size(), 1u);
+  EXPECT_EQ(page[0].map_id(), ids[2]);
+  EXPECT_FALSE(more);
 }
 
 TEST_F(MapStoreTest, DeleteAndUnknownIds) {

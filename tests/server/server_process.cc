@@ -37,7 +37,12 @@ ServerProcess::~ServerProcess() {
 absl::Status ServerProcess::Start(const std::string& store_dir,
                                   const std::vector<std::string>& extra_args,
                                   const std::string& binary) {
-  const std::string program = binary.empty() ? COVPLAN_SERVER_BIN : binary;
+  // COVPLAN_TEST_SERVER_BIN runs the suite against another build (e.g. to
+  // show that a test fails on the code before a fix).
+  const char* override_bin = std::getenv("COVPLAN_TEST_SERVER_BIN");
+  const std::string program = !binary.empty() ? binary
+                              : (override_bin != nullptr && *override_bin != '\0') ? override_bin
+                                                                                    : COVPLAN_SERVER_BIN;
   log_path_ = absl::StrCat(store_dir, ".server.", ::getpid(), ".", absl::ToUnixMicros(absl::Now()), ".log");
   std::vector<std::string> args = {program, "--address=127.0.0.1", "--port=0",
                                    "--metrics_address=127.0.0.1", "--metrics_port=0",
@@ -71,11 +76,16 @@ absl::Status ServerProcess::Start(const std::string& store_dir,
           !absl::SimpleAtoi(Field(line, "metrics_port"), &metrics_port_)) {
         return absl::InternalError(absl::StrCat("cannot parse start-up line: ", line));
       }
+      // The store is indexed after the port opens; tests start once it is.
+      for (int j = 0; j < 600 && log().find("msg=\"map store indexed\"") == std::string::npos; ++j) {
+        absl::SleepFor(absl::Milliseconds(20));
+      }
       return absl::OkStatus();
     }
     int status = 0;
     if (::waitpid(pid_, &status, WNOHANG) == pid_) {
       pid_ = -1;
+      start_exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
       return absl::InternalError(absl::StrCat("server exited during start-up: ", text));
     }
     absl::SleepFor(absl::Milliseconds(50));

@@ -1,6 +1,7 @@
 // Test-only: runs a real covplan-server process on loopback with a chosen
-// store directory, learns its ports from its start-up log line, and stops it
-// with SIGTERM (SIGKILL if it does not exit in time).
+// store directory, learns its ports from its start-up log line (and waits
+// for the store to be indexed), and stops it with SIGTERM (SIGKILL if it
+// does not exit in time).
 //
 //   ServerProcess server;
 //   ASSERT_TRUE(server.Start(store_dir, {"--threads=1"}).ok());
@@ -28,7 +29,8 @@ class ServerProcess {
   ServerProcess(const ServerProcess&) = delete;
   ServerProcess& operator=(const ServerProcess&) = delete;
 
-  // Starts `binary` (default: the covplan-server built with the tests).
+  // Starts `binary` (default: $COVPLAN_TEST_SERVER_BIN if set, else the
+  // covplan-server built with the tests).
   absl::Status Start(const std::string& store_dir, const std::vector<std::string>& extra_args,
                      const std::string& binary = "");
   // SIGTERM, then waits up to `timeout`; returns the exit status, or -1 if
@@ -44,11 +46,15 @@ class ServerProcess {
   std::string target() const;
   std::string log() const;  // everything the server wrote to stderr
   pid_t pid() const { return pid_; }
+  // When Start failed because the process exited: its exit status (or 128 +
+  // signal); -1 otherwise.
+  int start_exit_status() const { return start_exit_status_; }
 
  private:
   pid_t pid_ = -1;
   int port_ = 0;
   int metrics_port_ = 0;
+  int start_exit_status_ = -1;
   std::string log_path_;
 };
 
