@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "google/protobuf/util/json_util.h"
 #include "planner/grid/grid.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/partition/rank.h"
 
@@ -120,6 +121,35 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
       d->add_rank_reversed(reversed);
     }
   }
+  if (const BoustrophedonDetail* bd = plan.detail_as<BoustrophedonDetail>()) {
+    v1::BoustrophedonDetail* d = out->mutable_boustrophedon();
+    for (const BoustrophedonCellInfo& info : bd->cells) {
+      v1::BoustrophedonCell* c = d->add_cells();
+      c->set_first_col(info.cell.first_col);
+      for (const RowInterval& iv : info.cell.columns) c->add_row_lo(iv.lo), c->add_row_hi(iv.hi);
+      c->set_axis(info.axis == SweepAxis::kHorizontal ? v1::SWEEP_AXIS_HORIZONTAL : v1::SWEEP_AXIS_VERTICAL);
+      c->set_num_lines(info.num_lines);
+    }
+    for (int index : bd->cell_order) d->add_cell_order(index);
+    for (bool reversed : bd->cell_reversed) d->add_cell_reversed(reversed);
+  }
+  for (const ChargeCycle& c : plan.cycles) {
+    v1::ChargeCycle* o = out->add_cycles();
+    o->set_first_waypoint(c.first_waypoint);
+    o->set_last_waypoint(c.last_waypoint);
+    o->set_resume_waypoint(c.resume_waypoint);
+    o->set_leave_waypoint(c.leave_waypoint);
+    o->set_energy(c.energy);
+    o->set_energy_at_leave(c.energy_at_leave);
+    if (c.resume_waypoint >= 0 && c.resume_waypoint < static_cast<int>(plan.path.size())) {
+      const Waypoint& w = plan.path[c.resume_waypoint];
+      o->mutable_resume()->set_x(w.x);
+      o->mutable_resume()->set_y(w.y);
+      o->mutable_resume()->set_theta(w.theta);
+    }
+    o->set_resume_unit(c.resume_unit);
+    o->set_resumes_mid_unit(c.resumes_mid_unit);
+  }
   for (const Waypoint& w : plan.path) {
     v1::Waypoint* p = out->add_path();
     p->set_x(w.x);
@@ -164,6 +194,10 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_unreachable_free_cells(static_cast<int32_t>(s.unreachable_free_cells));
   o->set_covered_cells(static_cast<int32_t>(s.covered_cells));
   o->set_no_go_cells(static_cast<int32_t>(s.no_go_cells));
+  o->set_charge_cycles(static_cast<int32_t>(s.charge_cycles));
+  o->set_energy_total(s.energy_total);
+  o->set_energy_unconstrained(s.energy_unconstrained);
+  o->set_energy_lower_bound(s.energy_lower_bound);
 }
 
 void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
@@ -291,6 +325,18 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   o.unreachable_free_cells = s.unreachable_free_cells();
   o.covered_cells = s.covered_cells();
   o.no_go_cells = s.no_go_cells();
+  o.charge_cycles = s.charge_cycles();
+  o.energy_total = s.energy_total();
+  o.energy_unconstrained = s.energy_unconstrained();
+  o.energy_lower_bound = s.energy_lower_bound();
+  for (const v1::ChargeCycle& c : response.cycles()) {
+    const int n = static_cast<int>(plan.path.size());
+    for (int w : {c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint()}) {
+      if (w < 0 || w >= n) return absl::InvalidArgumentError("plan charge cycle refers to a missing waypoint");
+    }
+    plan.cycles.push_back({c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint(),
+                           c.energy(), c.energy_at_leave(), c.resume_unit(), c.resumes_mid_unit()});
+  }
   return plan;
 }
 
