@@ -12,6 +12,7 @@
 #include "planner/boustrophedon/decomposition.h"
 #include "planner/boustrophedon/ox_plow.h"
 #include "planner/engine/engine.h"
+#include "planner/replan/replanner.h"
 #include "tests/testing/grid_fixtures.h"
 #include "tests/testing/plan_conformance.h"
 #include "tests/testing/shipped_maps.h"
@@ -209,6 +210,37 @@ TEST(BoustrophedonPlanner, SweepsEveryCellToCoverAndKeepsCellsWhole) {
       }
     }
   }
+}
+
+TEST(BoustrophedonPlanner, PlansCanBeReplannedAroundNewObstacles) {
+  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const OccupancyMap map = testing::LoadShippedMap("sample_office.yaml");
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry, &cache, EngineLimits{});
+  PlanRequest r;
+  r.planner = "boustrophedon";
+  r.common.robot.tool_width_m = 0.8;
+  r.common.time_limit_s = 0.3;
+  absl::StatusOr<EngineResult> res = engine.Plan(SourceOf(map, "office"), r);
+  ASSERT_TRUE(res.ok()) << res.status();
+  RetainedPlan retained{"p", "office", res->plan, r, res->area};
+  const std::vector<Waypoint>& path = res->plan.path;
+  RobotProgress at;
+  at.waypoint = static_cast<int>(path.size()) / 5;
+  at.position = Point2{path[at.waypoint].x, path[at.waypoint].y};
+  // Block a coverage cell well ahead of the robot.
+  Observations seen;
+  for (size_t i = path.size() / 2; i < path.size(); ++i) {
+    if (path[i].kind == SegmentKind::kCoverage) {
+      seen.points = {{path[i].x, path[i].y}};
+      break;
+    }
+  }
+  ASSERT_FALSE(seen.points.empty());
+  absl::StatusOr<ReplanResult> replanned = Replan(retained, at, seen, ReplanOptions(), nullptr);
+  ASSERT_TRUE(replanned.ok()) << replanned.status();
+  EXPECT_GT(replanned->stats.remaining_cells, 0);
+  EXPECT_EQ(replanned->plan.path.front().kind, SegmentKind::kStart);
 }
 
 TEST(BoustrophedonPlanner, RefusesForeignOptions) {

@@ -16,6 +16,7 @@
 #include "gtest/gtest.h"
 #include "planner/energy/battery.h"
 #include "planner/engine/engine.h"
+#include "planner/replan/replanner.h"
 #include "tests/testing/plan_conformance.h"
 #include "tests/testing/shipped_maps.h"
 
@@ -275,6 +276,24 @@ TEST_F(BatteryPlans, BadBatteryInputIsRefusedWithAReason) {
   tiny.capacity = 3.0;
   EXPECT_THAT(std::string(plan_with(tiny).message()), HasSubstr("battery: rank "));
   EXPECT_THAT(std::string(plan_with(tiny, "boustrophedon").message()), HasSubstr("battery: cell "));
+}
+
+TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
+  PlanRequest r = Request("oarp");
+  BatteryOptions b;
+  b.capacity = 150;
+  b.station = FreeStation();
+  r.battery = b;
+  absl::StatusOr<EngineResult> res = Plan(r);
+  ASSERT_TRUE(res.ok()) << res.status();
+  RetainedPlan retained{"p", "m", res->plan, r, res->area};
+  RobotProgress at;
+  at.distance_m = 5.0;
+  Observations seen;
+  seen.points = {{res->plan.path[res->plan.path.size() / 2].x, res->plan.path[res->plan.path.size() / 2].y}};
+  absl::StatusOr<ReplanResult> replanned = Replan(retained, at, seen, ReplanOptions(), nullptr);
+  EXPECT_EQ(replanned.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(std::string(replanned.status().message()), HasSubstr("battery plan"));
 }
 
 TEST(EnergyModel, TurnsAndTimeAreCharged) {
