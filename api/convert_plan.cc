@@ -132,6 +132,7 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
     }
     for (int index : bd->cell_order) d->add_cell_order(index);
     for (bool reversed : bd->cell_reversed) d->add_cell_reversed(reversed);
+    for (bool mirrored : bd->cell_mirrored) d->add_cell_mirrored(mirrored);
   }
   for (const ChargeCycle& c : plan.cycles) {
     v1::ChargeCycle* o = out->add_cycles();
@@ -262,6 +263,36 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
       detail->rank_order.push_back(index);
     }
     detail->rank_reversed.assign(reversed.begin(), reversed.end());
+    plan.detail = std::move(detail);
+  }
+  if (response.has_boustrophedon()) {
+    const v1::BoustrophedonDetail& b = response.boustrophedon();
+    auto detail = std::make_shared<BoustrophedonDetail>();
+    for (const v1::BoustrophedonCell& c : b.cells()) {
+      if (c.row_lo_size() != c.row_hi_size() || c.first_col() < 0 ||
+          c.first_col() + c.row_lo_size() > plan.grid->cols()) {
+        return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
+      }
+      BoustrophedonCellInfo info;
+      info.cell.first_col = c.first_col();
+      for (int k = 0; k < c.row_lo_size(); ++k) {
+        if (c.row_lo(k) < 0 || c.row_lo(k) > c.row_hi(k) || c.row_hi(k) >= plan.grid->rows()) {
+          return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
+        }
+        info.cell.columns.push_back({c.row_lo(k), c.row_hi(k)});
+      }
+      info.axis = c.axis() == v1::SWEEP_AXIS_HORIZONTAL ? SweepAxis::kHorizontal : SweepAxis::kVertical;
+      info.num_lines = c.num_lines();
+      detail->cells.push_back(std::move(info));
+    }
+    for (int32_t index : b.cell_order()) {
+      if (index < 0 || index >= static_cast<int>(detail->cells.size())) {
+        return absl::InvalidArgumentError("plan cell_order refers to a missing cell");
+      }
+      detail->cell_order.push_back(index);
+    }
+    detail->cell_reversed.assign(b.cell_reversed().begin(), b.cell_reversed().end());
+    detail->cell_mirrored.assign(b.cell_mirrored().begin(), b.cell_mirrored().end());
     plan.detail = std::move(detail);
   }
   for (const v1::Waypoint& p : response.path()) {

@@ -2,14 +2,15 @@
 # Battery-constrained tours on every plain building of ../shared/data/maps/ipa
 # (0.05 m/px, tool 0.8 m, IPA colour rule free_thresh 0.021), for OARP and
 # boustrophedon plans, two battery capacities, energy = distance (m), reserve
-# 5 %, station at the unconstrained plan's start (a free cell centre).
+# 5 % of the capacity.
 # Prints first the unconstrained plans (turns, path length, estimated
 # duration, covered free-area ratio, planning time), then per map, planner
 # and capacity: charge cycles, total energy, the unconstrained energy of the
 # same tour from the station and back, the lower bound (unconstrained + the
 # station visits no split of this order avoids) and the gap to it. The
-# station is the first of the unconstrained plan's coverage waypoints that
-# is not on an obstacle pixel (the engine refuses those).
+# station (the same for both planners) is the first of the unconstrained
+# OARP plan's coverage waypoints not on an obstacle pixel (the engine refuses
+# those).
 #   scripts/bench_battery.sh [CAPACITY_A CAPACITY_B]     (default 400 200)
 # The maps are licensed for academic, non-commercial use: they are read in
 # place and never copied into this repository.
@@ -61,7 +62,7 @@ for f in "${maps[@]}"; do
       ok=0
       for station in $($PY -c 'import json,sys
 p=[w for w in json.load(open(sys.argv[1]))["path"] if w["kind"]=="COVERAGE"]
-print(" ".join("%.3f,%.3f" % (w["x"], w["y"]) for w in p[:8]))' "$plain"); do
+print(" ".join("%.3f,%.3f" % (w["x"], w["y"]) for w in p[:8]))' "$TMP/$name.oarp.json"); do
         if "$CLI" plan --map "$f" "${common[@]}" --planner "$planner" "${extra[@]}" --battery-capacity "$cap" \
              --reserve "$reserve" --station "$station" --out "$TMP/bat.json" >/dev/null 2>"$TMP/err"; then
           ok=1; break

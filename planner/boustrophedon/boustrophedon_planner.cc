@@ -1,11 +1,13 @@
 #include "planner/boustrophedon/boustrophedon_planner.h"
 
+#include <array>
 #include <cmath>
 #include <utility>
 
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
+#include "planner/boustrophedon/cell_tour.h"
 #include "planner/tour/polyline_tour.h"
 #include "planner/tour/tour_model.h"
 
@@ -32,7 +34,8 @@ absl::Status BoustrophedonOptions::Validate() const {
 }
 
 size_t BoustrophedonDetail::MemoryBytes() const {
-  size_t bytes = sizeof(*this) + cell_order.capacity() * sizeof(int) + cell_reversed.capacity() / 8;
+  size_t bytes = sizeof(*this) + cell_order.capacity() * sizeof(int) + cell_reversed.capacity() / 8 +
+                 cell_mirrored.capacity() / 8;
   for (const BoustrophedonCellInfo& c : cells) bytes += sizeof(c) + c.cell.columns.capacity() * sizeof(RowInterval);
   return bytes;
 }
@@ -67,11 +70,15 @@ absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> BoustrophedonPlanne
   if (!hit && ctx.all_cached != nullptr) *ctx.all_cached = false;
   const int64_t n = static_cast<int64_t>(d->decomposition->cells.size());
   if (n == 0) return absl::InvalidArgumentError("no cells to cover: the coverage area is empty");
-  if (n > ctx.limits.max_ranks) {
+  // Four entry corners per cell: the transition table has 4n endpoints, as
+  // many as OARP's 2 * max_ranks at n = max_ranks / 2.
+  if (2 * n > ctx.limits.max_ranks) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "the map decomposes into %d boustrophedon cells at tool width %g m, above the limit of %d "
-        "tour elements; use a wider tool or split the map",
-        n, ctx.area->cover->cell_size(), ctx.limits.max_ranks));
+        "cells (the transition table over their corners would take about %d MiB); use a wider tool "
+        "or split the map",
+        n, ctx.area->cover->cell_size(), ctx.limits.max_ranks / 2,
+        TransitionTable::EstimateBytes(static_cast<int>(4 * n)) >> 20));
   }
   return d;
 }
@@ -92,25 +99,26 @@ absl::StatusOr<CoveragePlan> BoustrophedonPlanner::Plan(const PlanContext& ctx) 
   std::optional<SweepAxis> forced;
   if (options.sweep_axis == BoustrophedonAxis::kVertical) forced = SweepAxis::kVertical;
   if (options.sweep_axis == BoustrophedonAxis::kHorizontal) forced = SweepAxis::kHorizontal;
-  std::vector<PolylineElement> elements;
+  std::vector<std::array<PolylineElement, 2>> elements;
   for (size_t i = 0; i < d->decomposition->cells.size(); ++i) {
     const BcdCell& cell = d->decomposition->cells[i];
     SweepLines lines = ChooseSweepLines(cover, cell, forced);
     detail->cells.push_back({cell, lines.axis, static_cast<int>(lines.lines.size())});
-    elements.push_back(OxPlowElement(cover, lines, static_cast<int>(i)));
+    elements.push_back({OxPlowElement(cover, lines, static_cast<int>(i), false),
+                        OxPlowElement(cover, lines, static_cast<int>(i), true)});
   }
   Pose2 start_pose;
   if (common.robot.start.has_value()) {
     start_pose = *common.robot.start;
   } else {
-    const Point2 p = elements[0].points[0];
-    const Point2 q = elements[0].points.size() > 1 ? elements[0].points[1] : p;
+    const Point2 p = elements[0][0].points[0];
+    const Point2 q = elements[0][0].points.size() > 1 ? elements[0][0].points[1] : p;
     start_pose = {p.x, p.y, q.y != p.y || q.x != p.x ? std::atan2(q.y - p.y, q.x - p.x) : M_PI / 2};
   }
   const std::optional<Pose2> end_pose = common.robot.end;
   const absl::Time t_model = absl::Now();
-  absl::StatusOr<PolylineTourModel> model =
-      PolylineTourModel::Create(drive, std::move(elements), start_pose, end_pose,
+  absl::StatusOr<CellTourModel> model =
+      CellTourModel::Create(drive, std::move(elements), start_pose, end_pose,
                                 std::make_shared<TravelTimeCost>(common.robot), common.stop, common.num_threads);
   if (!model.ok()) {
     if (absl::IsFailedPrecondition(model.status())) {
@@ -136,7 +144,8 @@ absl::StatusOr<CoveragePlan> BoustrophedonPlanner::Plan(const PlanContext& ctx) 
   plan.grid = ctx.area->drive;
   model->BuildPath(tour.vertices, &plan.path, &plan.sweeps);
   for (int v : tour.vertices) {
-    detail->cell_order.push_back(v / 2);
+    detail->cell_order.push_back(v / 4);
+    detail->cell_mirrored.push_back((v / 2) % 2 == 1);
     detail->cell_reversed.push_back(v % 2 == 1);
   }
   plan.termination = tour.termination;

@@ -2,8 +2,8 @@
 // line decomposition of the cells to cover into cells that open and close
 // at connectivity changes (decomposition.h), an ox-plow path per cell with a
 // sweep axis chosen per cell (ox_plow.h), and the cells toured by the anytime
-// GTSP over PolylineTourModel elements (each cell entered at either end of
-// its ox-plow path), priced by the robot's time model, transitions on the
+// GTSP over CellTourModel elements (each cell entered at any of its four
+// corners: either end of the first or of the last line), priced by the robot's time model, transitions on the
 // drive grid. A cell is always swept whole, in one visit. Registered as
 // "boustrophedon".
 //
@@ -49,6 +49,7 @@ class BoustrophedonDetail final : public PlannerDetail {
  public:
   std::vector<BoustrophedonCellInfo> cells;
   std::vector<int> cell_order;      // visiting order (indices into cells)
+  std::vector<bool> cell_mirrored;  // per visit: ox-plow path started at the first line's other end
   std::vector<bool> cell_reversed;  // per visit: ox-plow path driven from its end
   size_t MemoryBytes() const override;
 };

@@ -58,12 +58,13 @@ SweepLines ChooseSweepLines(const Grid& grid, const BcdCell& cell, std::optional
   return horizontal->lines.size() < vertical->lines.size() ? *horizontal : *vertical;
 }
 
-PolylineElement OxPlowElement(const Grid& grid, const SweepLines& sl, int tag) {
+PolylineElement OxPlowElement(const Grid& grid, const SweepLines& sl, int tag, bool mirrored) {
   PolylineElement e;
   e.kind = TourElementKind::kCell;
   const CellIndex step = sl.axis == SweepAxis::kVertical ? CellIndex{0, 1} : CellIndex{1, 0};
-  auto line_start = [&](size_t k) { return k % 2 == 0 ? sl.lines[k].front() : sl.lines[k].back(); };
-  auto line_end = [&](size_t k) { return k % 2 == 0 ? sl.lines[k].back() : sl.lines[k].front(); };
+  auto up = [&](size_t k) { return (k % 2 == 0) != mirrored; };
+  auto line_start = [&](size_t k) { return up(k) ? sl.lines[k].front() : sl.lines[k].back(); };
+  auto line_end = [&](size_t k) { return up(k) ? sl.lines[k].back() : sl.lines[k].front(); };
   CellIndex at = line_start(0);
   e.first_cell = at;
   e.points.push_back(grid.CellCenter(at));

@@ -117,7 +117,12 @@ TEST(Decompose, RandomGridsArePartitionedAndEveryCellIsPlowedWhole) {
       for (auto axis : {std::optional<SweepAxis>(), std::optional(SweepAxis::kVertical),
                         std::optional(SweepAxis::kHorizontal)}) {
         const SweepLines lines = ChooseSweepLines(g, d.cells[i], axis);
-        ASSERT_EQ(CheckOxPlow(g, d.cells[i], OxPlowElement(g, lines, static_cast<int>(i))), "") << "cell " << i;
+        for (bool mirrored : {false, true}) {
+          const PolylineElement e = OxPlowElement(g, lines, static_cast<int>(i), mirrored);
+          ASSERT_EQ(CheckOxPlow(g, d.cells[i], e), "") << "cell " << i;
+          // Plain starts at the first line's first cell, mirrored at its last.
+          EXPECT_EQ(e.first_cell, mirrored ? lines.lines[0].back() : lines.lines[0].front());
+        }
       }
     }
   }
@@ -194,6 +199,7 @@ TEST(BoustrophedonPlanner, SweepsEveryCellToCoverAndKeepsCellsWhole) {
     const auto* detail = plan.detail_as<BoustrophedonDetail>();
     ASSERT_NE(detail, nullptr);
     ASSERT_EQ(detail->cell_order.size(), detail->cells.size());
+    ASSERT_EQ(detail->cell_mirrored.size(), detail->cells.size());
     EXPECT_EQ(std::set<int>(detail->cell_order.begin(), detail->cell_order.end()).size(), detail->cells.size());
     // The coverage segments of a cell form one contiguous run, in tour order.
     std::vector<int> runs;

@@ -88,7 +88,7 @@ TEST_F(BatteryPlans, CyclesFitStartAndEndAtTheStationAndCoverWhatThePlanCovers) 
     absl::StatusOr<EngineResult> unconstrained = Plan(plain);
     ASSERT_TRUE(unconstrained.ok()) << unconstrained.status();
     const double total = unconstrained->plan.stats.coverage_length_m + unconstrained->plan.stats.transition_length_m;
-    for (double share : {0.5, 0.2}) {
+    for (double share : {0.5, 0.35}) {
       for (bool interruptible : {false, true}) {
         SCOPED_TRACE(planner + " share " + std::to_string(share) + (interruptible ? " interruptible" : " atomic"));
         PlanRequest r = plain;

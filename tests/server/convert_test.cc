@@ -379,6 +379,34 @@ TEST(BatteryProtoTest, BatteryAndBoustrophedonOptionsAreConvertedAndValidated) {
   EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon.sweep_axis"));
 }
 
+TEST(BatteryProtoTest, BoustrophedonDetailRoundTrips) {
+  CoveragePlan plan = SmallPlan();
+  plan.planner = "boustrophedon";
+  auto detail = std::make_shared<BoustrophedonDetail>();
+  detail->cells.push_back({BcdCell{0, {{0, 1}}}, SweepAxis::kVertical, 1});
+  detail->cells.push_back({BcdCell{1, {{1, 1}, {0, 1}}}, SweepAxis::kHorizontal, 2});
+  detail->cell_order = {1, 0};
+  detail->cell_reversed = {true, false};
+  detail->cell_mirrored = {false, true};
+  plan.detail = detail;
+  v1::PlanResponse response;
+  PlanToProto(plan, &response);
+  ASSERT_TRUE(response.has_boustrophedon());
+  EXPECT_EQ(response.boustrophedon().cells(1).axis(), v1::SWEEP_AXIS_HORIZONTAL);
+  absl::StatusOr<CoveragePlan> back = PlanFromProto(response);
+  ASSERT_TRUE(back.ok()) << back.status();
+  const auto* d = back->detail_as<BoustrophedonDetail>();
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->cells[1].cell.columns[1].hi, 1);
+  EXPECT_EQ(d->cell_order, detail->cell_order);
+  EXPECT_EQ(d->cell_mirrored, detail->cell_mirrored);
+  v1::PlanResponse again;
+  PlanToProto(*back, &again);
+  EXPECT_EQ(again.SerializeAsString(), response.SerializeAsString());
+  response.mutable_boustrophedon()->mutable_cells(0)->set_row_hi(0, 7);
+  EXPECT_THAT(PlanFromProto(response), StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon cell"));
+}
+
 TEST(BatteryProtoTest, ChargeCyclesRoundTripAndReachPlanJson) {
   CoveragePlan plan = SmallPlan();
   plan.cycles.push_back({0, 2, 1, 1, 12.5, 7.0, 3, false});
