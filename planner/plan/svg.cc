@@ -151,12 +151,16 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
   const double chars = kLegendChars + static_cast<double>(summary.size()) +
                        (zones.regions.empty() ? 0 : 10) + (zones.no_go.empty() ? 0 : 14);
   const double fs = std::min(0.45 * legend_h, (w - 0.4) / (0.56 * chars));
+  const std::string sweeps_legend =
+      plan.cycles.empty()
+          ? std::string("<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
+                        "<tspan fill=\"#8e44ad\">vertical ranks</tspan>")
+          : absl::StrFormat("<tspan fill=\"#e6194b\">%d charge cycles</tspan> (colours; station legs dotted)",
+                            static_cast<int>(plan.cycles.size()));
   absl::StrAppendFormat(&out,
                         "<text x=\"%.4f\" y=\"%.4f\" font-family=\"sans-serif\" font-size=\"%.4f\">"
-                        "<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
-                        "<tspan fill=\"#8e44ad\">vertical ranks</tspan> · "
-                        "<tspan fill=\"#1f8a5b\">transitions</tspan>%s%s</text>\n",
-                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), summary, zone_legend);
+                        "%s · <tspan fill=\"#1f8a5b\">transitions</tspan>%s%s</text>\n",
+                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), sweeps_legend, summary, zone_legend);
   absl::StrAppend(&out, "</svg>\n");
   return out;
 }

@@ -16,6 +16,7 @@
 #include "gtest/gtest.h"
 #include "planner/energy/battery.h"
 #include "planner/engine/engine.h"
+#include "planner/plan/svg.h"
 #include "planner/replan/replanner.h"
 #include "tests/testing/plan_conformance.h"
 #include "tests/testing/shipped_maps.h"
@@ -294,6 +295,24 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   absl::StatusOr<ReplanResult> replanned = Replan(retained, at, seen, ReplanOptions(), nullptr);
   EXPECT_EQ(replanned.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(replanned.status().message()), HasSubstr("battery plan"));
+}
+
+TEST_F(BatteryPlans, TheSvgColoursEachCycle) {
+  PlanRequest r = Request("oarp");
+  BatteryOptions b;
+  b.capacity = 60;
+  b.station = FreeStation();
+  r.battery = b;
+  absl::StatusOr<EngineResult> res = Plan(r);
+  ASSERT_TRUE(res.ok()) << res.status();
+  ASSERT_GE(res->plan.cycles.size(), 2u);
+  const std::string svg = RenderPlanSvg(res->plan, &map_);
+  EXPECT_THAT(svg, HasSubstr(absl::StrFormat("%d charge cycles", res->plan.cycles.size())));
+  EXPECT_THAT(svg, HasSubstr("stroke=\"#e6194b\""));  // cycle 0
+  EXPECT_THAT(svg, HasSubstr("stroke=\"#3cb44b\""));  // cycle 1
+  absl::StatusOr<EngineResult> plain = Plan(Request("oarp"));
+  ASSERT_TRUE(plain.ok());
+  EXPECT_THAT(RenderPlanSvg(plain->plan, &map_), ::testing::Not(HasSubstr("charge cycles")));
 }
 
 TEST(EnergyModel, TurnsAndTimeAreCharged) {
