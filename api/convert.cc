@@ -320,6 +320,7 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
     battery.energy.per_turn = b.energy().per_turn();
     battery.energy.per_second = b.energy().per_second();
     battery.interruptible_units = b.interruptible_units();
+    battery.atomic_units.assign(b.atomic_units().begin(), b.atomic_units().end());
     RETURN_IF_ERROR(battery.Validate());
     out.battery = battery;
   }

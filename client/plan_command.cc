@@ -39,7 +39,7 @@ constexpr char kUsage[] =
     "                    [--region AREA]... [--no-go AREA]...\n"
     "                    [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
     "                     [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
-    "                     [--interruptible]]\n"
+    "                     [--interruptible [--atomic-units ID,ID...]]]\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
     "--resolution) or a .geojson polygon map (Polygon/MultiPolygon in metres; the free\n"
     "space). Without --local the server defaults to 127.0.0.1:50051.\n"
@@ -143,7 +143,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
-                 "energy-per-second"},
+                 "energy-per-second", "atomic-units"},
                 {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -194,7 +194,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   }
   ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
   const bool battery = capacity || a.Get("station") || a.Get("reserve") || a.Get("energy-per-metre") ||
-                       a.Get("energy-per-turn") || a.Get("energy-per-second") || a.Has("interruptible");
+                       a.Get("energy-per-turn") || a.Get("energy-per-second") || a.Has("interruptible") ||
+                       a.Get("atomic-units");
   if (battery) {
     if (!capacity || !a.Get("station")) {
       return absl::InvalidArgumentError("a battery needs --battery-capacity E and --station X,Y[,THETA]");
@@ -211,6 +212,16 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     ASSIGN_OR_RETURN(std::optional<double> per_second, a.GetDouble("energy-per-second"));
     if (per_second) b->mutable_energy()->set_per_second(*per_second);
     b->set_interruptible_units(a.Has("interruptible"));
+    if (auto ids = a.Get("atomic-units")) {
+      for (absl::string_view id : absl::StrSplit(*ids, ',')) {
+        int value = 0;
+        if (!absl::SimpleAtoi(id, &value)) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
+        }
+        b->add_atomic_units(value);
+      }
+    }
   }
   if (auto p = a.Get("partition")) {
     if (*p == "mincut") r.set_partition_solver(v1::MINCUT);

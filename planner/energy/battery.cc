@@ -1,5 +1,6 @@
 #include "planner/energy/battery.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_format.h"
@@ -44,10 +45,19 @@ absl::Status BatteryOptions::Validate() const {
         "battery.reserve (%g) must be below battery.capacity (%g): nothing would be left to drive on",
         reserve, capacity));
   }
+  if (!atomic_units.empty() && !interruptible_units) {
+    return absl::InvalidArgumentError(
+        "battery.atomic_units only makes sense with battery.interruptible_units (all units are atomic otherwise)");
+  }
   if (!std::isfinite(station.x) || !std::isfinite(station.y) || !std::isfinite(station.theta)) {
     return absl::InvalidArgumentError("battery.station must have finite x, y and theta");
   }
   return energy.Validate();
+}
+
+bool BatteryOptions::IsAtomic(int tag) const {
+  if (!interruptible_units) return true;
+  return std::find(atomic_units.begin(), atomic_units.end(), tag) != atomic_units.end();
 }
 
 double SegmentEnergy(double heading_before, const Waypoint& a, const Waypoint& b,

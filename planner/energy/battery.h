@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <vector>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "planner/plan/coverage_plan.h"
@@ -39,6 +40,10 @@ struct BatteryOptions {
   // interrupted by a charge. true: units may be left after any of their
   // coverage lines and resumed there.
   bool interruptible_units = false;
+  // With interruptible_units: the tags (Waypoint::rank: cell or rank ids) of
+  // the units that stay atomic anyway (the paper's set A; the rest is B).
+  std::vector<int> atomic_units;
+  bool IsAtomic(int tag) const;
 
   double budget() const { return capacity - reserve; }
   // InvalidArgument naming the field ("battery.capacity: ...") for values

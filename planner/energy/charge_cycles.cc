@@ -140,7 +140,7 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
     if (!same_unit) {
       unit_tag.push_back(path[i].rank);
       pieces.push_back({i - 1, i, static_cast<int>(unit_tag.size()) - 1, 0});
-    } else if (battery.interruptible_units) {
+    } else if (!battery.IsAtomic(path[i].rank)) {
       pieces.push_back({pieces.back().z, i, pieces.back().unit, pieces.back().line + 1});
     } else {
       pieces.back().z = i;
@@ -156,7 +156,7 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
   auto unit_name = [&](int k) {
     const Piece& p = pieces[k];
     const std::string unit = absl::StrFormat("%s %d", UnitWord(plan.planner), unit_tag[p.unit]);
-    return battery.interruptible_units ? absl::StrFormat("line %d of %s", p.line, unit) : unit;
+    return battery.IsAtomic(unit_tag[p.unit]) ? unit : absl::StrFormat("line %d of %s", p.line, unit);
   };
   // seg + turn energy of the segment ending at waypoint t, after t - 1.
   auto step = [&](int t) { return SegmentEnergy(path[t - 1].theta, path[t - 1], path[t], model, robot); };

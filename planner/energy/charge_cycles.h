@@ -2,7 +2,8 @@
 // neutral CoveragePlan). The plan's coverage segments are grouped into units
 // by their tag (Waypoint::rank: an OARP rank, a boustrophedon cell; an
 // untagged segment is a unit of its own), in path order. Atomic units are
-// pieces; interruptible units are cut after each of their coverage lines,
+// pieces (all units, or with interruptible_units those in atomic_units);
+// interruptible units are cut after each of their coverage lines,
 // and a cycle that leaves after line k returns to that very point. The
 // pieces are split optimally for the plan's order (charge_split.h); every
 // cycle starts and ends at the station, with kFromStation / kToStation legs

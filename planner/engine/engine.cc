@@ -181,8 +181,10 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   const CoverageArea& area = *ctx.area;
   plan.planner = std::string(resolved.planner->name());
   if (request.battery.has_value()) {
+    const absl::Time t = absl::Now();
     ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *area.drive, *request.battery, request.common.robot,
                                                  request.common.stop));
+    plan.stats.tour_ms += absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
   }
 
   // The engine's own check: no segment may enter a no-go zone's interior.

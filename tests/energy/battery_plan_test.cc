@@ -197,6 +197,25 @@ TEST_F(BatteryPlans, InterruptibleCellsResumeWhereTheRobotLeft) {
   }
   EXPECT_GT(mid, 0);
   EXPECT_EQ(Swept(res->plan), Swept(plain->plan));
+  // A cell listed in atomic_units is never resumed mid-cell (or, if it
+  // cannot be done in one charge, the request names it).
+  int interrupted = -1;
+  for (const ChargeCycle& cy : res->plan.cycles) {
+    if (cy.resumes_mid_unit) interrupted = cy.resume_unit;
+  }
+  r.battery->atomic_units = {interrupted};
+  absl::StatusOr<EngineResult> mixed = Plan(r);
+  if (mixed.ok()) {
+    for (const ChargeCycle& cy : mixed->plan.cycles) {
+      EXPECT_FALSE(cy.resumes_mid_unit && cy.resume_unit == interrupted);
+    }
+    EXPECT_EQ(Swept(mixed->plan), Swept(plain->plan));
+  } else {
+    EXPECT_THAT(std::string(mixed.status().message()),
+                HasSubstr(absl::StrFormat("battery: cell %d needs", interrupted)));
+  }
+  r.battery->interruptible_units = false;
+  EXPECT_THAT(std::string(Plan(r).status().message()), HasSubstr("battery.atomic_units"));
 }
 
 TEST_F(BatteryPlans, BadBatteryInputIsRefusedWithAReason) {
