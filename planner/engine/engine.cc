@@ -195,6 +195,14 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
       if (resolved.zones.no_go->SegmentLengthInInterior({a.x, a.y}, {b.x, b.y}) <= 1e-9) continue;
       const bool from_start = i <= 2 && request.common.robot.start.has_value();
       const bool to_end = i + 2 >= plan.path.size() && request.common.robot.end.has_value();
+      const bool station_leg = request.battery.has_value() &&
+                               (b.kind == SegmentKind::kToStation || b.kind == SegmentKind::kFromStation);
+      if (station_leg) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "battery.station: the move between (%.3f, %.3f) and (%.3f, %.3f) near the station would "
+            "cross a no-go zone; move the station away from the zone",
+            a.x, a.y, b.x, b.y));
+      }
       if (from_start || to_end) {
         return absl::InvalidArgumentError(absl::StrFormat(
             "%s: the move between (%.3f, %.3f) and the grid at (%.3f, %.3f) would cross a no-go zone",
