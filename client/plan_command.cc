@@ -37,6 +37,7 @@ constexpr char kUsage[] =
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
     "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp]\n"
     "                    [--region AREA]... [--no-go AREA]...\n"
+    "                    [--sweep-axis auto|vertical|horizontal]   (boustrophedon)\n"
     "                    [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
     "                     [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
     "                     [--interruptible [--atomic-units ID,ID...]]]\n"
@@ -143,7 +144,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
-                 "energy-per-second", "atomic-units"},
+                 "energy-per-second", "atomic-units", "sweep-axis"},
                 {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -222,6 +223,14 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
         b->add_atomic_units(value);
       }
     }
+  }
+  if (auto axis = a.Get("sweep-axis")) {
+    if (r.planner() != "boustrophedon") return absl::InvalidArgumentError("--sweep-axis needs --planner boustrophedon");
+    v1::BoustrophedonOptions* o = r.mutable_boustrophedon();
+    if (*axis == "auto") o->set_sweep_axis(v1::SWEEP_AXIS_AUTO);
+    else if (*axis == "vertical") o->set_sweep_axis(v1::SWEEP_AXIS_VERTICAL);
+    else if (*axis == "horizontal") o->set_sweep_axis(v1::SWEEP_AXIS_HORIZONTAL);
+    else return absl::InvalidArgumentError(absl::StrCat("--sweep-axis must be auto, vertical or horizontal, got '", *axis, "'"));
   }
   if (auto p = a.Get("partition")) {
     if (*p == "mincut") r.set_partition_solver(v1::MINCUT);
