@@ -17,6 +17,7 @@
 #include "planner/partition/rank.h"
 #include "api/digest.h"
 #include "api/geojson.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
 
 namespace covplan {
@@ -282,6 +283,46 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
             absl::StrCat(prefix, "tour_solver: unknown value ", static_cast<int>(tour)));
     }
     out.options = std::move(oarp);
+  } else if (request.planner_options_case() == v1::PlanRequest::kBoustrophedon || out.planner == "boustrophedon") {
+    if (request.planner_options_case() != v1::PlanRequest::kBoustrophedon &&
+        request.planner_options_case() != v1::PlanRequest::PLANNER_OPTIONS_NOT_SET) {
+      return absl::InvalidArgumentError("planner_options: planner 'boustrophedon' takes the boustrophedon options");
+    }
+    const v1::BoustrophedonOptions& b = request.boustrophedon();
+    auto options_b = std::make_shared<BoustrophedonOptions>();
+    switch (b.sweep_axis()) {
+      case v1::SWEEP_AXIS_UNSPECIFIED:
+      case v1::SWEEP_AXIS_AUTO: options_b->sweep_axis = BoustrophedonAxis::kAuto; break;
+      case v1::SWEEP_AXIS_VERTICAL: options_b->sweep_axis = BoustrophedonAxis::kVertical; break;
+      case v1::SWEEP_AXIS_HORIZONTAL: options_b->sweep_axis = BoustrophedonAxis::kHorizontal; break;
+      default:
+        return absl::InvalidArgumentError(
+            absl::StrCat("boustrophedon.sweep_axis: unknown value ", static_cast<int>(b.sweep_axis())));
+    }
+    switch (b.tour_solver()) {
+      case v1::TOUR_SOLVER_UNSPECIFIED:
+      case v1::GTSP: options_b->tour_solver = TourSolver::kGtsp; break;
+      case v1::GREEDY: options_b->tour_solver = TourSolver::kGreedy; break;
+      default:
+        return absl::InvalidArgumentError(
+            absl::StrCat("boustrophedon.tour_solver: unknown value ", static_cast<int>(b.tour_solver())));
+    }
+    out.options = std::move(options_b);
+  }
+  if (request.has_battery()) {
+    const v1::Battery& b = request.battery();
+    if (!b.has_station()) return absl::InvalidArgumentError("battery.station is required");
+    BatteryOptions battery;
+    battery.capacity = b.capacity();
+    battery.reserve = b.reserve();
+    battery.station = Pose2{b.station().x(), b.station().y(), b.station().theta()};
+    if (b.energy().has_per_metre()) battery.energy.per_metre = b.energy().per_metre();
+    battery.energy.per_turn = b.energy().per_turn();
+    battery.energy.per_second = b.energy().per_second();
+    battery.interruptible_units = b.interruptible_units();
+    battery.atomic_units.assign(b.atomic_units().begin(), b.atomic_units().end());
+    RETURN_IF_ERROR(battery.Validate());
+    out.battery = battery;
   }
   // 0 means "default" for both (proto3 scalars have no presence).
   if (request.time_limit_s() != 0.0) options.time_limit_s = request.time_limit_s();

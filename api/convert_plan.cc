@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "google/protobuf/util/json_util.h"
 #include "planner/grid/grid.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/partition/rank.h"
 
@@ -120,6 +121,36 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
       d->add_rank_reversed(reversed);
     }
   }
+  if (const BoustrophedonDetail* bd = plan.detail_as<BoustrophedonDetail>()) {
+    v1::BoustrophedonDetail* d = out->mutable_boustrophedon();
+    for (const BoustrophedonCellInfo& info : bd->cells) {
+      v1::BoustrophedonCell* c = d->add_cells();
+      c->set_first_col(info.cell.first_col);
+      for (const RowInterval& iv : info.cell.columns) c->add_row_lo(iv.lo), c->add_row_hi(iv.hi);
+      c->set_axis(info.axis == SweepAxis::kHorizontal ? v1::SWEEP_AXIS_HORIZONTAL : v1::SWEEP_AXIS_VERTICAL);
+      c->set_num_lines(info.num_lines);
+    }
+    for (int index : bd->cell_order) d->add_cell_order(index);
+    for (bool reversed : bd->cell_reversed) d->add_cell_reversed(reversed);
+    for (bool mirrored : bd->cell_mirrored) d->add_cell_mirrored(mirrored);
+  }
+  for (const ChargeCycle& c : plan.cycles) {
+    v1::ChargeCycle* o = out->add_cycles();
+    o->set_first_waypoint(c.first_waypoint);
+    o->set_last_waypoint(c.last_waypoint);
+    o->set_resume_waypoint(c.resume_waypoint);
+    o->set_leave_waypoint(c.leave_waypoint);
+    o->set_energy(c.energy);
+    o->set_energy_at_leave(c.energy_at_leave);
+    if (c.resume_waypoint >= 0 && c.resume_waypoint < static_cast<int>(plan.path.size())) {
+      const Waypoint& w = plan.path[c.resume_waypoint];
+      o->mutable_resume()->set_x(w.x);
+      o->mutable_resume()->set_y(w.y);
+      o->mutable_resume()->set_theta(w.theta);
+    }
+    o->set_resume_unit(c.resume_unit);
+    o->set_resumes_mid_unit(c.resumes_mid_unit);
+  }
   for (const Waypoint& w : plan.path) {
     v1::Waypoint* p = out->add_path();
     p->set_x(w.x);
@@ -167,6 +198,10 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_mission_covered_cells(static_cast<int32_t>(s.mission_covered_cells));
   o->set_mission_cut_off_cells(static_cast<int32_t>(s.mission_cut_off_cells));
   o->set_mission_obstructed_cells(static_cast<int32_t>(s.mission_obstructed_cells));
+  o->set_charge_cycles(static_cast<int32_t>(s.charge_cycles));
+  o->set_energy_total(s.energy_total);
+  o->set_energy_unconstrained(s.energy_unconstrained);
+  o->set_energy_lower_bound(s.energy_lower_bound);
 }
 
 void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
@@ -233,6 +268,36 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
     detail->rank_reversed.assign(reversed.begin(), reversed.end());
     plan.detail = std::move(detail);
   }
+  if (response.has_boustrophedon()) {
+    const v1::BoustrophedonDetail& b = response.boustrophedon();
+    auto detail = std::make_shared<BoustrophedonDetail>();
+    for (const v1::BoustrophedonCell& c : b.cells()) {
+      if (c.row_lo_size() != c.row_hi_size() || c.first_col() < 0 ||
+          c.first_col() + c.row_lo_size() > plan.grid->cols()) {
+        return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
+      }
+      BoustrophedonCellInfo info;
+      info.cell.first_col = c.first_col();
+      for (int k = 0; k < c.row_lo_size(); ++k) {
+        if (c.row_lo(k) < 0 || c.row_lo(k) > c.row_hi(k) || c.row_hi(k) >= plan.grid->rows()) {
+          return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
+        }
+        info.cell.columns.push_back({c.row_lo(k), c.row_hi(k)});
+      }
+      info.axis = c.axis() == v1::SWEEP_AXIS_HORIZONTAL ? SweepAxis::kHorizontal : SweepAxis::kVertical;
+      info.num_lines = c.num_lines();
+      detail->cells.push_back(std::move(info));
+    }
+    for (int32_t index : b.cell_order()) {
+      if (index < 0 || index >= static_cast<int>(detail->cells.size())) {
+        return absl::InvalidArgumentError("plan cell_order refers to a missing cell");
+      }
+      detail->cell_order.push_back(index);
+    }
+    detail->cell_reversed.assign(b.cell_reversed().begin(), b.cell_reversed().end());
+    detail->cell_mirrored.assign(b.cell_mirrored().begin(), b.cell_mirrored().end());
+    plan.detail = std::move(detail);
+  }
   for (const v1::Waypoint& p : response.path()) {
     Waypoint w;
     w.x = p.x();
@@ -297,6 +362,18 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   o.mission_covered_cells = s.mission_covered_cells();
   o.mission_cut_off_cells = s.mission_cut_off_cells();
   o.mission_obstructed_cells = s.mission_obstructed_cells();
+  o.charge_cycles = s.charge_cycles();
+  o.energy_total = s.energy_total();
+  o.energy_unconstrained = s.energy_unconstrained();
+  o.energy_lower_bound = s.energy_lower_bound();
+  for (const v1::ChargeCycle& c : response.cycles()) {
+    const int n = static_cast<int>(plan.path.size());
+    for (int w : {c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint()}) {
+      if (w < 0 || w >= n) return absl::InvalidArgumentError("plan charge cycle refers to a missing waypoint");
+    }
+    plan.cycles.push_back({c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint(),
+                           c.energy(), c.energy_at_leave(), c.resume_unit(), c.resumes_mid_unit()});
+  }
   return plan;
 }
 

@@ -37,6 +37,10 @@ constexpr char kUsage[] =
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
     "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp]\n"
     "                    [--region AREA]... [--no-go AREA]...\n"
+    "                    [--sweep-axis auto|vertical|horizontal]   (boustrophedon)\n"
+    "                    [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
+    "                     [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
+    "                     [--interruptible [--atomic-units ID,ID...]]]\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
     "--resolution) or a .geojson polygon map (Polygon/MultiPolygon in metres; the free\n"
     "space). Without --local the server defaults to 127.0.0.1:50051.\n"
@@ -138,8 +142,10 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
       ParseArgs(args,
                 {"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
-                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner"},
-                {"local", "negate"}, {"region", "no-go"}));
+                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
+                 "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
+                 "energy-per-second", "atomic-units", "sweep-axis"},
+                {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   c.map_path = *a.Get("map");
@@ -186,6 +192,45 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   }
   if (auto it = a.repeated.find("no-go"); it != a.repeated.end()) {
     for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("no-go", text, r.mutable_no_go()));
+  }
+  ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
+  const bool battery = capacity || a.Get("station") || a.Get("reserve") || a.Get("energy-per-metre") ||
+                       a.Get("energy-per-turn") || a.Get("energy-per-second") || a.Has("interruptible") ||
+                       a.Get("atomic-units");
+  if (battery) {
+    if (!capacity || !a.Get("station")) {
+      return absl::InvalidArgumentError("a battery needs --battery-capacity E and --station X,Y[,THETA]");
+    }
+    v1::Battery* b = r.mutable_battery();
+    b->set_capacity(*capacity);
+    RETURN_IF_ERROR(ParsePose("station", *a.Get("station"), b->mutable_station()));
+    ASSIGN_OR_RETURN(std::optional<double> reserve, a.GetDouble("reserve"));
+    if (reserve) b->set_reserve(*reserve);
+    ASSIGN_OR_RETURN(std::optional<double> per_metre, a.GetDouble("energy-per-metre"));
+    if (per_metre) b->mutable_energy()->set_per_metre(*per_metre);
+    ASSIGN_OR_RETURN(std::optional<double> per_turn, a.GetDouble("energy-per-turn"));
+    if (per_turn) b->mutable_energy()->set_per_turn(*per_turn);
+    ASSIGN_OR_RETURN(std::optional<double> per_second, a.GetDouble("energy-per-second"));
+    if (per_second) b->mutable_energy()->set_per_second(*per_second);
+    b->set_interruptible_units(a.Has("interruptible"));
+    if (auto ids = a.Get("atomic-units")) {
+      for (absl::string_view id : absl::StrSplit(*ids, ',')) {
+        int value = 0;
+        if (!absl::SimpleAtoi(id, &value)) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
+        }
+        b->add_atomic_units(value);
+      }
+    }
+  }
+  if (auto axis = a.Get("sweep-axis")) {
+    if (r.planner() != "boustrophedon") return absl::InvalidArgumentError("--sweep-axis needs --planner boustrophedon");
+    v1::BoustrophedonOptions* o = r.mutable_boustrophedon();
+    if (*axis == "auto") o->set_sweep_axis(v1::SWEEP_AXIS_AUTO);
+    else if (*axis == "vertical") o->set_sweep_axis(v1::SWEEP_AXIS_VERTICAL);
+    else if (*axis == "horizontal") o->set_sweep_axis(v1::SWEEP_AXIS_HORIZONTAL);
+    else return absl::InvalidArgumentError(absl::StrCat("--sweep-axis must be auto, vertical or horizontal, got '", *axis, "'"));
   }
   if (auto p = a.Get("partition")) {
     if (*p == "mincut") r.set_partition_solver(v1::MINCUT);
@@ -296,7 +341,12 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
       s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
       s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
       s.partition_ms(), s.transitions_ms(), s.tour_ms(),
-      s.decomposition_cached() ? " (decomposition cached)" : "");
+      s.decomposition_cached() ? " (decomposition cached)" : "") +
+         (r.cycles().empty()
+              ? std::string()
+              : absl::StrFormat("battery    %d charge cycles, energy %.1f (unconstrained %.1f, bound %.1f)\n",
+                                s.charge_cycles(), s.energy_total(), s.energy_unconstrained(),
+                                s.energy_lower_bound()));
 }
 
 int RunPlanCommand(const std::vector<std::string>& args) {

@@ -8,6 +8,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
+#include "planner/energy/charge_cycles.h"
 #include "planner/tour/path_timing.h"
 
 namespace covplan {
@@ -75,6 +76,7 @@ absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanReque
                                                       absl::StrJoin(registry_->Names(), ", ")));
   }
   RETURN_IF_ERROR(request.common.Validate());
+  if (request.battery.has_value()) RETURN_IF_ERROR(request.battery->Validate());
   r.options = request.options != nullptr ? request.options : r.planner->DefaultOptions();
   RETURN_IF_ERROR(r.planner->CheckOptions(*r.options));
   AreaLimits area_limits;
@@ -92,6 +94,11 @@ absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanReque
         return absl::InvalidArgumentError(absl::StrFormat(
             "%s (%.3f, %.3f) lies in a no-go zone", name, (*pose)->x, (*pose)->y));
       }
+    }
+    if (request.battery.has_value() &&
+        r.zones.no_go->Contains({request.battery->station.x, request.battery->station.y})) {
+      return absl::InvalidArgumentError(absl::StrFormat("battery.station (%.3f, %.3f) lies in a no-go zone",
+                                                        request.battery->station.x, request.battery->station.y));
     }
   }
   return r;
@@ -158,13 +165,27 @@ absl::StatusOr<std::shared_ptr<const CoverageArea>> PlanningEngine::AreaFor(
 }
 
 absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
-                                                  const PlanRequest& request) const {
-  ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
+                                                  const PlanRequest& original) const {
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
+  PlanRequest request = original;
+  if (request.battery.has_value()) {
+    // A battery tour starts and ends at the station.
+    if (!request.common.robot.start) request.common.robot.start = request.battery->station;
+    if (!request.common.robot.end) request.common.robot.end = request.battery->station;
+  }
   PlanContext ctx;
   bool all_cached = true;
   RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
   ASSIGN_OR_RETURN(CoveragePlan plan, resolved.planner->Plan(ctx));
   const CoverageArea& area = *ctx.area;
+  plan.planner = std::string(resolved.planner->name());
+  if (request.battery.has_value()) {
+    const absl::Time t = absl::Now();
+    ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *area.drive, *request.battery, request.common.robot,
+                                                 request.common.stop));
+    plan.stats.tour_ms += absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
+  }
 
   // The engine's own check: no segment may enter a no-go zone's interior.
   if (resolved.zones.has_no_go()) {
@@ -174,6 +195,14 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
       if (resolved.zones.no_go->SegmentLengthInInterior({a.x, a.y}, {b.x, b.y}) <= 1e-9) continue;
       const bool from_start = i <= 2 && request.common.robot.start.has_value();
       const bool to_end = i + 2 >= plan.path.size() && request.common.robot.end.has_value();
+      const bool station_leg = request.battery.has_value() &&
+                               (b.kind == SegmentKind::kToStation || b.kind == SegmentKind::kFromStation);
+      if (station_leg) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "battery.station: the move between (%.3f, %.3f) and (%.3f, %.3f) near the station would "
+            "cross a no-go zone; move the station away from the zone",
+            a.x, a.y, b.x, b.y));
+      }
       if (from_start || to_end) {
         return absl::InvalidArgumentError(absl::StrFormat(
             "%s: the move between (%.3f, %.3f) and the grid at (%.3f, %.3f) would cross a no-go zone",
@@ -185,7 +214,6 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
     }
   }
 
-  plan.planner = std::string(resolved.planner->name());
   PlanStats& s = plan.stats;
   const PlanStats path_stats = ComputePathStats(plan.path, request.common.robot);
   s.num_turns = path_stats.num_turns;

@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,7 @@
 #include "planner/engine/artifact_cache.h"
 #include "planner/engine/planner.h"
 #include "planner/engine/site.h"
+#include "planner/energy/battery.h"
 #include "planner/geometry/area.h"
 #include "planner/plan/coverage_plan.h"
 
@@ -59,6 +61,10 @@ struct PlanRequest {
   std::shared_ptr<const PlannerOptions> options;  // null: the planner's defaults
   std::vector<PolygonInput> regions;
   std::vector<PolygonInput> no_go;
+  // Battery-constrained tour (planner/energy): the plan is split into charge
+  // cycles from and to the station. Unless given, robot.start and robot.end
+  // default to the station.
+  std::optional<BatteryOptions> battery;
 };
 
 // A plan kept for GetPlan and later continuation: the plan, the request it

@@ -1,6 +1,7 @@
 // The planners this build ships. Adding a planner: its folder under
 // planner/, one Register line here, its options message in the proto.
 #include "planner/engine/engine.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
 
 namespace covplan {
@@ -8,6 +9,7 @@ namespace covplan {
 PlannerRegistry PlannerRegistry::WithBuiltins() {
   PlannerRegistry registry;
   registry.Register(std::make_unique<OarpPlanner>());
+  registry.Register(std::make_unique<BoustrophedonPlanner>());
   return registry;
 }
 

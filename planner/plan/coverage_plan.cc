@@ -29,6 +29,7 @@ const char* TerminationLimitName(TerminationLimit l) {
 size_t CoveragePlan::MemoryBytes() const {
   size_t bytes = sizeof(*this) + path.capacity() * sizeof(Waypoint) + planner.capacity();
   for (const CoverageSweep& s : sweeps) bytes += sizeof(s) + s.cells.capacity() * sizeof(CellIndex);
+  bytes += cycles.capacity() * sizeof(ChargeCycle);
   if (detail) bytes += detail->MemoryBytes();
   return bytes;  // the grid is shared with the coverage area, not counted here
 }

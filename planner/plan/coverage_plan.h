@@ -105,6 +105,26 @@ struct PlanStats {
   bool decomposition_cached = false;  // every per-map artifact came from the cache
   std::string partition_solver;
   std::string tour_solver;
+  // Battery plans only (planner/energy): energy in the battery's units.
+  int64_t charge_cycles = 0;
+  double energy_total = 0.0;          // sum over the cycles
+  double energy_unconstrained = 0.0;  // the same tour from the station and back, no charges
+  double energy_lower_bound = 0.0;    // unconstrained + the return legs no split avoids (see charge_cycles.h)
+};
+
+// One charge cycle of a battery plan: path[first_waypoint] and
+// path[last_waypoint] are at the station; the robot drives to
+// path[resume_waypoint], works, and must leave for the station at
+// path[leave_waypoint].
+struct ChargeCycle {
+  int first_waypoint = 0;
+  int last_waypoint = 0;
+  int resume_waypoint = 0;
+  int leave_waypoint = 0;
+  double energy = 0.0;        // the whole cycle, station to station
+  double energy_at_leave = 0.0;  // used when leaving for the station
+  int resume_unit = -1;       // tag (Waypoint::rank) of the unit work resumes in
+  bool resumes_mid_unit = false;  // the previous cycle left this unit unfinished
 };
 
 // Planner-specific detail, beside the planner-neutral result.
@@ -119,6 +139,7 @@ struct CoveragePlan {
   std::shared_ptr<const Grid> grid; // the grid the path was planned on (drive grid)
   std::vector<Waypoint> path;
   std::vector<CoverageSweep> sweeps;  // one per coverage segment, in path order
+  std::vector<ChargeCycle> cycles;    // battery plans only, in path order
   PlanStats stats;
   Termination termination;
   std::shared_ptr<const PlannerDetail> detail;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -86,7 +87,16 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
   }
   AppendPolygons(&out, zones.regions, "#4a90d9", "#1f5fa8", 0.08 * s);
   AppendPolygons(&out, zones.no_go, "#e03131", "#a61e1e", 0.08 * s);
-  // Coverage segments, coloured by direction (horizontal / vertical sweeps).
+  // Coverage segments, coloured by direction (horizontal / vertical sweeps),
+  // or, in battery plans, by charge cycle (station legs dotted, same colour).
+  static constexpr const char* kCycleColours[] = {"#e6194b", "#3cb44b", "#4363d8", "#f58231", "#911eb4",
+                                                  "#42d4f4", "#f032e6", "#9a6324", "#469990", "#808000"};
+  std::vector<int> cycle_of(plan.path.size(), -1);
+  for (size_t c = 0; c < plan.cycles.size(); ++c) {
+    for (int w = plan.cycles[c].first_waypoint + 1; w <= plan.cycles[c].last_waypoint; ++w) {
+      if (w >= 0 && w < static_cast<int>(plan.path.size())) cycle_of[w] = static_cast<int>(c);
+    }
+  }
   const double stroke = 0.55 * s;
   absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-linecap=\"round\" fill=\"none\">\n", stroke);
   for (size_t i = 1; i < plan.path.size(); ++i) {
@@ -94,7 +104,7 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
     const Waypoint& b = plan.path[i];
     if (b.kind != SegmentKind::kCoverage) continue;
     const bool horizontal = std::abs(b.y - a.y) <= std::abs(b.x - a.x);
-    const char* color = horizontal ? "#f08c2e" : "#8e44ad";
+    const char* color = cycle_of[i] >= 0 ? kCycleColours[cycle_of[i] % 10] : horizontal ? "#f08c2e" : "#8e44ad";
     absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\" stroke-opacity=\"0.8\"/>\n",
                           a.x, a.y, b.x, b.y, color);
   }
@@ -109,6 +119,18 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
                           plan.path[i - 1].x, plan.path[i - 1].y, plan.path[i].x, plan.path[i].y);
   }
   absl::StrAppend(&out, "</g>\n");
+  if (!plan.cycles.empty()) {
+    absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" fill=\"none\">\n",
+                          0.15 * s, 0.1 * s, 0.25 * s);
+    for (size_t i = 1; i < plan.path.size(); ++i) {
+      const SegmentKind k = plan.path[i].kind;
+      if ((k != SegmentKind::kToStation && k != SegmentKind::kFromStation) || cycle_of[i] < 0) continue;
+      absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\"/>\n",
+                            plan.path[i - 1].x, plan.path[i - 1].y, plan.path[i].x, plan.path[i].y,
+                            kCycleColours[cycle_of[i] % 10]);
+    }
+    absl::StrAppend(&out, "</g>\n");
+  }
   if (!plan.path.empty()) {
     const Waypoint& st = plan.path.front();
     const Waypoint& en = plan.path.back();
@@ -129,12 +151,16 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
   const double chars = kLegendChars + static_cast<double>(summary.size()) +
                        (zones.regions.empty() ? 0 : 10) + (zones.no_go.empty() ? 0 : 14);
   const double fs = std::min(0.45 * legend_h, (w - 0.4) / (0.56 * chars));
+  const std::string sweeps_legend =
+      plan.cycles.empty()
+          ? std::string("<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
+                        "<tspan fill=\"#8e44ad\">vertical ranks</tspan>")
+          : absl::StrFormat("<tspan fill=\"#e6194b\">%d charge cycles</tspan> (colours; station legs dotted)",
+                            static_cast<int>(plan.cycles.size()));
   absl::StrAppendFormat(&out,
                         "<text x=\"%.4f\" y=\"%.4f\" font-family=\"sans-serif\" font-size=\"%.4f\">"
-                        "<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
-                        "<tspan fill=\"#8e44ad\">vertical ranks</tspan> · "
-                        "<tspan fill=\"#1f8a5b\">transitions</tspan>%s%s</text>\n",
-                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), summary, zone_legend);
+                        "%s · <tspan fill=\"#1f8a5b\">transitions</tspan>%s%s</text>\n",
+                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), sweeps_legend, summary, zone_legend);
   absl::StrAppend(&out, "</svg>\n");
   return out;
 }

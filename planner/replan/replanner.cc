@@ -254,6 +254,12 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   if (old.area == nullptr || old.plan.grid == nullptr || old.area->drive == nullptr) {
     return absl::FailedPreconditionError("the plan has no coverage area to replan on");
   }
+  if (!old.plan.cycles.empty()) {
+    // The remainder would lose its charge stops; the battery state at the
+    // robot is not known here.
+    return absl::FailedPreconditionError(
+        "replanning a battery plan (charge cycles) is not supported yet: plan again with the battery");
+  }
   Context c;
   c.old = &old;
   c.old_oarp = old.plan.detail_as<OarpDetail>();

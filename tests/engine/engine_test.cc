@@ -76,7 +76,7 @@ TEST(Registry, SelectsByNameAndRefusesUnknownPlannersAndForeignOptions) {
   PlanRequest r = Request("boustrophedon-typo", 0.8);
   absl::StatusOr<EngineResult> result = engine.Plan(SourceOf(map, "m"), r);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(std::string(result.status().message()), HasSubstr("registered: oarp"));
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("registered: boustrophedon, oarp"));
 
   struct OtherOptions final : PlannerOptions {
     absl::Status Validate() const override { return absl::OkStatus(); }

@@ -9,6 +9,7 @@
 #include "gtest/gtest.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/grid/grid.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
 #include "tests/server/test_maps.h"
 
@@ -219,7 +220,7 @@ TEST(EngineValidationTest, ToolMustFitPixelAndMapAndZonesTheMap) {
   v1::PlanRequest unknown;
   unknown.set_planner("nope");
   EXPECT_THAT(absl::StatusOr<int>(check(0.4, limits, unknown)),
-              StatusIs(absl::StatusCode::kInvalidArgument, "unknown planner 'nope'; registered: oarp"));
+              StatusIs(absl::StatusCode::kInvalidArgument, "unknown planner 'nope'; registered: boustrophedon, oarp"));
 }
 
 TEST(MapIdTest, ContentDerivedAndWellFormed) {
@@ -332,6 +333,100 @@ TEST(PlanJsonTest, SnakeCaseNamesEnumNamesAndDefaultsPrinted) {
   EXPECT_THAT(*json, HasSubstr("\"planner\": \"oarp\""));
   EXPECT_THAT(*json, HasSubstr("\"sweeps\": ["));
   EXPECT_THAT(*json, ::testing::Not(HasSubstr("numRanks")));
+}
+
+}  // namespace
+}  // namespace covplan
+
+namespace covplan {
+namespace {
+
+TEST(BatteryProtoTest, BatteryAndBoustrophedonOptionsAreConvertedAndValidated) {
+  v1::PlanRequest request = RequestWithTool(0.5);
+  request.set_planner("boustrophedon");
+  request.mutable_boustrophedon()->set_sweep_axis(v1::SWEEP_AXIS_HORIZONTAL);
+  v1::Battery* b = request.mutable_battery();
+  b->set_capacity(100);
+  b->set_reserve(10);
+  b->mutable_station()->set_x(1.5);
+  b->mutable_station()->set_y(2.5);
+  b->mutable_energy()->set_per_turn(0.5);
+  b->set_interruptible_units(true);
+  absl::StatusOr<PlanRequest> r = PlanRequestFromProto(request);
+  ASSERT_TRUE(r.ok()) << r.status();
+  const auto* o = dynamic_cast<const BoustrophedonOptions*>(r->options.get());
+  ASSERT_NE(o, nullptr);
+  EXPECT_EQ(o->sweep_axis, BoustrophedonAxis::kHorizontal);
+  ASSERT_TRUE(r->battery.has_value());
+  EXPECT_DOUBLE_EQ(r->battery->budget(), 90.0);
+  EXPECT_DOUBLE_EQ(r->battery->energy.per_metre, 1.0);  // unset: distance
+  EXPECT_DOUBLE_EQ(r->battery->energy.per_turn, 0.5);
+  EXPECT_TRUE(r->battery->interruptible_units);
+
+  for (double cap : {0.0, -1.0, std::nan("")}) {
+    v1::PlanRequest bad = request;
+    bad.mutable_battery()->set_capacity(cap);
+    EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "battery.capacity"));
+  }
+  v1::PlanRequest bad = request;
+  bad.mutable_battery()->set_reserve(100);
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "battery.reserve"));
+  bad = request;
+  bad.mutable_battery()->clear_station();
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "battery.station"));
+  bad = request;
+  bad.mutable_boustrophedon()->set_sweep_axis(static_cast<v1::SweepAxis>(42));
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon.sweep_axis"));
+}
+
+TEST(BatteryProtoTest, BoustrophedonDetailRoundTrips) {
+  CoveragePlan plan = SmallPlan();
+  plan.planner = "boustrophedon";
+  auto detail = std::make_shared<BoustrophedonDetail>();
+  detail->cells.push_back({BcdCell{0, {{0, 1}}}, SweepAxis::kVertical, 1});
+  detail->cells.push_back({BcdCell{1, {{1, 1}, {0, 1}}}, SweepAxis::kHorizontal, 2});
+  detail->cell_order = {1, 0};
+  detail->cell_reversed = {true, false};
+  detail->cell_mirrored = {false, true};
+  plan.detail = detail;
+  v1::PlanResponse response;
+  PlanToProto(plan, &response);
+  ASSERT_TRUE(response.has_boustrophedon());
+  EXPECT_EQ(response.boustrophedon().cells(1).axis(), v1::SWEEP_AXIS_HORIZONTAL);
+  absl::StatusOr<CoveragePlan> back = PlanFromProto(response);
+  ASSERT_TRUE(back.ok()) << back.status();
+  const auto* d = back->detail_as<BoustrophedonDetail>();
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->cells[1].cell.columns[1].hi, 1);
+  EXPECT_EQ(d->cell_order, detail->cell_order);
+  EXPECT_EQ(d->cell_mirrored, detail->cell_mirrored);
+  v1::PlanResponse again;
+  PlanToProto(*back, &again);
+  EXPECT_EQ(again.SerializeAsString(), response.SerializeAsString());
+  response.mutable_boustrophedon()->mutable_cells(0)->set_row_hi(0, 7);
+  EXPECT_THAT(PlanFromProto(response), StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon cell"));
+}
+
+TEST(BatteryProtoTest, ChargeCyclesRoundTripAndReachPlanJson) {
+  CoveragePlan plan = SmallPlan();
+  plan.cycles.push_back({0, 2, 1, 1, 12.5, 7.0, 3, false});
+  plan.stats.charge_cycles = 1;
+  plan.stats.energy_total = 12.5;
+  v1::PlanResponse response;
+  PlanToProto(plan, &response);
+  ASSERT_EQ(response.cycles_size(), 1);
+  EXPECT_DOUBLE_EQ(response.cycles(0).resume().x(), plan.path[1].x);
+  absl::StatusOr<CoveragePlan> back = PlanFromProto(response);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->cycles.size(), 1u);
+  EXPECT_EQ(back->cycles[0].last_waypoint, 2);
+  EXPECT_DOUBLE_EQ(back->cycles[0].energy_at_leave, 7.0);
+  absl::StatusOr<std::string> json = PlanToJson(response);
+  ASSERT_TRUE(json.ok());
+  EXPECT_THAT(*json, HasSubstr("\"cycles\""));
+  EXPECT_THAT(*json, HasSubstr("\"resume_waypoint\": 1"));
+  response.mutable_cycles(0)->set_last_waypoint(99);
+  EXPECT_THAT(PlanFromProto(response), StatusIs(absl::StatusCode::kInvalidArgument, "charge cycle"));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <random>
@@ -531,6 +532,49 @@ TEST_F(ServiceTest, DrainingServiceRefusesNewWork) {
   v1::PutMapResponse put;
   const grpc::Status status = PutMap(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1), &put);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE);
+}
+
+// Battery plans over gRPC: charge cycles in the reply, bad battery input
+// refused with INVALID_ARGUMENT naming the field.
+TEST_F(ServiceTest, BatteryPlansOverGrpcAndBadBatteryInput) {
+  const std::string id = PutTwoRooms();
+  v1::PlanRequest request = PlanRequestFor(id, 0.4);
+  request.set_planner("boustrophedon");
+  v1::Battery* b = request.mutable_battery();
+  b->set_capacity(25);
+  b->set_reserve(1);
+  b->mutable_station()->set_x(1.0);
+  b->mutable_station()->set_y(0.6);
+  v1::PlanResponse response;
+  grpc::Status status = Plan(request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(response.cycles_size(), 2);
+  EXPECT_EQ(response.stats().charge_cycles(), response.cycles_size());
+  EXPECT_EQ(response.stats().covered_cells(), response.stats().free_cells());
+  EXPECT_TRUE(response.has_boustrophedon());
+  for (const v1::ChargeCycle& c : response.cycles()) {
+    EXPECT_LE(c.energy(), 24.0 + 1e-9);
+    EXPECT_DOUBLE_EQ(response.path(c.first_waypoint()).x(), 1.0);
+    EXPECT_DOUBLE_EQ(response.path(c.last_waypoint()).y(), 0.6);
+  }
+  const std::vector<std::pair<std::function<void(v1::Battery*)>, const char*>> bad = {
+      {[](v1::Battery* x) { x->set_capacity(0); }, "battery.capacity"},
+      {[](v1::Battery* x) { x->set_capacity(-3); }, "battery.capacity"},
+      {[](v1::Battery* x) { x->set_capacity(std::nan("")); }, "battery.capacity"},
+      {[](v1::Battery* x) { x->set_reserve(25); }, "battery.reserve"},
+      {[](v1::Battery* x) { x->clear_station(); }, "battery.station"},
+      {[](v1::Battery* x) { x->mutable_station()->set_x(40); }, "outside the map"},
+      {[](v1::Battery* x) { x->mutable_station()->set_x(0.2), x->mutable_station()->set_y(0.2); }, "obstacle"},
+      {[](v1::Battery* x) { x->set_capacity(1.5); }, "needs"},
+  };
+  for (const auto& [mutate, message] : bad) {
+    SCOPED_TRACE(message);
+    v1::PlanRequest r = request;
+    mutate(r.mutable_battery());
+    status = Plan(r, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+    EXPECT_THAT(status.error_message(), HasSubstr(message));
+  }
 }
 
 }  // namespace
