@@ -210,9 +210,12 @@ void CoveragePlannerService::RecordCall(const CallInfo& call, const absl::Status
 
 void CoveragePlannerService::MaybeTrimMemory(absl::Duration work) {
   // Large solves and decodes leave freed pages in glibc's arenas; give them
-  // back (off the reply's path, at most every 100 ms) so resident memory
+  // back (off the reply's path, when idle, at most every 100 ms) so resident memory
   // follows the budgets instead of the high-water mark.
   if (work < kTrimAfterWork) return;
+  // malloc_trim locks every arena in turn: only when no solve runs or waits,
+  // so it never stalls a call that is racing its deadline.
+  if (in_flight_.load() != 0 || pool_.queued() != 0) return;
   const int64_t now_ms = absl::ToUnixMillis(absl::Now());
   int64_t last = last_trim_ms_.load();
   if (now_ms - last < 100 || !last_trim_ms_.compare_exchange_strong(last, now_ms)) return;
