@@ -11,8 +11,10 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "google/protobuf/util/json_util.h"
+#include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "planner/oarp/oarp_planner.h"
+#include "api/convert_stc.h"
 #include "planner/partition/rank.h"
 
 namespace covplan {
@@ -120,6 +122,7 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
       d->add_rank_reversed(reversed);
     }
   }
+  if (const StcDetail* stc = plan.detail_as<StcDetail>()) StcDetailToProto(*stc, out->mutable_stc());
   for (const Waypoint& w : plan.path) {
     v1::Waypoint* p = out->add_path();
     p->set_x(w.x);
@@ -229,6 +232,9 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
     }
     detail->rank_reversed.assign(reversed.begin(), reversed.end());
     plan.detail = std::move(detail);
+  }
+  if (response.has_stc()) {
+    ASSIGN_OR_RETURN(plan.detail, StcDetailFromProto(response.stc()));
   }
   for (const v1::Waypoint& p : response.path()) {
     Waypoint w;

@@ -2,12 +2,14 @@
 // planner/, one Register line here, its options message in the proto.
 #include "planner/engine/engine.h"
 #include "planner/oarp/oarp_planner.h"
+#include "planner/stc/stc_planner.h"
 
 namespace covplan {
 
 PlannerRegistry PlannerRegistry::WithBuiltins() {
   PlannerRegistry registry;
   registry.Register(std::make_unique<OarpPlanner>());
+  registry.Register(std::make_unique<StcPlanner>());
   return registry;
 }
 
