@@ -82,6 +82,7 @@ void StcDetailToProto(const StcDetail& d, v1::StcDetail* out) {
   out->set_extra_moves(static_cast<int32_t>(d.extra_moves));
   out->set_subcells_covered_twice(static_cast<int32_t>(d.subcells_covered_twice));
   out->set_discarded_cells(static_cast<int32_t>(d.discarded_cells));
+  out->set_orphan_cells(static_cast<int32_t>(d.orphan_cells));
 }
 
 absl::StatusOr<std::shared_ptr<const StcDetail>> StcDetailFromProto(const v1::StcDetail& p) {
@@ -101,6 +102,7 @@ absl::StatusOr<std::shared_ptr<const StcDetail>> StcDetailFromProto(const v1::St
   d->extra_moves = p.extra_moves();
   d->subcells_covered_twice = p.subcells_covered_twice();
   d->discarded_cells = p.discarded_cells();
+  d->orphan_cells = p.orphan_cells();
   return std::shared_ptr<const StcDetail>(std::move(d));
 }
 

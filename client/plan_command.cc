@@ -35,8 +35,11 @@ constexpr char kUsage[] =
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
-    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp]\n"
-    "                    [--region AREA]... [--no-go AREA]...\n"
+    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|...]\n"
+    "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
+    "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
+    "--algorithm is another name for --planner. The --stc-* flags and --sweep-direction\n"
+    "set the stc planner's options (--sweep-direction: the prim tree only).\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
     "--resolution) or a .geojson polygon map (Polygon/MultiPolygon in metres; the free\n"
     "space). Without --local the server defaults to 127.0.0.1:50051.\n"
@@ -138,7 +141,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
       ParseArgs(args,
                 {"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
-                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner"},
+                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
+                 "algorithm", "stc-tree", "sweep-direction", "stc-partial"},
                 {"local", "negate"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -180,7 +184,34 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     if (*seed < 0 || *seed > UINT32_MAX) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
     r.set_seed(static_cast<uint32_t>(*seed));
   }
+  if (a.Get("planner") && a.Get("algorithm") && *a.Get("planner") != *a.Get("algorithm")) {
+    return absl::InvalidArgumentError("--algorithm is another name for --planner: give one of them");
+  }
   if (auto p = a.Get("planner")) r.set_planner(*p);
+  if (auto p = a.Get("algorithm")) r.set_planner(*p);
+  if (a.Get("stc-tree") || a.Get("sweep-direction") || a.Get("stc-partial")) {
+    if (r.planner() != "stc") {
+      return absl::InvalidArgumentError("--stc-tree, --sweep-direction and --stc-partial need --planner stc");
+    }
+    v1::StcOptions* stc = r.mutable_stc();
+    if (auto t = a.Get("stc-tree")) {
+      if (*t == "dfs") stc->set_tree(v1::STC_TREE_DFS);
+      else if (*t == "prim") stc->set_tree(v1::STC_TREE_PRIM);
+      else return absl::InvalidArgumentError(absl::StrCat("--stc-tree must be dfs or prim, got '", *t, "'"));
+    }
+    if (auto d = a.Get("sweep-direction")) {
+      if (*d == "horizontal") stc->set_sweep_direction(v1::STC_SWEEP_HORIZONTAL);
+      else if (*d == "vertical") stc->set_sweep_direction(v1::STC_SWEEP_VERTICAL);
+      else return absl::InvalidArgumentError(
+          absl::StrCat("--sweep-direction must be horizontal or vertical, got '", *d, "'"));
+    }
+    if (auto m = a.Get("stc-partial")) {
+      if (*m == "cover") stc->set_partial_cells(v1::STC_PARTIAL_COVER);
+      else if (*m == "discard") stc->set_partial_cells(v1::STC_PARTIAL_DISCARD);
+      else return absl::InvalidArgumentError(
+          absl::StrCat("--stc-partial must be cover or discard, got '", *m, "'"));
+    }
+  }
   if (auto it = a.repeated.find("region"); it != a.repeated.end()) {
     for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("region", text, r.mutable_regions()));
   }
@@ -279,6 +310,15 @@ absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
 
 std::string FormatPlanSummary(const v1::PlanResponse& r) {
   const v1::PlanStats& s = r.stats();
+  std::string stc;
+  if (r.has_stc()) {
+    const v1::StcDetail& d = r.stc();
+    stc = absl::StrFormat(
+        "stc        %d coarse cells (%d partly free, %d orphan sub-cells), %d extra moves, %d sub-cells "
+        "covered twice%s\n",
+        d.coarse_cells(), d.partial_coarse_cells(), d.orphan_cells(), d.extra_moves(), d.subcells_covered_twice(),
+        d.discarded_cells() > 0 ? absl::StrFormat(", %d cells discarded", d.discarded_cells()) : "");
+  }
   return absl::StrFormat(
       "plan       %s (map %s, planner %s)\n"
       "grid       %d x %d cells of %.3f m, %d to cover, %d swept (%d unreachable, not planned)%s\n"
@@ -296,7 +336,8 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
       s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
       s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
       s.partition_ms(), s.transitions_ms(), s.tour_ms(),
-      s.decomposition_cached() ? " (decomposition cached)" : "");
+      s.decomposition_cached() ? " (decomposition cached)" : "") +
+         stc;
 }
 
 int RunPlanCommand(const std::vector<std::string>& args) {

@@ -15,7 +15,24 @@ CoarseGrid::CoarseGrid(const Grid& drive, const Grid& cover, CellIndex offset, P
       if (drive.IsFree(c)) free_[id] |= 1 << p;
       if (drive.IsFree(c) && cover.IsFree(c)) target_[id] |= 1 << p;
     }
+    // kCover: a node when its free sub-cells are connected inside the cell
+    // (a thin wall through it, or only diagonal sub-cells, would make the
+    // ring jump between rooms); the others' sub-cells are orphans.
     bool node = free_[id] != 0;
+    if (node && partial_ == PartialCells::kCover) {
+      uint8_t reached = static_cast<uint8_t>(free_[id] & -free_[id]);  // lowest free position
+      for (int round = 0; round < 3; ++round) {
+        for (int p = 0; p < 4; ++p) {
+          if (!((reached >> p) & 1)) continue;
+          for (int q : {(p + 1) % 4, (p + 3) % 4}) {
+            if (!((free_[id] >> q) & 1)) continue;
+            const CellIndex a = SubCell(id, p), b = SubCell(id, q);
+            if (drive.Passable(a.row, a.col, b.row - a.row, b.col - a.col)) reached |= 1 << q;
+          }
+        }
+      }
+      node = reached == free_[id];
+    }
     if (partial_ == PartialCells::kDiscard) {
       node = free_[id] == 15;
       for (int p = 0; node && p < 4; ++p) {
@@ -59,7 +76,15 @@ bool CoarseGrid::CanLink(int id, int side) const {
   const int other = Neighbour(id, side);
   if (other < 0 || !IsNode(id) || !IsNode(other)) return false;
   const bool first = Crossable(id, side, side), second = Crossable(id, side, (side + 1) % 4);
-  return partial_ == PartialCells::kDiscard ? first && second : first || second;
+  if (partial_ == PartialCells::kDiscard) return first && second;
+  // The ring crosses the side at both pairs: a pair of free sub-cells with a
+  // thin wall between them would send the robot round through a door.
+  auto walled = [&](int pos) {
+    const CellIndex a = SubCell(id, pos);
+    const CellIndex b{a.row + kSideRow[side], a.col + kSideCol[side]};
+    return drive_->IsFree(a) && drive_->IsFree(b) && !drive_->Passable(a.row, a.col, kSideRow[side], kSideCol[side]);
+  };
+  return (first || second) && !walled(side) && !walled((side + 1) % 4);
 }
 
 }  // namespace covplan

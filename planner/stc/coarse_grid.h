@@ -55,11 +55,18 @@ class CoarseGrid {
   uint8_t free_bits(int id) const { return free_[id]; }
   // Bit p set: the sub-cell at ring position p is a cell to cover.
   uint8_t target_bits(int id) const { return target_[id]; }
-  // The coarse cell is a node of the spanning tree.
+  // The coarse cell is a node of the spanning tree: with kCover, its free
+  // sub-cells are connected inside it; with kDiscard, all four are free and
+  // linked around the ring.
   bool IsNode(int id) const { return node_[id] != 0; }
+  // A cell to cover outside every node (kCover only; swept by excursions).
+  bool IsOrphan(CellIndex c) const {
+    return partial_ == PartialCells::kCover && drive_->IsFree(c) && !IsNode(CoarseOf(c));
+  }
   // The tree may link `id` to its neighbour across `side` (both are nodes,
   // and the robot can cross: with kCover one passable sub-cell link on that
-  // side suffices, with kDiscard both links must be passable).
+  // side suffices when the other pair is not two free cells split by a thin
+  // wall; with kDiscard both links must be passable).
   bool CanLink(int id, int side) const;
   // The two sub-cells facing each other across `side` at ring position
   // `pos` (pos is side or side + 1) are both free and passable.

@@ -5,6 +5,7 @@
 #include "absl/strings/str_format.h"
 #include "planner/common/status_macros.h"
 #include "planner/stc/spanning_tree.h"
+#include "planner/stc/stc_walk.h"
 
 namespace covplan {
 
@@ -40,9 +41,12 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
   // The robot's memory: the tree, the coarse cells sensed, the sub-cells known free.
   StcTree tree;
   tree.sides.assign(world.size(), 0);
-  std::vector<uint8_t> seen(world.size(), 0), sensed(world.size(), 0);
-  std::vector<uint8_t> known_free(truth.size(), 0), covered(truth.size(), 0);
+  std::vector<uint8_t> seen(world.size(), 0), sensed(world.size(), 0), sensed_around(world.size(), 0);
+  std::vector<uint8_t> known_free(truth.size(), 0);
+  std::vector<CellIndex> known_cells;
   auto sense_around = [&](int id) {
+    if (sensed_around[id]) return;
+    sensed_around[id] = 1;
     for (int side = -1; side < 4; ++side) {
       const int n = side < 0 ? id : world.Neighbour(id, side);
       if (n < 0 || sensed[n]) continue;
@@ -51,52 +55,32 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
       const uint8_t bits = robot->SenseFreeBits(world, n);
       for (int p = 0; p < 4; ++p) {
         const CellIndex c = world.SubCell(n, p);
-        if ((bits >> p) & 1) known_free[truth.Index(c.row, c.col)] = 1;
+        if (!((bits >> p) & 1)) continue;
+        known_free[truth.Index(c.row, c.col)] = 1;
+        known_cells.push_back(c);
       }
     }
   };
-  auto is_target = [&](CellIndex c) {
-    return truth.IsFree(c) && world.IsNode(world.CoarseOf(c)) && !covered[truth.Index(c.row, c.col)];
+  StcWalker::World w;
+  w.may_enter = [&](CellIndex c) { return truth.InBounds(c.row, c.col) && known_free[truth.Index(c.row, c.col)]; };
+  // The sensor saw both cells, so it saw whether a wall stands between them.
+  w.passable = [&](CellIndex c, int dr, int dc) { return truth.Passable(c.row, c.col, dr, dc); };
+  w.to_cover = [&](CellIndex c) {
+    return truth.IsFree(c) && (partial == PartialCells::kCover || world.IsNode(world.CoarseOf(c)));
   };
-  // Shortest path over sensed free cells (BFS), then driven.
-  std::vector<int64_t> parent(truth.size(), -1);
-  std::vector<uint32_t> stamp(truth.size(), 0);
-  uint32_t round = 0;
-  auto drive_to = [&](CellIndex goal) -> absl::Status {
-    const CellIndex from = robot->at();
-    const int64_t src = truth.Index(from.row, from.col), dst = truth.Index(goal.row, goal.col);
-    ++round;
-    std::vector<int64_t> queue = {src};
-    stamp[src] = round;
-    constexpr int kDr[4] = {0, 1, 0, -1}, kDc[4] = {1, 0, -1, 0};
-    for (size_t head = 0; head < queue.size() && stamp[dst] != round; ++head) {
-      const CellIndex c = truth.FromIndex(queue[head]);
-      for (int d = 0; d < 4; ++d) {
-        const int r = c.row + kDr[d], col = c.col + kDc[d];
-        if (!truth.InBounds(r, col) || !known_free[truth.Index(r, col)]) continue;
-        // The sensor saw both cells, so it saw whether a wall stands between them.
-        if (!truth.Passable(c.row, c.col, kDr[d], kDc[d]) || stamp[truth.Index(r, col)] == round) continue;
-        stamp[truth.Index(r, col)] = round;
-        parent[truth.Index(r, col)] = queue[head];
-        queue.push_back(truth.Index(r, col));
-      }
-    }
-    if (stamp[dst] != round) return absl::NotFoundError("no sensed path yet");
-    std::vector<CellIndex> path;
-    for (int64_t v = dst; v != src; v = parent[v]) path.push_back(truth.FromIndex(v));
-    for (auto it = path.rbegin(); it != path.rend(); ++it) {
-      RETURN_IF_ERROR(robot->Step(*it));
-      covered[truth.Index(it->row, it->col)] = 1;
-      ++stats.steps;
-    }
+  w.orphan = [&](CellIndex c) { return world.IsOrphan(c); };
+  w.on_step = [&](CellIndex c) -> absl::Status {
+    RETURN_IF_ERROR(robot->Step(c));
+    ++stats.steps;
+    sense_around(world.CoarseOf(c));
     return absl::OkStatus();
   };
-
-  std::vector<CellIndex> deferred;
   seen[root.cell] = 1;
   sense_around(root.cell);
-  covered[truth.Index(start.row, start.col)] = 1;
+  StcWalker walker(truth, std::move(w), start);
+  std::vector<CellIndex> deferred;
   StcRoot at = root;
+  const StopToken never;
   while (true) {
     // DFS, one side at a time as the circumnavigation reaches it.
     if (!tree.HasEdge(at.cell, at.position)) {
@@ -112,10 +96,10 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
     at = NextOnRing(world, tree, at);
     if (at.cell == root.cell && at.position == root.position) break;
     const CellIndex sub = world.SubCell(at.cell, at.position);
-    if (!is_target(sub)) continue;
+    if (!truth.IsFree(sub)) continue;
     // A sub-cell whose only known way in leads through cells not sensed
-    // yet is left for the end, when every cell of the tree is sensed.
-    const absl::Status moved = drive_to(sub);
+    // yet is left for later, when more is sensed.
+    const absl::Status moved = walker.Visit(sub, never);
     if (absl::IsNotFound(moved)) {
       deferred.push_back(sub);
       ++stats.deferred_cells;
@@ -123,13 +107,27 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
       RETURN_IF_ERROR(moved);
     }
   }
-  for (const CellIndex& sub : deferred) {
-    if (!is_target(sub)) continue;
-    const absl::Status moved = drive_to(sub);
-    if (absl::IsNotFound(moved)) return absl::InternalError("on-line STC: a sensed cell cannot be reached");
-    RETURN_IF_ERROR(moved);
+  RETURN_IF_ERROR(walker.Excursions());
+  // What is left: deferred tree cells and (kCover) orphans it knows of;
+  // reaching them senses more, so repeat until nothing known is left.
+  while (true) {
+    std::vector<CellIndex> pending;
+    for (const CellIndex& c : deferred) {
+      if (!walker.covered(c)) pending.push_back(c);
+    }
+    if (partial == PartialCells::kCover) {
+      for (const CellIndex& c : known_cells) {
+        if (!walker.covered(c)) pending.push_back(c);
+      }
+    }
+    if (pending.empty()) break;
+    const absl::Status swept = walker.SweepRemaining(pending, never);
+    if (absl::IsNotFound(swept)) return absl::InternalError("on-line STC: a sensed cell cannot be reached");
+    RETURN_IF_ERROR(swept);
   }
-  if (robot->at() != start) RETURN_IF_ERROR(drive_to(start));
+  const absl::Status back = walker.GoTo(start);
+  if (absl::IsNotFound(back)) return absl::InternalError("on-line STC: no known way back to the start");
+  RETURN_IF_ERROR(back);
   return stats;
 }
 

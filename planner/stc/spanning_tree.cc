@@ -105,15 +105,24 @@ StcTree BuildPrimTree(const CoarseGrid& coarse, StcRoot root, SweepDirection dir
   });
 }
 
+std::vector<std::vector<CellIndex>> CircumnavigateEach(const CoarseGrid& coarse, const StcTree& tree) {
+  std::vector<std::vector<CellIndex>> rings;
+  for (const StcRoot& root : tree.roots) {
+    std::vector<CellIndex>& ring = rings.emplace_back();
+    StcRoot at = root;
+    do {
+      ring.push_back(coarse.SubCell(at.cell, at.position));
+      at = NextOnRing(coarse, tree, at);
+    } while (at.cell != root.cell || at.position != root.position);
+  }
+  return rings;
+}
+
 std::vector<CellIndex> Circumnavigate(const CoarseGrid& coarse, const StcTree& tree) {
   std::vector<CellIndex> out;
   out.reserve(static_cast<size_t>(tree.num_nodes) * 4);
-  for (const StcRoot& root : tree.roots) {
-    StcRoot at = root;
-    do {
-      out.push_back(coarse.SubCell(at.cell, at.position));
-      at = NextOnRing(coarse, tree, at);
-    } while (at.cell != root.cell || at.position != root.position);
+  for (const std::vector<CellIndex>& ring : CircumnavigateEach(coarse, tree)) {
+    out.insert(out.end(), ring.begin(), ring.end());
   }
   return out;
 }

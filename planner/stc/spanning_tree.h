@@ -45,6 +45,8 @@ StcTree BuildPrimTree(const CoarseGrid& coarse, StcRoot root, SweepDirection dir
 // Every sub-cell (4 per node, free or not) in the order the counter-clockwise
 // circumnavigation of each tree visits them, starting at its root.
 std::vector<CellIndex> Circumnavigate(const CoarseGrid& coarse, const StcTree& tree);
+// The same, one ring per tree (roots[i] -> ring i).
+std::vector<std::vector<CellIndex>> CircumnavigateEach(const CoarseGrid& coarse, const StcTree& tree);
 
 // The next (cell, position) of the circumnavigation after (cell, position).
 inline StcRoot NextOnRing(const CoarseGrid& coarse, const StcTree& tree, StcRoot at) {

@@ -50,8 +50,16 @@ absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover, c
     const StcTree tree = options.tree == StcTreeMethod::kDfs
                              ? BuildDfsTree(coarse, root)
                              : BuildPrimTree(coarse, root, options.sweep_direction);
-    const std::vector<CellIndex> order = Circumnavigate(coarse, tree);
-    ASSIGN_OR_RETURN(StcWalk walk, WalkInOrder(drive, cover, order, start_cell, end_cell, stop));
+    std::vector<uint8_t> orphan;
+    if (options.partial_cells == PartialCells::kCover) {
+      orphan.assign(drive.size(), 0);
+      for (int64_t i = 0; i < drive.size(); ++i) {
+        const CellIndex c = drive.FromIndex(i);
+        orphan[i] = cover.free_flags()[i] && coarse.IsOrphan(c);
+      }
+    }
+    ASSIGN_OR_RETURN(StcWalk walk,
+                     WalkForest(drive, cover, CircumnavigateEach(coarse, tree), orphan, start_cell, end_cell, stop));
     // Most cells covered (differs only when partial cells are discarded),
     // then fewest moves, then fewest partly free coarse cells.
     const int64_t partial = tree.num_nodes - coarse.num_full_nodes();
@@ -69,6 +77,7 @@ absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover, c
     d->full_coarse_cells = coarse.num_full_nodes();
     d->partial_coarse_cells = tree.num_nodes - coarse.num_full_nodes();
     d->tree_edges = tree.num_edges;
+    for (uint8_t o : orphan) d->orphan_cells += o;
     d->trees = static_cast<int64_t>(tree.roots.size());
     d->extra_moves = walk.extra_moves;
     d->subcells_covered_twice = walk.cells_covered_twice;

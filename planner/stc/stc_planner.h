@@ -49,6 +49,7 @@ class StcDetail final : public PlannerDetail {
   int64_t coarse_cells = 0;     // tree nodes
   int64_t full_coarse_cells = 0;     // nodes whose four sub-cells are free
   int64_t partial_coarse_cells = 0;  // nodes with 1-3 free sub-cells
+  int64_t orphan_cells = 0;     // free sub-cells outside every node, swept by excursions
   int64_t tree_edges = 0;
   int64_t trees = 0;            // components (1 unless partial cells are discarded)
   int64_t extra_moves = 0;      // moves that cover nothing new before the last new cell

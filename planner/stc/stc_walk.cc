@@ -3,7 +3,9 @@
 #include <cmath>
 #include <utility>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "planner/common/status_macros.h"
 
 namespace covplan {
 namespace {
@@ -11,105 +13,319 @@ namespace {
 constexpr int kDr[4] = {0, 1, 0, -1};
 constexpr int kDc[4] = {1, 0, -1, 0};
 
-// Shortest 4-neighbour paths on the drive grid, reusing its buffers.
-class Bridge {
- public:
-  explicit Bridge(const Grid& grid)
-      : grid_(grid), stamp_(grid.size(), 0), parent_(grid.size(), -1) {}
+}  // namespace
 
-  // Cells after `from` up to and including `to`; empty when unreachable.
-  std::vector<CellIndex> Path(CellIndex from, CellIndex to) {
+StcWalker::StcWalker(const Grid& shape, World world, CellIndex start)
+    : shape_(shape),
+      world_(std::move(world)),
+      at_(start),
+      covered_(shape.size(), 0),
+      stamp_(shape.size(), 0),
+      parent_(shape.size(), -1) {
+  walk_.start = start;
+  walk_.start_covers = world_.to_cover(start);
+  if (walk_.start_covers) {
+    covered_[shape_.Index(start.row, start.col)] = 1;
+    walk_.covered_cells = 1;
+  }
+}
+
+absl::Status StcWalker::Step(CellIndex to) {
+  const int64_t i = shape_.Index(to.row, to.col);
+  const bool fresh = world_.to_cover(to) && !covered_[i];
+  walk_.steps.push_back(to);
+  walk_.covers.push_back(fresh);
+  if (fresh) {
+    covered_[i] = 1;
+    ++walk_.covered_cells;
+  }
+  at_ = to;
+  return world_.on_step ? world_.on_step(to) : absl::OkStatus();
+}
+
+std::vector<CellIndex> StcWalker::Path(CellIndex from, CellIndex to) {
+  ++round_;
+  const int64_t src = shape_.Index(from.row, from.col), dst = shape_.Index(to.row, to.col);
+  queue_.clear();
+  queue_.push_back(src);
+  stamp_[src] = round_;
+  for (size_t head = 0; head < queue_.size() && stamp_[dst] != round_; ++head) {
+    const CellIndex c = shape_.FromIndex(queue_[head]);
+    for (int d = 0; d < 4; ++d) {
+      const CellIndex n{c.row + kDr[d], c.col + kDc[d]};
+      if (!shape_.InBounds(n.row, n.col) || !world_.may_enter(n) || !world_.passable(c, kDr[d], kDc[d])) continue;
+      const int64_t ni = shape_.Index(n.row, n.col);
+      if (stamp_[ni] == round_) continue;
+      stamp_[ni] = round_;
+      parent_[ni] = queue_[head];
+      queue_.push_back(ni);
+    }
+  }
+  std::vector<CellIndex> path;
+  if (stamp_[dst] != round_) return path;
+  for (int64_t v = dst; v != src; v = parent_[v]) path.push_back(shape_.FromIndex(v));
+  return {path.rbegin(), path.rend()};
+}
+
+absl::Status StcWalker::Excursion(CellIndex from, int depth) {
+  for (int d = 0; d < 4; ++d) {
+    const CellIndex o{from.row + kDr[d], from.col + kDc[d]};
+    if (!shape_.InBounds(o.row, o.col) || !world_.may_enter(o) || !world_.orphan(o) || covered(o) ||
+        !world_.passable(from, kDr[d], kDc[d])) {
+      continue;
+    }
+    RETURN_IF_ERROR(Step(o));
+    RETURN_IF_ERROR(Excursion(o, depth + 1));
+    RETURN_IF_ERROR(Step(from));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status StcWalker::Excursions() { return Excursion(at_, 0); }
+
+absl::Status StcWalker::Visit(CellIndex next, const StopToken& stop) {
+  if (covered(next)) return absl::OkStatus();
+  // An orphan touching both this cell and the next is swept on the way.
+  int via = -1;
+  for (int d = 0; d < 4 && via < 0; ++d) {
+    const CellIndex o{at_.row + kDr[d], at_.col + kDc[d]};
+    if (!shape_.InBounds(o.row, o.col) || !world_.may_enter(o) || !world_.orphan(o) || covered(o) ||
+        !world_.passable(at_, kDr[d], kDc[d])) {
+      continue;
+    }
+    const int dr = next.row - o.row, dc = next.col - o.col;
+    if (std::abs(dr) + std::abs(dc) == 1 && world_.passable(o, dr, dc)) via = d;
+  }
+  const CellIndex here = at_;
+  for (int d = 0; d < 4; ++d) {
+    if (d == via) continue;
+    const CellIndex o{here.row + kDr[d], here.col + kDc[d]};
+    if (!shape_.InBounds(o.row, o.col) || !world_.may_enter(o) || !world_.orphan(o) || covered(o) ||
+        !world_.passable(here, kDr[d], kDc[d])) {
+      continue;
+    }
+    RETURN_IF_ERROR(Step(o));
+    RETURN_IF_ERROR(Excursion(o, 1));
+    RETURN_IF_ERROR(Step(here));
+  }
+  if (via >= 0) {
+    const CellIndex o{here.row + kDr[via], here.col + kDc[via]};
+    if (!covered(o)) RETURN_IF_ERROR(Step(o));
+  }
+  if (covered(next)) return absl::OkStatus();
+  const bool adjacent = std::abs(next.row - at_.row) + std::abs(next.col - at_.col) == 1 &&
+                        world_.passable(at_, next.row - at_.row, next.col - at_.col);
+  if (adjacent) return Step(next);
+  if (++bridges_ % 256 == 0 && stop.ShouldStop()) {
+    return absl::DeadlineExceededError("stopped while walking the STC order");
+  }
+  const std::vector<CellIndex> path = Path(at_, next);
+  if (path.empty()) return absl::NotFoundError("no known path to the next sub-cell");
+  for (const CellIndex& c : path) RETURN_IF_ERROR(Step(c));
+  return absl::OkStatus();
+}
+
+absl::Status StcWalker::SweepRemaining(const std::vector<CellIndex>& pending, const StopToken& stop) {
+  // Nearest first: one BFS from the robot to the closest unswept pending cell.
+  std::vector<uint8_t> want(shape_.size(), 0);
+  int64_t left = 0;
+  for (const CellIndex& c : pending) {
+    if (!covered(c) && !want[shape_.Index(c.row, c.col)]) {
+      want[shape_.Index(c.row, c.col)] = 1;
+      ++left;
+    }
+  }
+  while (left > 0) {
+    if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while sweeping the last STC cells");
     ++round_;
-    const int64_t src = grid_.Index(from.row, from.col), dst = grid_.Index(to.row, to.col);
+    const int64_t src = shape_.Index(at_.row, at_.col);
     queue_.clear();
     queue_.push_back(src);
     stamp_[src] = round_;
-    for (size_t head = 0; head < queue_.size() && stamp_[dst] != round_; ++head) {
-      const CellIndex c = grid_.FromIndex(queue_[head]);
-      for (int d = 0; d < 4; ++d) {
-        if (!grid_.Passable(c.row, c.col, kDr[d], kDc[d])) continue;
-        const int64_t n = grid_.Index(c.row + kDr[d], c.col + kDc[d]);
-        if (stamp_[n] == round_) continue;
-        stamp_[n] = round_;
-        parent_[n] = queue_[head];
-        queue_.push_back(n);
+    int64_t found = -1;
+    for (size_t head = 0; head < queue_.size() && found < 0; ++head) {
+      const CellIndex c = shape_.FromIndex(queue_[head]);
+      for (int d = 0; d < 4 && found < 0; ++d) {
+        const CellIndex n{c.row + kDr[d], c.col + kDc[d]};
+        if (!shape_.InBounds(n.row, n.col) || !world_.may_enter(n) || !world_.passable(c, kDr[d], kDc[d])) continue;
+        const int64_t ni = shape_.Index(n.row, n.col);
+        if (stamp_[ni] == round_) continue;
+        stamp_[ni] = round_;
+        parent_[ni] = queue_[head];
+        queue_.push_back(ni);
+        if (want[ni] && !covered_[ni]) found = ni;
       }
     }
+    if (found < 0) return absl::NotFoundError("no known path to the remaining cells");
     std::vector<CellIndex> path;
-    if (stamp_[dst] != round_) return path;
-    for (int64_t v = dst; v != src; v = parent_[v]) path.push_back(grid_.FromIndex(v));
-    return {path.rbegin(), path.rend()};
+    for (int64_t v = found; v != src; v = parent_[v]) path.push_back(shape_.FromIndex(v));
+    for (auto it = path.rbegin(); it != path.rend(); ++it) RETURN_IF_ERROR(Step(*it));
+    RETURN_IF_ERROR(Excursions());
+    left = 0;
+    for (const CellIndex& c : pending) left += want[shape_.Index(c.row, c.col)] && !covered(c);
   }
+  return absl::OkStatus();
+}
 
- private:
-  const Grid& grid_;
-  std::vector<uint32_t> stamp_;
-  std::vector<int64_t> parent_;
-  std::vector<int64_t> queue_;
-  uint32_t round_ = 0;
-};
+absl::Status StcWalker::GoTo(CellIndex end) {
+  if (at_ == end) return absl::OkStatus();
+  const std::vector<CellIndex> path = Path(at_, end);
+  if (path.empty()) return absl::NotFoundError("no known path to the end cell");
+  for (const CellIndex& c : path) RETURN_IF_ERROR(Step(c));
+  return absl::OkStatus();
+}
 
-}  // namespace
-
-absl::StatusOr<StcWalk> WalkInOrder(const Grid& drive, const Grid& cover, const std::vector<CellIndex>& order,
-                                    CellIndex start, CellIndex end, const StopToken& stop) {
-  if (!drive.IsFree(start) || !drive.IsFree(end)) return absl::InternalError("STC walk outside the drive grid");
-  auto is_target = [&](CellIndex c) { return drive.IsFree(c) && cover.IsFree(c); };
-  StcWalk walk;
-  walk.start = start;
-  std::vector<uint8_t> covered(drive.size(), 0), entered(drive.size(), 0);
-  auto index = [&](CellIndex c) { return drive.Index(c.row, c.col); };
-  walk.start_covers = is_target(start);
-  if (walk.start_covers) {
-    covered[index(start)] = 1;
-    ++walk.covered_cells;
-  }
-  entered[index(start)] = 1;
-  Bridge bridge(drive);
-  CellIndex at = start;
-  auto step = [&](CellIndex to) {
-    const bool fresh = is_target(to) && !covered[index(to)];
-    walk.steps.push_back(to);
-    walk.covers.push_back(fresh);
-    if (fresh) {
-      covered[index(to)] = 1;
-      ++walk.covered_cells;
-    }
-    at = to;
-  };
-  int64_t bridges = 0;
-  for (const CellIndex& next : order) {
-    if (!is_target(next) || covered[index(next)]) continue;
-    const bool adjacent = std::abs(next.row - at.row) + std::abs(next.col - at.col) == 1 &&
-                          drive.Passable(at.row, at.col, next.row - at.row, next.col - at.col);
-    if (adjacent) {
-      step(next);
-      continue;
-    }
-    if (++bridges % 256 == 0 && stop.ShouldStop()) {
-      return absl::DeadlineExceededError("stopped while walking the STC order");
-    }
-    const std::vector<CellIndex> path = bridge.Path(at, next);
-    if (path.empty()) {
-      return absl::InternalError(absl::StrFormat("STC: cell (%d, %d) cannot be reached from (%d, %d)",
-                                                 next.row, next.col, at.row, at.col));
-    }
-    for (const CellIndex& c : path) step(c);
-  }
+StcWalk StcWalker::Finish() const {
+  StcWalk walk = walk_;
   walk.coverage_steps = static_cast<int64_t>(walk.steps.size());
   while (walk.coverage_steps > 0 && !walk.covers[walk.coverage_steps - 1]) --walk.coverage_steps;
+  std::vector<uint8_t> entered(shape_.size(), 0);
+  entered[shape_.Index(walk.start.row, walk.start.col)] = 1;
   for (int64_t i = 0; i < walk.coverage_steps; ++i) {
     walk.extra_moves += !walk.covers[i];
-    uint8_t& e = entered[index(walk.steps[i])];
+    uint8_t& e = entered[shape_.Index(walk.steps[i].row, walk.steps[i].col)];
     if (e == 1) ++walk.cells_covered_twice;
     if (e < 2) ++e;
   }
-  if (at != end) {
-    const std::vector<CellIndex> path = bridge.Path(at, end);
-    if (path.empty()) return absl::InternalError("STC: the end cell cannot be reached");
-    for (const CellIndex& c : path) step(c);
-  }
   return walk;
+}
+
+absl::StatusOr<StcWalk> WalkInOrder(const Grid& drive, const Grid& cover, const std::vector<CellIndex>& order,
+                                    const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
+                                    const StopToken& stop) {
+  if (!drive.IsFree(start) || !drive.IsFree(end)) return absl::InternalError("STC walk outside the drive grid");
+  StcWalker::World world;
+  world.may_enter = [&](CellIndex c) { return drive.IsFree(c); };
+  world.passable = [&](CellIndex c, int dr, int dc) { return drive.Passable(c.row, c.col, dr, dc); };
+  world.to_cover = [&](CellIndex c) { return drive.IsFree(c) && cover.IsFree(c); };
+  world.orphan = [&](CellIndex c) { return !orphan.empty() && orphan[drive.Index(c.row, c.col)] != 0; };
+  StcWalker walker(drive, std::move(world), start);
+  auto internal = [](const absl::Status& s) {
+    return absl::IsNotFound(s) ? absl::InternalError(absl::StrCat("STC: ", s.message())) : s;
+  };
+  for (const CellIndex& next : order) {
+    if (!drive.IsFree(next) || !cover.IsFree(next)) continue;
+    const absl::Status s = walker.Visit(next, stop);
+    if (!s.ok()) return internal(s);
+  }
+  absl::Status s = walker.Excursions();
+  if (!s.ok()) return internal(s);
+  std::vector<CellIndex> pending;
+  for (int64_t i = 0; i < drive.size(); ++i) {
+    if (!orphan.empty() && orphan[i]) pending.push_back(drive.FromIndex(i));
+  }
+  s = walker.SweepRemaining(pending, stop);
+  if (!s.ok()) return internal(s);
+  s = walker.GoTo(end);
+  if (!s.ok()) return internal(s);
+  return walker.Finish();
+}
+
+absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
+                                   const std::vector<std::vector<CellIndex>>& rings,
+                                   const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
+                                   const StopToken& stop) {
+  if (!drive.IsFree(start) || !drive.IsFree(end)) return absl::InternalError("STC walk outside the drive grid");
+  auto to_cover = [&](CellIndex c) { return drive.IsFree(c) && cover.IsFree(c); };
+  StcWalker::World world;
+  world.may_enter = [&](CellIndex c) { return drive.IsFree(c); };
+  world.passable = [&](CellIndex c, int dr, int dc) { return drive.Passable(c.row, c.col, dr, dc); };
+  world.to_cover = to_cover;
+  world.orphan = [&](CellIndex c) { return !orphan.empty() && orphan[drive.Index(c.row, c.col)] != 0; };
+  StcWalker walker(drive, std::move(world), start);
+  auto internal = [](const absl::Status& s) {
+    return absl::IsNotFound(s) ? absl::InternalError(absl::StrCat("STC: ", s.message())) : s;
+  };
+  // Which ring (and where in it) each free tree cell is.
+  std::vector<int32_t> tree_of(drive.size(), -1), index_in(drive.size(), -1);
+  for (size_t t = 0; t < rings.size(); ++t) {
+    for (size_t k = 0; k < rings[t].size(); ++k) {
+      const CellIndex c = rings[t][k];
+      if (!drive.IsFree(c)) continue;
+      tree_of[drive.Index(c.row, c.col)] = static_cast<int32_t>(t);
+      index_in[drive.Index(c.row, c.col)] = static_cast<int32_t>(k);
+    }
+  }
+  std::vector<uint8_t> walked(rings.size(), 0);
+  struct Frame {
+    int tree;
+    size_t first;
+    size_t k;
+  };
+  std::vector<Frame> stack;
+  auto begin = [&](int tree, CellIndex at) {
+    walked[tree] = 1;
+    stack.push_back({tree, static_cast<size_t>(index_in[drive.Index(at.row, at.col)]), 0});
+  };
+  constexpr int kDr[4] = {0, 1, 0, -1}, kDc[4] = {1, 0, -1, 0};
+  // A tree next to the robot not walked yet: walk it from there.
+  auto splice = [&]() {
+    const CellIndex at = walker.at();
+    for (int d = 0; d < 4; ++d) {
+      const CellIndex n{at.row + kDr[d], at.col + kDc[d]};
+      if (!drive.IsFree(n) || !drive.Passable(at.row, at.col, kDr[d], kDc[d])) continue;
+      const int t = tree_of[drive.Index(n.row, n.col)];
+      if (t < 0 || walked[t]) continue;
+      begin(t, n);
+      return true;
+    }
+    return false;
+  };
+  auto run = [&]() -> absl::Status {
+    while (!stack.empty()) {
+      Frame& f = stack.back();
+      const std::vector<CellIndex>& ring = rings[f.tree];
+      if (f.k == ring.size()) {
+        stack.pop_back();
+        continue;
+      }
+      const CellIndex c = ring[(f.first + f.k++) % ring.size()];
+      if (!to_cover(c)) continue;
+      RETURN_IF_ERROR(walker.Visit(c, stop));
+      splice();
+    }
+    return absl::OkStatus();
+  };
+  const int first_tree = tree_of[drive.Index(start.row, start.col)];
+  absl::Status s;
+  if (first_tree >= 0) {
+    begin(first_tree, start);
+    s = run();
+    if (!s.ok()) return internal(s);
+  }
+  // Trees never met: nearest first (BFS over the drive grid).
+  while (true) {
+    if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while walking the STC forest");
+    std::vector<uint8_t> seen(drive.size(), 0);
+    std::vector<int64_t> queue = {drive.Index(walker.at().row, walker.at().col)};
+    seen[queue[0]] = 1;
+    int64_t found = -1;
+    for (size_t head = 0; head < queue.size() && found < 0; ++head) {
+      const int64_t v = queue[head];
+      if (tree_of[v] >= 0 && !walked[tree_of[v]]) found = v;
+      const CellIndex c = drive.FromIndex(v);
+      for (int d = 0; d < 4; ++d) {
+        if (!drive.Passable(c.row, c.col, kDr[d], kDc[d])) continue;
+        const int64_t n = drive.Index(c.row + kDr[d], c.col + kDc[d]);
+        if (!seen[n]) seen[n] = 1, queue.push_back(n);
+      }
+    }
+    if (found < 0) break;
+    begin(tree_of[found], drive.FromIndex(found));
+    s = run();
+    if (!s.ok()) return internal(s);
+  }
+  s = walker.Excursions();
+  if (!s.ok()) return internal(s);
+  std::vector<CellIndex> pending;
+  for (int64_t i = 0; i < drive.size(); ++i) {
+    if (!orphan.empty() && orphan[i]) pending.push_back(drive.FromIndex(i));
+  }
+  s = walker.SweepRemaining(pending, stop);
+  if (!s.ok()) return internal(s);
+  s = walker.GoTo(end);
+  if (!s.ok()) return internal(s);
+  return walker.Finish();
 }
 
 void AppendWalk(const Grid& drive, const StcWalk& walk, const std::optional<Pose2>& start_pose,

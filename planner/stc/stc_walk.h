@@ -42,11 +42,72 @@ struct StcWalk {
   int64_t cells_covered_twice = 0;    // drive cells entered more than once within the coverage steps
 };
 
-// Visits the cells to cover among `order` in that order, from `start`
-// (covered when it is a cell to cover), then drives to `end`. Internal when a
-// cell cannot be reached (the drive grid is one component).
+// The robot's walk over the tool-width grid, one unit move at a time, over
+// what `World` says it knows. Cells to cover outside the tree ("orphans":
+// free sub-cells of coarse cells whose free sub-cells are not connected
+// inside the cell, e.g. split by a thin wall or only diagonal) are swept by
+// excursions from the tree cell next to them: on the way to the next tree
+// cell when an orphan touches both (no extra move), else out and back.
+class StcWalker {
+ public:
+  struct World {
+    std::function<bool(CellIndex)> may_enter;  // free and known to the robot
+    std::function<bool(CellIndex, int, int)> passable;  // (cell, dr, dc)
+    std::function<bool(CellIndex)> to_cover;            // a cell to cover
+    std::function<bool(CellIndex)> orphan;              // to cover, outside the tree
+    std::function<absl::Status(CellIndex)> on_step;     // after each move (the robot drives)
+  };
+  StcWalker(const Grid& shape, World world, CellIndex start);
+
+  // Goes to `next` (a tree cell to cover) unless already covered, sweeping
+  // orphans on the way. NotFound when the known cells hold no path.
+  absl::Status Visit(CellIndex next, const StopToken& stop);
+  // Orphan excursions from where the robot stands.
+  absl::Status Excursions();
+  // Every cell to cover still unswept that `pending` lists, nearest first.
+  absl::Status SweepRemaining(const std::vector<CellIndex>& pending, const StopToken& stop);
+  // Drives to `end` (no coverage counted after the last new cell).
+  absl::Status GoTo(CellIndex end);
+  bool covered(CellIndex c) const { return covered_[shape_.Index(c.row, c.col)] != 0; }
+  CellIndex at() const { return at_; }
+  // The walk so far, with the repeat statistics filled.
+  StcWalk Finish() const;
+
+ private:
+  absl::Status Step(CellIndex to);
+  absl::Status Excursion(CellIndex from, int depth);
+  std::vector<CellIndex> Path(CellIndex from, CellIndex to);
+
+  const Grid& shape_;
+  World world_;
+  CellIndex at_;
+  StcWalk walk_;
+  std::vector<uint8_t> covered_;
+  std::vector<uint32_t> stamp_;
+  std::vector<int64_t> parent_;
+  std::vector<int64_t> queue_;
+  uint32_t round_ = 0;
+  int64_t bridges_ = 0;
+};
+
+// Off-line, for a forest (one ring per tree, rings[0] holding the start's
+// tree when it has one): walks the start's ring from the start; whenever the
+// robot stands next to a cell of a tree not walked yet, that tree's ring is
+// spliced in from that cell (a tree met on the way costs a step in and a
+// step back instead of a trip); trees never met are walked nearest first.
+// Orphans (`orphan`, per drive cell, may be empty) are swept on the way.
+absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
+                                   const std::vector<std::vector<CellIndex>>& rings,
+                                   const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
+                                   const StopToken& stop);
+
+// Off-line: visits the cells to cover among `order` in that order from
+// `start` (covered when it is a cell to cover), with the orphan cells of
+// `orphan` (per cell of `drive`, may be empty) swept on the way, then drives
+// to `end`. Internal when a cell cannot be reached.
 absl::StatusOr<StcWalk> WalkInOrder(const Grid& drive, const Grid& cover, const std::vector<CellIndex>& order,
-                                    CellIndex start, CellIndex end, const StopToken& stop);
+                                    const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
+                                    const StopToken& stop);
 
 // Appends the walk to plan->path and plan->sweeps, merging straight runs of
 // moves of one kind into one segment. The first waypoint is `start_pose`

@@ -90,7 +90,6 @@ TEST(OfflineStc, TreesSpanTheCoarseCellsAndTheRingVisitsEachSubCellOnce) {
             if (tree.HasEdge(id, side)) EXPECT_TRUE(coarse.CanLink(id, side));
           }
         }
-        if (partial == PartialCells::kCover) EXPECT_EQ(tree.roots.size(), 1u);  // the drive grid is connected
         const std::vector<CellIndex> ring = Circumnavigate(coarse, tree);
         ASSERT_EQ(static_cast<int>(ring.size()), 4 * coarse.num_nodes());
         std::vector<int> seen(static_cast<size_t>(coarse.size()) * 4, 0);
