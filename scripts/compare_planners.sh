@@ -18,8 +18,10 @@ if [ ! -d "$IPA" ]; then
   exit 2
 fi
 algorithms=()
+listed="(every registered planner)"
 if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then
   algorithms=(--algorithms "$1")
+  listed=$1
   shift
 fi
 BIN=${COVPLAN_BIN:-}
@@ -32,7 +34,7 @@ out=$(mktemp)
 trap 'rm -f "$out"' EXIT
 {
   echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(date -u +%F)"
-  echo "command: scripts/compare_planners.sh ${algorithms[*]:1} $*"
+  echo "planners: $listed; extra flags: ${*:-none}"
   echo
   header=1
   for f in "$IPA"/*.png; do

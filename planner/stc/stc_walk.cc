@@ -67,21 +67,35 @@ std::vector<CellIndex> StcWalker::Path(CellIndex from, CellIndex to) {
   return {path.rbegin(), path.rend()};
 }
 
-absl::Status StcWalker::Excursion(CellIndex from, int depth) {
-  for (int d = 0; d < 4; ++d) {
-    const CellIndex o{from.row + kDr[d], from.col + kDc[d]};
+absl::Status StcWalker::Excursion(CellIndex from) {
+  // Depth first over orphans, out and back; an explicit stack, since a chain
+  // of orphans can be as long as the map is large.
+  struct Frame {
+    CellIndex cell;
+    int next_dir;
+  };
+  std::vector<Frame> stack = {{from, 0}};
+  while (!stack.empty()) {
+    Frame& f = stack.back();
+    if (f.next_dir == 4) {
+      stack.pop_back();
+      if (!stack.empty()) RETURN_IF_ERROR(Step(stack.back().cell));  // back out
+      continue;
+    }
+    const int d = f.next_dir++;
+    const CellIndex c = f.cell;
+    const CellIndex o{c.row + kDr[d], c.col + kDc[d]};
     if (!shape_.InBounds(o.row, o.col) || !world_.may_enter(o) || !world_.orphan(o) || covered(o) ||
-        !world_.passable(from, kDr[d], kDc[d])) {
+        !world_.passable(c, kDr[d], kDc[d])) {
       continue;
     }
     RETURN_IF_ERROR(Step(o));
-    RETURN_IF_ERROR(Excursion(o, depth + 1));
-    RETURN_IF_ERROR(Step(from));
+    stack.push_back({o, 0});
   }
   return absl::OkStatus();
 }
 
-absl::Status StcWalker::Excursions() { return Excursion(at_, 0); }
+absl::Status StcWalker::Excursions() { return Excursion(at_); }
 
 absl::Status StcWalker::Visit(CellIndex next, const StopToken& stop) {
   if (covered(next)) return absl::OkStatus();
@@ -105,12 +119,15 @@ absl::Status StcWalker::Visit(CellIndex next, const StopToken& stop) {
       continue;
     }
     RETURN_IF_ERROR(Step(o));
-    RETURN_IF_ERROR(Excursion(o, 1));
+    RETURN_IF_ERROR(Excursion(o));
     RETURN_IF_ERROR(Step(here));
   }
   if (via >= 0) {
     const CellIndex o{here.row + kDr[via], here.col + kDc[via]};
-    if (!covered(o)) RETURN_IF_ERROR(Step(o));
+    if (!covered(o)) {
+      RETURN_IF_ERROR(Step(o));
+      RETURN_IF_ERROR(Excursion(o));
+    }
   }
   if (covered(next)) return absl::OkStatus();
   const bool adjacent = std::abs(next.row - at_.row) + std::abs(next.col - at_.col) == 1 &&
@@ -128,14 +145,8 @@ absl::Status StcWalker::Visit(CellIndex next, const StopToken& stop) {
 absl::Status StcWalker::SweepRemaining(const std::vector<CellIndex>& pending, const StopToken& stop) {
   // Nearest first: one BFS from the robot to the closest unswept pending cell.
   std::vector<uint8_t> want(shape_.size(), 0);
-  int64_t left = 0;
-  for (const CellIndex& c : pending) {
-    if (!covered(c) && !want[shape_.Index(c.row, c.col)]) {
-      want[shape_.Index(c.row, c.col)] = 1;
-      ++left;
-    }
-  }
-  while (left > 0) {
+  for (const CellIndex& c : pending) want[shape_.Index(c.row, c.col)] = 1;
+  while (true) {
     if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while sweeping the last STC cells");
     ++round_;
     const int64_t src = shape_.Index(at_.row, at_.col);
@@ -156,13 +167,14 @@ absl::Status StcWalker::SweepRemaining(const std::vector<CellIndex>& pending, co
         if (want[ni] && !covered_[ni]) found = ni;
       }
     }
-    if (found < 0) return absl::NotFoundError("no known path to the remaining cells");
+    if (found < 0) break;
     std::vector<CellIndex> path;
     for (int64_t v = found; v != src; v = parent_[v]) path.push_back(shape_.FromIndex(v));
     for (auto it = path.rbegin(); it != path.rend(); ++it) RETURN_IF_ERROR(Step(*it));
     RETURN_IF_ERROR(Excursions());
-    left = 0;
-    for (const CellIndex& c : pending) left += want[shape_.Index(c.row, c.col)] && !covered(c);
+  }
+  for (const CellIndex& c : pending) {
+    if (!covered(c)) return absl::NotFoundError("no known path to the remaining cells");
   }
   return absl::OkStatus();
 }
@@ -188,37 +200,6 @@ StcWalk StcWalker::Finish() const {
     if (e < 2) ++e;
   }
   return walk;
-}
-
-absl::StatusOr<StcWalk> WalkInOrder(const Grid& drive, const Grid& cover, const std::vector<CellIndex>& order,
-                                    const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
-                                    const StopToken& stop) {
-  if (!drive.IsFree(start) || !drive.IsFree(end)) return absl::InternalError("STC walk outside the drive grid");
-  StcWalker::World world;
-  world.may_enter = [&](CellIndex c) { return drive.IsFree(c); };
-  world.passable = [&](CellIndex c, int dr, int dc) { return drive.Passable(c.row, c.col, dr, dc); };
-  world.to_cover = [&](CellIndex c) { return drive.IsFree(c) && cover.IsFree(c); };
-  world.orphan = [&](CellIndex c) { return !orphan.empty() && orphan[drive.Index(c.row, c.col)] != 0; };
-  StcWalker walker(drive, std::move(world), start);
-  auto internal = [](const absl::Status& s) {
-    return absl::IsNotFound(s) ? absl::InternalError(absl::StrCat("STC: ", s.message())) : s;
-  };
-  for (const CellIndex& next : order) {
-    if (!drive.IsFree(next) || !cover.IsFree(next)) continue;
-    const absl::Status s = walker.Visit(next, stop);
-    if (!s.ok()) return internal(s);
-  }
-  absl::Status s = walker.Excursions();
-  if (!s.ok()) return internal(s);
-  std::vector<CellIndex> pending;
-  for (int64_t i = 0; i < drive.size(); ++i) {
-    if (!orphan.empty() && orphan[i]) pending.push_back(drive.FromIndex(i));
-  }
-  s = walker.SweepRemaining(pending, stop);
-  if (!s.ok()) return internal(s);
-  s = walker.GoTo(end);
-  if (!s.ok()) return internal(s);
-  return walker.Finish();
 }
 
 absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
@@ -294,11 +275,12 @@ absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
     if (!s.ok()) return internal(s);
   }
   // Trees never met: nearest first (BFS over the drive grid).
-  while (true) {
+  std::vector<uint32_t> seen(drive.size(), 0);
+  std::vector<int64_t> queue;
+  for (uint32_t round = 1;; ++round) {
     if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while walking the STC forest");
-    std::vector<uint8_t> seen(drive.size(), 0);
-    std::vector<int64_t> queue = {drive.Index(walker.at().row, walker.at().col)};
-    seen[queue[0]] = 1;
+    queue.assign(1, drive.Index(walker.at().row, walker.at().col));
+    seen[queue[0]] = round;
     int64_t found = -1;
     for (size_t head = 0; head < queue.size() && found < 0; ++head) {
       const int64_t v = queue[head];
@@ -307,7 +289,7 @@ absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
       for (int d = 0; d < 4; ++d) {
         if (!drive.Passable(c.row, c.col, kDr[d], kDc[d])) continue;
         const int64_t n = drive.Index(c.row + kDr[d], c.col + kDc[d]);
-        if (!seen[n]) seen[n] = 1, queue.push_back(n);
+        if (seen[n] != round) seen[n] = round, queue.push_back(n);
       }
     }
     if (found < 0) break;

@@ -1,4 +1,4 @@
-// From an STC visiting order to the robot's walk and to a CoveragePlan path.
+// From STC's circumnavigation to the robot's walk and to a CoveragePlan path.
 //
 // The circumnavigation lists every sub-cell of the tree's coarse cells once.
 // Wholly free coarse cells need nothing more: consecutive sub-cells are
@@ -6,13 +6,15 @@
 // cell is partly blocked (or partly outside the regions) the walk skips the
 // sub-cells that are not to be covered and bridges each gap with a shortest
 // 4-neighbour path on the drive grid (BFS); a cell to cover that a bridge
-// passes is covered there and skipped later. These bridges are the only
-// extra moves: each is shortest for the order, and the order is the tree's.
+// passes is covered there and skipped later. Orphan sub-cells (outside every
+// tree node) cost an out-and-back move each unless one lies between two
+// consecutive cells of the walk. Bridges and excursions are the only extra
+// moves: each bridge is shortest for the order, and the order is the tree's.
 //
-//   ASSIGN_OR_RETURN(StcWalk walk, WalkInOrder(drive, cover, order, start, end, stop));
-//   AppendWalk(drive, walk, [&](CellIndex c) { return coarse.CoarseOf(c); }, &plan);
+//   ASSIGN_OR_RETURN(StcWalk walk, WalkForest(drive, cover, rings, orphan, start, end, stop));
+//   AppendWalk(drive, walk, start_pose, end_pose, tag, &plan);
 //
-// Thread-safety: pure functions.
+// Thread-safety: the functions are reentrant; a StcWalker is single-threaded.
 #ifndef COVPLAN_PLANNER_STC_STC_WALK_H_
 #define COVPLAN_PLANNER_STC_STC_WALK_H_
 
@@ -75,7 +77,7 @@ class StcWalker {
 
  private:
   absl::Status Step(CellIndex to);
-  absl::Status Excursion(CellIndex from, int depth);
+  absl::Status Excursion(CellIndex from);
   std::vector<CellIndex> Path(CellIndex from, CellIndex to);
 
   const Grid& shape_;
@@ -100,14 +102,6 @@ absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
                                    const std::vector<std::vector<CellIndex>>& rings,
                                    const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
                                    const StopToken& stop);
-
-// Off-line: visits the cells to cover among `order` in that order from
-// `start` (covered when it is a cell to cover), with the orphan cells of
-// `orphan` (per cell of `drive`, may be empty) swept on the way, then drives
-// to `end`. Internal when a cell cannot be reached.
-absl::StatusOr<StcWalk> WalkInOrder(const Grid& drive, const Grid& cover, const std::vector<CellIndex>& order,
-                                    const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
-                                    const StopToken& stop);
 
 // Appends the walk to plan->path and plan->sweeps, merging straight runs of
 // moves of one kind into one segment. The first waypoint is `start_pose`
