@@ -7,10 +7,14 @@
 // every sub-cell of every wholly free coarse cell exactly once (path length
 // 4·N·D for N such cells on a closed tour). Partly free coarse cells stay in
 // the tree: their free sub-cells are covered, the gaps bridged by shortest
-// drive-grid paths (stc_walk.h), and the detail reports the extra moves and
-// the sub-cells covered twice. The coarse grid can sit at four offsets
-// against the tool grid; the planner tries all four and keeps the walk with
-// the fewest moves. No per-map artifacts: planning is linear in the grid.
+// drive-grid paths (stc_walk.h). A coarse cell whose free sub-cells are not
+// connected inside it (a thin wall through it, diagonal sub-cells) is no
+// tree node: its sub-cells are "orphans", swept by excursions from the tree
+// next to them; trees the coarse graph falls into are spliced into the walk
+// where it meets them. The detail reports the extra moves and the sub-cells
+// covered twice. The coarse grid can sit at four offsets against the tool
+// grid; the planner tries all four and keeps the walk with the fewest moves.
+// No per-map artifacts: planning is linear in the grid (plus the bridges).
 //
 //   auto opts = std::make_shared<StcOptions>();
 //   opts->tree = StcTreeMethod::kPrim; opts->sweep_direction = SweepDirection::kVertical;
