@@ -19,6 +19,7 @@
 #include "api/geojson.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
+#include "api/convert_stc.h"
 
 namespace covplan {
 namespace {
@@ -323,6 +324,13 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
     battery.atomic_units.assign(b.atomic_units().begin(), b.atomic_units().end());
     RETURN_IF_ERROR(battery.Validate());
     out.battery = battery;
+  }
+  if (request.planner_options_case() == v1::PlanRequest::kStc) {
+    if (out.planner != "stc") {
+      return absl::InvalidArgumentError(
+          absl::StrCat("planner_options: the stc options are for planner 'stc', not '", out.planner, "'"));
+    }
+    ASSIGN_OR_RETURN(out.options, StcOptionsFromProto(request.stc()));
   }
   // 0 means "default" for both (proto3 scalars have no presence).
   if (request.time_limit_s() != 0.0) options.time_limit_s = request.time_limit_s();

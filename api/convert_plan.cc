@@ -11,9 +11,11 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "google/protobuf/util/json_util.h"
+#include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
+#include "api/convert_stc.h"
 #include "planner/partition/rank.h"
 
 namespace covplan {
@@ -151,6 +153,7 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
     o->set_resume_unit(c.resume_unit);
     o->set_resumes_mid_unit(c.resumes_mid_unit);
   }
+  if (const StcDetail* stc = plan.detail_as<StcDetail>()) StcDetailToProto(*stc, out->mutable_stc());
   for (const Waypoint& w : plan.path) {
     v1::Waypoint* p = out->add_path();
     p->set_x(w.x);
@@ -297,6 +300,9 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
     detail->cell_reversed.assign(b.cell_reversed().begin(), b.cell_reversed().end());
     detail->cell_mirrored.assign(b.cell_mirrored().begin(), b.cell_mirrored().end());
     plan.detail = std::move(detail);
+  }
+  if (response.has_stc()) {
+    ASSIGN_OR_RETURN(plan.detail, StcDetailFromProto(response.stc()));
   }
   for (const v1::Waypoint& p : response.path()) {
     Waypoint w;

@@ -7,12 +7,14 @@
 //   covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S] [--deadline-ms D]
 //   covplan gtsp ...
 //   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local | --server H:P]
+//   covplan compare --map FILE [--algorithms oarp,stc] [--tool-width M] [--json out.json]
 //
 // Subcommands parse their own flags (client/args.h); no global flags.
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "client/compare_command.h"
 #include "client/gtsp_command.h"
 #include "client/load_command.h"
 #include "client/plan_command.h"
@@ -31,6 +33,7 @@ constexpr char kUsage[] =
     "  load   load-test a server's Plan method; prints one JSON object\n"
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
     "  simulate  drive a plan through the true map, replanning on new obstacles; prints JSON\n"
+    "  compare   plan one map with several planners and print one table (and JSON)\n"
     "Run 'covplan <command> --help' for its flags.\n";
 
 }  // namespace
@@ -48,6 +51,7 @@ int main(int argc, char** argv) {
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "simulate") return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
+  if (command == "compare") return covplan::RunCompareCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

@@ -35,12 +35,15 @@ constexpr char kUsage[] =
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
-    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp]\n"
-    "                    [--region AREA]... [--no-go AREA]...\n"
+    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|boustrophedon]\n"
+    "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
+    "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
     "                    [--sweep-axis auto|vertical|horizontal]   (boustrophedon)\n"
     "                    [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
     "                     [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
     "                     [--interruptible [--atomic-units ID,ID...]]]\n"
+    "--algorithm is another name for --planner. The --stc-* flags and --sweep-direction\n"
+    "set the stc planner's options (--sweep-direction: the prim tree only).\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
     "--resolution) or a .geojson polygon map (Polygon/MultiPolygon in metres; the free\n"
     "space). Without --local the server defaults to 127.0.0.1:50051.\n"
@@ -144,7 +147,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
-                 "energy-per-second", "atomic-units", "sweep-axis"},
+                 "energy-per-second", "atomic-units", "sweep-axis",
+                 "algorithm", "stc-tree", "sweep-direction", "stc-partial"},
                 {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -186,7 +190,34 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     if (*seed < 0 || *seed > UINT32_MAX) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
     r.set_seed(static_cast<uint32_t>(*seed));
   }
+  if (a.Get("planner") && a.Get("algorithm") && *a.Get("planner") != *a.Get("algorithm")) {
+    return absl::InvalidArgumentError("--algorithm is another name for --planner: give one of them");
+  }
   if (auto p = a.Get("planner")) r.set_planner(*p);
+  if (auto p = a.Get("algorithm")) r.set_planner(*p);
+  if (a.Get("stc-tree") || a.Get("sweep-direction") || a.Get("stc-partial")) {
+    if (r.planner() != "stc") {
+      return absl::InvalidArgumentError("--stc-tree, --sweep-direction and --stc-partial need --planner stc");
+    }
+    v1::StcOptions* stc = r.mutable_stc();
+    if (auto t = a.Get("stc-tree")) {
+      if (*t == "dfs") stc->set_tree(v1::STC_TREE_DFS);
+      else if (*t == "prim") stc->set_tree(v1::STC_TREE_PRIM);
+      else return absl::InvalidArgumentError(absl::StrCat("--stc-tree must be dfs or prim, got '", *t, "'"));
+    }
+    if (auto d = a.Get("sweep-direction")) {
+      if (*d == "horizontal") stc->set_sweep_direction(v1::STC_SWEEP_HORIZONTAL);
+      else if (*d == "vertical") stc->set_sweep_direction(v1::STC_SWEEP_VERTICAL);
+      else return absl::InvalidArgumentError(
+          absl::StrCat("--sweep-direction must be horizontal or vertical, got '", *d, "'"));
+    }
+    if (auto m = a.Get("stc-partial")) {
+      if (*m == "cover") stc->set_partial_cells(v1::STC_PARTIAL_COVER);
+      else if (*m == "discard") stc->set_partial_cells(v1::STC_PARTIAL_DISCARD);
+      else return absl::InvalidArgumentError(
+          absl::StrCat("--stc-partial must be cover or discard, got '", *m, "'"));
+    }
+  }
   if (auto it = a.repeated.find("region"); it != a.repeated.end()) {
     for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("region", text, r.mutable_regions()));
   }
@@ -324,6 +355,15 @@ absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
 
 std::string FormatPlanSummary(const v1::PlanResponse& r) {
   const v1::PlanStats& s = r.stats();
+  std::string stc;
+  if (r.has_stc()) {
+    const v1::StcDetail& d = r.stc();
+    stc = absl::StrFormat(
+        "stc        %d coarse cells (%d partly free, %d orphan sub-cells), %d extra moves, %d sub-cells "
+        "covered twice%s\n",
+        d.coarse_cells(), d.partial_coarse_cells(), d.orphan_cells(), d.extra_moves(), d.subcells_covered_twice(),
+        d.discarded_cells() > 0 ? absl::StrFormat(", %d cells discarded", d.discarded_cells()) : "");
+  }
   return absl::StrFormat(
       "plan       %s (map %s, planner %s)\n"
       "grid       %d x %d cells of %.3f m, %d to cover, %d swept (%d unreachable, not planned)%s\n"
@@ -346,7 +386,8 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
               ? std::string()
               : absl::StrFormat("battery    %d charge cycles, energy %.1f (unconstrained %.1f, bound %.1f)\n",
                                 s.charge_cycles(), s.energy_total(), s.energy_unconstrained(),
-                                s.energy_lower_bound()));
+                                s.energy_lower_bound())) +
+         stc;
 }
 
 int RunPlanCommand(const std::vector<std::string>& args) {

@@ -142,13 +142,19 @@ TEST_F(BatteryPlans, CyclesFitStartAndEndAtTheStationAndCoverWhatThePlanCovers) 
         EXPECT_GE(plan.stats.energy_lower_bound + 1e-9, plan.stats.energy_unconstrained);
         EXPECT_EQ(Swept(plan), Swept(unconstrained->plan));
         EXPECT_EQ(plan.stats.covered_cells, unconstrained->plan.stats.covered_cells);
-        // Atomic units: every unit's coverage segments lie in one cycle.
+        // Atomic units: every unit's coverage segments lie in one cycle. A
+        // unit is a run of coverage segments with one tag in path order (an
+        // OARP rank, a boustrophedon cell, one visit of an STC tree node:
+        // STC's circumnavigation passes a node more than once).
         if (!interruptible) {
-          std::map<int, size_t> cycle_of_unit;
+          std::map<int, size_t> cycle_of_unit;  // unit number -> cycle
+          int unit = -1, last_tag = -2;
           for (size_t c = 0; c < plan.cycles.size(); ++c) {
             for (int w = plan.cycles[c].resume_waypoint + 1; w <= plan.cycles[c].leave_waypoint; ++w) {
-              if (plan.path[w].kind != SegmentKind::kCoverage || plan.path[w].rank < 0) continue;
-              auto [it, fresh] = cycle_of_unit.emplace(plan.path[w].rank, c);
+              if (plan.path[w].kind != SegmentKind::kCoverage) continue;
+              if (plan.path[w].rank < 0 || plan.path[w].rank != last_tag) ++unit;
+              last_tag = plan.path[w].rank;
+              auto [it, fresh] = cycle_of_unit.emplace(unit, c);
               EXPECT_EQ(it->second, c) << "unit " << plan.path[w].rank << " interrupted";
             }
             EXPECT_FALSE(plan.cycles[c].resumes_mid_unit);

@@ -191,5 +191,76 @@ TEST(ClientPlanTest, RegionAndNoGoFlagsTakeRingsAndGeoJsonFiles) {
   std::filesystem::remove_all(dir);
 }
 
+// `--algorithm stc` (the alias of --planner) plans the same locally and
+// through a server; bad STC options are INVALID_ARGUMENT naming the field.
+TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
+  const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
+  const std::string dir = (std::filesystem::temp_directory_path() /
+                           absl::StrCat("covplan_client_stc_", ::getpid()))
+                              .string();
+  std::filesystem::create_directories(dir);
+  ServerConfig config;
+  config.port = 0;
+  config.metrics_port = -1;
+  config.store_dir = dir + "/store";
+  absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+  ASSERT_TRUE(server.ok()) << server.status();
+  const std::string address = absl::StrCat("127.0.0.1:", (*server)->port());
+  const std::string local = dir + "/local.json", remote = dir + "/remote.json";
+  ASSERT_EQ(RunPlanCommand({"--map", map, "--local", "--algorithm", "stc", "--stc-tree", "prim",
+                            "--sweep-direction", "vertical", "--out", local}),
+            0);
+  ASSERT_EQ(RunPlanCommand({"--map", map, "--server", address, "--planner", "stc", "--stc-tree", "prim",
+                            "--sweep-direction", "vertical", "--out", remote}),
+            0);
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    v1::PlanResponse r;
+    EXPECT_TRUE(google::protobuf::util::JsonStringToMessage(ss.str(), &r).ok()) << path;
+    return r;
+  };
+  v1::PlanResponse a = read(local), b = read(remote);
+  EXPECT_EQ(a.planner(), "stc");
+  ASSERT_TRUE(a.has_stc());
+  EXPECT_EQ(a.stc().tree(), v1::STC_TREE_PRIM);
+  EXPECT_EQ(a.stats().covered_cells(), a.stats().free_cells());
+  Normalise(&a);
+  Normalise(&b);
+  a.clear_map_id();  // the server names stored maps by content too, but normalise anyway
+  b.clear_map_id();
+  EXPECT_EQ(*PlanToJson(a), *PlanToJson(b));
+
+  // Through the RPC: a bad tree value and STC options for OARP.
+  auto stub = v1::CoveragePlanner::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  absl::StatusOr<v1::Map> proto_map = MapProtoFromFile(map, MapFileOverrides(), InputLimits());
+  ASSERT_TRUE(proto_map.ok());
+  v1::PlanRequest request;
+  *request.mutable_map() = *proto_map;
+  request.mutable_robot()->set_tool_width_m(0.8);
+  request.set_planner("stc");
+  request.mutable_stc()->set_tree(static_cast<v1::StcTree>(42));
+  v1::PlanResponse reply;
+  {
+    grpc::ClientContext context;
+    const grpc::Status status = stub->Plan(&context, request, &reply);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("stc.tree"));
+  }
+  request.set_planner("oarp");
+  request.mutable_stc()->set_tree(v1::STC_TREE_PRIM);
+  {
+    grpc::ClientContext context;
+    const grpc::Status status = stub->Plan(&context, request, &reply);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  }
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--planner", "oarp", "--algorithm", "stc"}), 0);
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--stc-tree", "prim"}), 0);  // not the stc planner
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--algorithm", "stc", "--stc-tree", "bfs"}), 0);
+  server->reset();
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace covplan

@@ -11,6 +11,7 @@
 #include "planner/grid/grid.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
+#include "planner/stc/stc_planner.h"
 #include "tests/server/test_maps.h"
 
 namespace covplan {
@@ -333,6 +334,66 @@ TEST(PlanJsonTest, SnakeCaseNamesEnumNamesAndDefaultsPrinted) {
   EXPECT_THAT(*json, HasSubstr("\"planner\": \"oarp\""));
   EXPECT_THAT(*json, HasSubstr("\"sweeps\": ["));
   EXPECT_THAT(*json, ::testing::Not(HasSubstr("numRanks")));
+}
+
+// STC options reach the planner; a bad value or options for another
+// planner are INVALID_ARGUMENT naming the proto field.
+TEST(PlanRequestFromProtoTest, StcOptionsAndTheirErrors) {
+  v1::PlanRequest request = RequestWithTool(0.5);
+  request.set_planner("stc");
+  request.mutable_stc()->set_tree(v1::STC_TREE_PRIM);
+  request.mutable_stc()->set_sweep_direction(v1::STC_SWEEP_VERTICAL);
+  absl::StatusOr<PlanRequest> ok = PlanRequestFromProto(request);
+  ASSERT_TRUE(ok.ok()) << ok.status();
+  const auto* stc = dynamic_cast<const StcOptions*>(ok->options.get());
+  ASSERT_NE(stc, nullptr);
+  EXPECT_EQ(stc->tree, StcTreeMethod::kPrim);
+  EXPECT_EQ(stc->sweep_direction, SweepDirection::kVertical);
+  EXPECT_EQ(stc->partial_cells, PartialCells::kCover);
+
+  v1::PlanRequest bad = request;
+  bad.mutable_stc()->set_tree(static_cast<v1::StcTree>(7));
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.tree: unknown value 7"));
+  bad = request;
+  bad.mutable_stc()->set_sweep_direction(static_cast<v1::StcSweepDirection>(-2));
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.sweep_direction"));
+  bad = request;
+  bad.mutable_stc()->set_partial_cells(static_cast<v1::StcPartialCells>(5));
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.partial_cells"));
+  bad = request;
+  bad.mutable_stc()->set_tree(v1::STC_TREE_DFS);  // a direction without PRIM
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.sweep_direction"));
+  bad = request;
+  bad.set_planner("oarp");
+  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "planner_options"));
+}
+
+TEST(PlanProtoTest, StcDetailRoundTrips) {
+  CoveragePlan plan;
+  plan.planner = "stc";
+  plan.grid = std::make_shared<const Grid>(Grid::FromAscii({"..", ".."}));
+  auto d = std::make_shared<StcDetail>();
+  d->tree = StcTreeMethod::kPrim;
+  d->offset = {1, 0};
+  d->coarse_cells = 12;
+  d->partial_coarse_cells = 3;
+  d->extra_moves = 5;
+  d->subcells_covered_twice = 4;
+  plan.detail = d;
+  v1::PlanResponse proto;
+  PlanToProto(plan, &proto);
+  ASSERT_TRUE(proto.has_stc());
+  EXPECT_FALSE(proto.has_oarp());
+  EXPECT_EQ(proto.stc().extra_moves(), 5);
+  absl::StatusOr<CoveragePlan> back = PlanFromProto(proto);
+  ASSERT_TRUE(back.ok()) << back.status();
+  const StcDetail* e = back->detail_as<StcDetail>();
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->tree, StcTreeMethod::kPrim);
+  EXPECT_EQ(e->offset, (CellIndex{1, 0}));
+  EXPECT_EQ(e->coarse_cells, 12);
+  EXPECT_EQ(e->partial_coarse_cells, 3);
+  EXPECT_EQ(e->subcells_covered_twice, 4);
 }
 
 }  // namespace
