@@ -24,6 +24,7 @@ constexpr char kUsage[] =
     "                      [--obstacle AREA]... [--obstacle-cell ROW,COL]... [--obstacle-point X,Y]...\n"
     "                      [--method auto|ilp1|ilp2|greedy_detour|full] [--seed N]\n"
     "                      [--server HOST:PORT] [--deadline-ms D] [--out plan.json]\n"
+    "                      [--map-id ID]   (routing metadata for a map-affine router)\n"
     "Reports obstacles the robot found while driving plan P (retained by the server)\n"
     "and prints the new plan for what is left, starting at the robot. --waypoint K is\n"
     "the segment being driven (the one ending at path[K]) and --at the robot's position\n"
@@ -66,7 +67,7 @@ absl::Status AddArea(const std::string& text, v1::Obstacles* out) {
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args, {"plan-id", "waypoint", "at", "distance", "method", "seed", "server",
-                                    "deadline-ms", "out"},
+                                    "deadline-ms", "out", "map-id"},
                              {}, {"obstacle", "obstacle-cell", "obstacle-point"}));
   v1::ReplanRequest request;
   if (!a.Get("plan-id")) return absl::InvalidArgumentError("--plan-id P is required");
@@ -123,7 +124,7 @@ absl::Status Run(const std::vector<std::string>& args) {
     timeout = absl::Milliseconds(*deadline_ms);
   }
   const std::string server = a.Get("server").value_or("127.0.0.1:50051");
-  absl::StatusOr<v1::ReplanResponse> response = RemotePlanner::Connect(server)->Replan(request, timeout);
+  absl::StatusOr<v1::ReplanResponse> response = RemotePlanner::Connect(server)->Replan(request, timeout, a.Get("map-id").value_or(""));
   if (!response.ok()) {
     return absl::Status(response.status().code(),
                         absl::StrCat("server ", server, " replied ",

@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "prometheus/exposer.h"
 #include "server/log.h"
+#include "server/process_metrics.h"
 
 namespace covplan {
 
@@ -40,6 +41,8 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
           absl::StrCat("cannot serve /metrics on ", bind, " (port in use?): ", e.what()));
     }
     server->exposer_->RegisterCollectable(server->metrics_->registry());
+    server->process_metrics_ = std::make_shared<ProcessMetrics>();
+    server->exposer_->RegisterCollectable(server->process_metrics_);
     const std::vector<int> ports = server->exposer_->GetListeningPorts();
     server->metrics_port_ = ports.empty() ? config.metrics_port : ports.front();
   }

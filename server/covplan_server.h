@@ -25,6 +25,7 @@ namespace grpc {
 class Server;
 }
 namespace prometheus {
+class Collectable;
 class Exposer;
 }
 
@@ -66,6 +67,7 @@ class CovplanServer {
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<prometheus::Exposer> exposer_;
+  std::shared_ptr<prometheus::Collectable> process_metrics_;  // registered weakly
   absl::Duration drain_notice_;
   int port_ = 0;
   int metrics_port_ = -1;
