@@ -8,7 +8,7 @@ PKGS=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev libglpk-dev glpk-utils libeigen3-dev libboost-graph-dev
   libyaml-cpp-dev libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
-  prometheus-cpp-dev curl python3
+  prometheus-cpp-dev libpq-dev curl python3
 )
 # Optional tools for fuzzing / sanitizer builds (clang + libFuzzer runtime).
 OPTIONAL=(clang libclang-rt-14-dev)

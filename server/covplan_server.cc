@@ -12,15 +12,42 @@
 #include "absl/strings/str_cat.h"
 #include "prometheus/exposer.h"
 #include "server/log.h"
+#include "server/map_store.h"
+#ifdef COVPLAN_HAVE_POSTGRES
+#include "server/pg_map_store.h"
+#endif
 #include "server/process_metrics.h"
 
 namespace covplan {
+namespace {
+
+absl::StatusOr<std::unique_ptr<MapRepository>> OpenMapStore(const ServerConfig& config) {
+  if (config.map_store == "disk") {
+    absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(config.store_dir);
+    if (!store.ok()) return store.status();
+    return std::unique_ptr<MapRepository>(std::move(*store));
+  }
+  if (config.map_store == "postgres") {
+#ifdef COVPLAN_HAVE_POSTGRES
+    absl::StatusOr<std::unique_ptr<PgMapStore>> store = PgMapStore::Open(config.pg_conninfo);
+    if (!store.ok()) return store.status();
+    return std::unique_ptr<MapRepository>(std::move(*store));
+#else
+    return absl::InvalidArgumentError(
+        "--map_store=postgres: this covplan-server was built without libpq (install libpq-dev)");
+#endif
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--map_store must be disk or postgres, not \"", config.map_store, "\""));
+}
+
+}  // namespace
 
 absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const ServerConfig& config) {
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
   std::unique_ptr<CovplanServer> server(new CovplanServer());
   server->drain_notice_ = config.drain_notice;
-  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(config.store_dir);
+  absl::StatusOr<std::unique_ptr<MapRepository>> store = OpenMapStore(config);
   if (!store.ok()) return store.status();
   server->store_ = std::move(*store);
   std::vector<std::string> corrupted;

@@ -29,42 +29,43 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "covplan/v1/covplan.pb.h"
+#include "server/map_repository.h"
 
 namespace covplan {
 
-class MapStore {
+class MapStore : public MapRepository {
  public:
   // Creates `dir` if needed and indexes (and verifies) the maps in it.
   static absl::StatusOr<std::unique_ptr<MapStore>> Open(const std::string& dir);
 
   // Stores the map under info.map_id(). Returns false when an intact copy was
   // already stored (idempotent); a corrupted copy is replaced.
-  absl::StatusOr<bool> Put(const v1::MapInfo& info, const v1::Map& map);
+  absl::StatusOr<bool> Put(const v1::MapInfo& info, const v1::Map& map) override;
 
   // NotFound for an unknown id, DataLoss for a damaged file.
-  absl::StatusOr<v1::GetMapResponse> Get(const std::string& map_id) const;
+  absl::StatusOr<v1::GetMapResponse> Get(const std::string& map_id) const override;
 
   // Metadata of every intact map (sorted by id); `corrupted` (optional)
   // receives the ids of damaged files.
-  std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const;
+  std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const override;
 
   // Returns false if there was no such map.
-  absl::StatusOr<bool> Delete(const std::string& map_id);
+  absl::StatusOr<bool> Delete(const std::string& map_id) override;
 
-  int64_t size() const;
+  int64_t size() const override;
   const std::string& dir() const { return dir_; }
 
   // Small server state beside the maps (e.g. the replan estimator), written
   // atomically. `name` is [a-z_]+ with a ".txt" suffix. NotFound if absent.
-  absl::Status PutState(const std::string& name, absl::string_view contents);
-  absl::StatusOr<std::string> GetState(const std::string& name) const;
+  absl::Status PutState(const std::string& name, absl::string_view contents) override;
+  absl::StatusOr<std::string> GetState(const std::string& name) const override;
 
   // Retained plans, so a mission survives a restart: one file per plan id
   // under plans/, written atomically. `plan_id` is [a-z0-9-]{1,64}.
   // NotFound when absent. TrimPlans keeps the newest `keep` files.
-  absl::Status PutPlan(const std::string& plan_id, absl::string_view contents);
-  absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const;
-  int64_t TrimPlans(int64_t keep);
+  absl::Status PutPlan(const std::string& plan_id, absl::string_view contents) override;
+  absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const override;
+  int64_t TrimPlans(int64_t keep) override;
 
  private:
   explicit MapStore(std::string dir) : dir_(std::move(dir)) {}

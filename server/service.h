@@ -40,6 +40,7 @@
 #include "planner/engine/engine.h"
 #include "planner/replan/replanner.h"
 #include "server/artifact_lru.h"
+#include "server/map_repository.h"
 #include "server/map_store.h"
 #include "server/metrics.h"
 #include "server/plan_registry.h"
@@ -77,7 +78,7 @@ struct CallInfo {
 
 class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService {
  public:
-  CoveragePlannerService(const ServiceOptions& options, MapStore* store, ServerMetrics* metrics);
+  CoveragePlannerService(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics);
   ~CoveragePlannerService() override;
 
   grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
@@ -149,7 +150,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
                                                v1::PlanRequest* origin);
 
   const ServiceOptions options_;
-  MapStore* const store_;
+  MapRepository* const store_;
   ServerMetrics* const metrics_;
   ArtifactLru cache_;
   const PlannerRegistry registry_;
