@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# Cache locality and failover through the map-affine router, on the
+# one-machine cluster (scripts/cluster.sh). Prints one JSON line per phase
+# and a per-replica hit-rate table; docs/benchmarks.md §8 quotes a run.
+#
+#   COVPLAN_BIN=build-rel/bin bash scripts/bench_cluster.sh
+#
+# Phases (each starts every replica fresh, so caches are cold):
+#   direct    one cached map straight to replica 1 vs through the router:
+#             the router's overhead per request;
+#   affine    MAPS generated maps (Zipf skew ZIPF) through the map-affine
+#             frontend;
+#   rr        the same workload through the round-robin frontend;
+#   failover  affine again, replica 2 SIGKILLed KILL_AT s into the run and
+#             restarted RESTART_AT s in; afterwards every acknowledged map
+#             is checked in the database.
+# Environment: MAPS (24), ZIPF (0.8), DURATION (30 s), CONCURRENCY (4),
+# DEADLINE_MS (1000), TOOL (0.4 m), CACHE_MB (3 per replica: below the
+# working set of all maps, above a third of it), KILL_AT (10), RESTART_AT (20).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export COVPLAN_BIN=${COVPLAN_BIN:-$PWD/build/bin}
+export COVPLAN_CLUSTER_DIR=${COVPLAN_CLUSTER_DIR:-/tmp/covplan-cluster}
+export CLUSTER_CACHE_MB=${CACHE_MB:-3}
+BASE=${COVPLAN_CLUSTER_PORT:-56100}
+MAPS=${MAPS:-24}
+ZIPF=${ZIPF:-0.8}
+DURATION=${DURATION:-30}
+CONCURRENCY=${CONCURRENCY:-4}
+DEADLINE_MS=${DEADLINE_MS:-1000}
+TOOL=${TOOL:-0.4}
+KILL_AT=${KILL_AT:-10}
+RESTART_AT=${RESTART_AT:-20}
+MAP_DIR=$COVPLAN_CLUSTER_DIR/load-maps
+CLUSTER="bash scripts/cluster.sh"
+COVPLAN=$COVPLAN_BIN/covplan
+
+/usr/bin/python3 scripts/gen_load_maps.py --out "$MAP_DIR" --count "$MAPS" --seed 1
+$CLUSTER up >/dev/null
+
+restart_replicas() {
+  for n in 1 2 3; do $CLUSTER kill "$n" >/dev/null || true; done
+  for n in 1 2 3; do $CLUSTER start "$n" >/dev/null; done
+  sleep 1.5  # router health checks (inter 500ms, rise 2) see them up
+}
+# "hits misses" of replica N's artifact cache.
+cache_counts() {
+  curl -s "127.0.0.1:$((BASE + 10 + $1))/metrics" |
+    awk '/^covplan_artifact_cache_hits_total/ {h=$2} /^covplan_artifact_cache_misses_total/ {m=$2}
+         /^covplan_requests_total\{code="OK",method="Plan"\}/ {p=$2}
+         END {printf "%d %d %d\n", h, m, p}'
+}
+hit_table() {  # label
+  for n in 1 2 3; do
+    read -r h m p < <(cache_counts "$n")
+    awk -v l="$1" -v n="$n" -v h="$h" -v m="$m" -v p="$p" 'BEGIN {
+      printf "%-9s replica%d  plans %5d  lookups %6d  hit rate %.3f\n", l, n, p, h + m, (h + m) ? h / (h + m) : 0 }'
+  done
+}
+load() {  # server [extra...]
+  "$COVPLAN" load --server "$1" --maps "$MAP_DIR" --zipf "$ZIPF" --seed 7 \
+    --concurrency "$CONCURRENCY" --duration "$DURATION" --deadline-ms "$DEADLINE_MS" \
+    --tool-width "$TOOL" --tour greedy "${@:2}"
+}
+
+echo "== direct vs router: one cached map, concurrency 1, 10 s each"
+restart_replicas
+ONE=$MAP_DIR/site_000.yaml
+"$COVPLAN" load --server "127.0.0.1:$((BASE + 1))" --map "$ONE" --concurrency 1 --duration 2 \
+  --tool-width "$TOOL" --tour greedy >/dev/null  # warm replica 1
+printf 'direct  '; "$COVPLAN" load --server "127.0.0.1:$((BASE + 1))" --map "$ONE" --concurrency 1 \
+  --duration 10 --tool-width "$TOOL" --tour greedy
+printf 'router  '; "$COVPLAN" load --server "127.0.0.1:$BASE" --map "$ONE" --concurrency 1 \
+  --duration 10 --tool-width "$TOOL" --tour greedy
+
+echo "== affine: $MAPS maps, zipf $ZIPF, ${DURATION}s, concurrency $CONCURRENCY, cache ${CLUSTER_CACHE_MB} MiB/replica"
+restart_replicas
+printf 'affine  '; load "127.0.0.1:$BASE"
+hit_table affine
+
+echo "== round robin: the same workload"
+restart_replicas
+printf 'rr      '; load "127.0.0.1:$((BASE + 5))"
+hit_table rr
+
+echo "== failover: affine, replica2 SIGKILL at ${KILL_AT}s, restarted at ${RESTART_AT}s"
+restart_replicas
+( sleep "$KILL_AT"; $CLUSTER kill 2; sleep "$((RESTART_AT - KILL_AT))"; $CLUSTER start 2 ) &
+KILLER=$!
+printf 'failover '; load "127.0.0.1:$BASE"
+wait "$KILLER"
+hit_table failover
+echo "== after the failover: hit rate over 10 more seconds of the same load"
+declare -A before
+for n in 1 2 3; do before[$n]=$(cache_counts "$n"); done
+printf 'recovered '; DURATION=10 load "127.0.0.1:$BASE"
+for n in 1 2 3; do
+  read -r h0 m0 p0 <<<"${before[$n]}"
+  read -r h m p < <(cache_counts "$n")
+  awk -v n="$n" -v h=$((h - h0)) -v m=$((m - m0)) -v p=$((p - p0)) 'BEGIN {
+    printf "recovered replica%d  plans %5d  lookups %6d  hit rate %.3f\n", n, p, h + m, (h + m) ? h / (h + m) : 0 }'
+done
+if [ -S "$COVPLAN_CLUSTER_DIR/pg/.s.PGSQL.$((BASE + 50))" ]; then
+  AS=""; [ "$(id -u)" = 0 ] && AS="runuser -u postgres --"
+  intact=$($AS psql -h "$COVPLAN_CLUSTER_DIR/pg" -p $((BASE + 50)) -U covplan -d covplan -Atc \
+    "SELECT count(*) FROM covplan_maps WHERE encode(sha256(payload), 'hex') = sha256")
+  echo "acknowledged maps: $MAPS, intact in the database after the run: $intact"
+fi
