@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "client/gtsp_command.h"
+#include "client/health_command.h"
 #include "client/load_command.h"
 #include "client/plan_command.h"
 #include "client/replan_command.h"
@@ -28,6 +29,7 @@ constexpr char kUsage[] =
     "  load   load-test a server's Plan method; prints one JSON object\n"
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
     "  simulate  drive a plan through the true map, replanning on new obstacles; prints JSON\n"
+    "  health exit 0 when a server's gRPC health check reports SERVING\n"
     "Run 'covplan <command> --help' for its flags.\n";
 
 }  // namespace
@@ -44,6 +46,7 @@ int main(int argc, char** argv) {
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "simulate") return covplan::RunSimulateCommand(args);
+  if (command == "health") return covplan::RunHealthCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

@@ -103,6 +103,7 @@ done
 if [ -S "$COVPLAN_CLUSTER_DIR/pg/.s.PGSQL.$((BASE + 50))" ]; then
   AS=""; [ "$(id -u)" = 0 ] && AS="runuser -u postgres --"
   intact=$($AS psql -h "$COVPLAN_CLUSTER_DIR/pg" -p $((BASE + 50)) -U covplan -d covplan -Atc \
-    "SELECT count(*) FROM covplan_maps WHERE encode(sha256(payload), 'hex') = sha256")
+    "SELECT count(*) FROM covplan_maps WHERE encode(sha256(payload), 'hex') = sha256
+       AND position('$MAP_DIR/'::bytea in info) > 0")
   echo "acknowledged maps: $MAPS, intact in the database after the run: $intact"
 fi
