@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
@@ -97,6 +98,7 @@ absl::Status Run(const std::vector<std::string>& args) {
   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(server);
   // One prepared request per map.
   std::vector<v1::PlanRequest> requests;
+  std::vector<std::string> acknowledged;
   for (const std::string& file : files) {
     ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, overrides, InputLimits()));
     v1::PlanRequest request;
@@ -114,6 +116,7 @@ absl::Status Run(const std::vector<std::string>& args) {
                                          stored.status().message()));
       }
       request.set_map_id(stored->map_id());
+      acknowledged.push_back(stored->map_id());
     }
     request.mutable_robot()->set_tool_width_m(tool.value_or(0.8));
     if (limit) request.set_time_limit_s(*limit);
@@ -129,6 +132,7 @@ absl::Status Run(const std::vector<std::string>& args) {
   report.concurrency = threads;
   report.deadline_ms = deadline;
   report.maps = static_cast<int>(requests.size());
+  report.map_ids = acknowledged;
   absl::Mutex mu;
   int64_t issued = 0;  // guarded by mu
   const absl::Time start = absl::Now();
@@ -182,14 +186,17 @@ std::string LoadReport::ToJson() const {
   for (const auto& [code, count] : codes) {
     absl::StrAppend(&codes_json, codes_json.empty() ? "" : ", ", "\"", code, "\": ", count);
   }
+  std::string ids_json;
+  if (!map_ids.empty()) ids_json = absl::StrCat(", \"map_ids\": [\"", absl::StrJoin(map_ids, "\", \""), "\"]");
   return absl::StrFormat(
       "{\"requests\": %d, \"ok\": %d, \"codes\": {%s}, \"p50_ms\": %.2f, \"p95_ms\": %.2f, "
       "\"p99_ms\": %.2f, \"max_ms\": %.2f, \"late\": %d, \"cut_short\": %d, "
       "\"concurrency\": %d, \"maps\": %d, \"deadline_ms\": %d, \"duration_s\": %.2f, "
-      "\"throughput_rps\": %.2f}",
+      "\"throughput_rps\": %.2f%s}",
       requests, ok, codes_json, Percentile(sorted, 0.50), Percentile(sorted, 0.95),
       Percentile(sorted, 0.99), sorted.empty() ? 0.0 : sorted.back(), late, cut_short,
-      concurrency, maps, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0);
+      concurrency, maps, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0,
+      ids_json);
 }
 
 int RunLoadCommand(const std::vector<std::string>& args) {

@@ -29,6 +29,7 @@ struct LoadReport {
   double duration_s = 0;
   int concurrency = 0;
   int maps = 1;  // distinct maps the requests were spread over
+  std::vector<std::string> map_ids;  // acknowledged by PutMap (empty with --inline)
   int64_t deadline_ms = 0;
 
   std::string ToJson() const;  // percentiles are computed here

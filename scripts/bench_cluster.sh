@@ -87,7 +87,7 @@ echo "== failover: affine, replica2 SIGKILL at ${KILL_AT}s, restarted at ${RESTA
 restart_replicas
 ( sleep "$KILL_AT"; $CLUSTER kill 2; sleep "$((RESTART_AT - KILL_AT))"; $CLUSTER start 2 ) &
 KILLER=$!
-printf 'failover '; load "127.0.0.1:$BASE"
+printf 'failover '; load "127.0.0.1:$BASE" | tee "$COVPLAN_CLUSTER_DIR/failover.json"
 wait "$KILLER"
 hit_table failover
 echo "== after the failover: hit rate over 10 more seconds of the same load"
@@ -104,6 +104,7 @@ if [ -S "$COVPLAN_CLUSTER_DIR/pg/.s.PGSQL.$((BASE + 50))" ]; then
   AS=""; [ "$(id -u)" = 0 ] && AS="runuser -u postgres --"
   intact=$($AS psql -h "$COVPLAN_CLUSTER_DIR/pg" -p $((BASE + 50)) -U covplan -d covplan -Atc \
     "SELECT count(*) FROM covplan_maps WHERE encode(sha256(payload), 'hex') = sha256
-       AND position('$MAP_DIR/'::bytea in info) > 0")
+       AND map_id IN ($(grep -o '"map_ids": \[[^]]*\]' "$COVPLAN_CLUSTER_DIR/failover.json" |
+                        sed -e 's/"map_ids": \[//' -e 's/\]//' -e "s/\"/'/g"))")
   echo "acknowledged maps: $MAPS, intact in the database after the run: $intact"
 fi

@@ -65,6 +65,8 @@ TEST_F(LoadCommandTest, MapsListSpreadsRequestsOverEveryMap) {
   EXPECT_THAT(json, HasSubstr("\"maps\": 2,"));
   // Both maps were registered by PutMap and so built on first use.
   EXPECT_EQ(StoredMaps(), 2);
+  // The acknowledged ids are listed, in --maps order.
+  EXPECT_THAT(json, ::testing::MatchesRegex(".*\"map_ids\": \\[\"[0-9a-f]{64}\", \"[0-9a-f]{64}\"\\]}\n"));
 }
 
 TEST_F(LoadCommandTest, InlineMapsNeedNoPutMap) {
@@ -76,6 +78,7 @@ TEST_F(LoadCommandTest, InlineMapsNeedNoPutMap) {
   EXPECT_THAT(json, HasSubstr("\"requests\": 8, \"ok\": 8,"));
   EXPECT_THAT(json, HasSubstr("\"maps\": 2,"));
   EXPECT_EQ(StoredMaps(), 0);
+  EXPECT_THAT(json, ::testing::Not(HasSubstr("map_ids")));
 }
 
 TEST_F(LoadCommandTest, MapAndMapsAreExclusive) {
