@@ -12,6 +12,8 @@ PKGS=(
 )
 # Optional tools for fuzzing / sanitizer builds (clang + libFuzzer runtime).
 OPTIONAL=(clang libclang-rt-14-dev)
+# COVPLAN_MINIMAL=1 (the container's build stage): only what the build needs.
+[ "${COVPLAN_MINIMAL:-0}" = 1 ] && OPTIONAL=()
 # Optional tools for the deploy checks (tests deploy.*: promtool, haproxy -c,
 # the manifest validator's npm packages; each check skips without them).
 # Only in CI (CI=true) or when asked (COVPLAN_DEPLOY_TOOLS=1): the Debian
@@ -42,7 +44,7 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${PKGS[@]}" >/dev/null
 # Optional packages: do not fail the install if unavailable.
-$SUDO apt-get install -y -qq --no-install-recommends "${OPTIONAL[@]}" >/dev/null || \
+[ ${#OPTIONAL[@]} -eq 0 ] || $SUDO apt-get install -y -qq --no-install-recommends "${OPTIONAL[@]}" >/dev/null || \
   echo "install-deps: optional packages (${OPTIONAL[*]}) not installed; fuzz target disabled"
 [ ${#DEPLOY_TOOLS[@]} -eq 0 ] || $SUDO apt-get install -y -qq --no-install-recommends "${DEPLOY_TOOLS[@]}" >/dev/null || \
   echo "install-deps: ${DEPLOY_TOOLS[*]} not installed; the deploy.rules and deploy.router checks skip"
