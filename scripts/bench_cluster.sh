@@ -57,10 +57,12 @@ hit_table() {  # label
       printf "%-9s replica%d  plans %5d  lookups %6d  hit rate %.3f\n", l, n, p, h + m, (h + m) ? h / (h + m) : 0 }'
   done
 }
+# The load report without its map id list (kept in $COVPLAN_CLUSTER_DIR/last-load.json).
+short() { tee "$COVPLAN_CLUSTER_DIR/last-load.json" | sed 's/, "map_ids": \[[^]]*\]//'; }
 load() {  # server [extra...]
   "$COVPLAN" load --server "$1" --maps "$MAP_DIR" --zipf "$ZIPF" --seed 7 \
     --concurrency "$CONCURRENCY" --duration "$DURATION" --deadline-ms "$DEADLINE_MS" \
-    --tool-width "$TOOL" --tour greedy "${@:2}"
+    --tool-width "$TOOL" --tour greedy "${@:2}" | short
 }
 
 echo "== direct vs router: one cached map, concurrency 1, 10 s each"
@@ -69,9 +71,9 @@ ONE=$MAP_DIR/site_000.yaml
 "$COVPLAN" load --server "127.0.0.1:$((BASE + 1))" --map "$ONE" --concurrency 1 --duration 2 \
   --tool-width "$TOOL" --tour greedy >/dev/null  # warm replica 1
 printf 'direct  '; "$COVPLAN" load --server "127.0.0.1:$((BASE + 1))" --map "$ONE" --concurrency 1 \
-  --duration 10 --tool-width "$TOOL" --tour greedy
+  --duration 10 --tool-width "$TOOL" --tour greedy | short
 printf 'router  '; "$COVPLAN" load --server "127.0.0.1:$BASE" --map "$ONE" --concurrency 1 \
-  --duration 10 --tool-width "$TOOL" --tour greedy
+  --duration 10 --tool-width "$TOOL" --tour greedy | short
 
 echo "== affine: $MAPS maps, zipf $ZIPF, ${DURATION}s, concurrency $CONCURRENCY, cache ${CLUSTER_CACHE_MB} MiB/replica"
 restart_replicas
@@ -87,7 +89,8 @@ echo "== failover: affine, replica2 SIGKILL at ${KILL_AT}s, restarted at ${RESTA
 restart_replicas
 ( sleep "$KILL_AT"; $CLUSTER kill 2; sleep "$((RESTART_AT - KILL_AT))"; $CLUSTER start 2 ) &
 KILLER=$!
-printf 'failover '; load "127.0.0.1:$BASE" | tee "$COVPLAN_CLUSTER_DIR/failover.json"
+printf 'failover '; load "127.0.0.1:$BASE"
+cp "$COVPLAN_CLUSTER_DIR/last-load.json" "$COVPLAN_CLUSTER_DIR/failover.json"
 wait "$KILLER"
 hit_table failover
 echo "== after the failover: hit rate over 10 more seconds of the same load"

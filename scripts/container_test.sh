@@ -2,8 +2,9 @@
 # Builds the covplan image without a Docker daemon or registry and runs it:
 #   1. a Debian 12 base image made locally: debootstrap --variant=minbase
 #      into a directory, imported with buildah (cached as
-#      localhost/covplan-debian:bookworm, ~30 MB of packages from the Debian
-#      mirror apt already uses);
+#      localhost/covplan-debian:bookworm-slim, ~30 MB of packages from the
+#      Debian mirror apt already uses; docs, man pages and locales dropped
+#      as in debian:12-slim);
 #   2. buildah bud --isolation chroot --format docker (HEALTHCHECK is a
 #      Docker-format field) with that base for both stages;
 #   3. the server from the image, `buildah run --isolation chroot` on the
@@ -22,7 +23,7 @@ cd "$(dirname "$0")/.."
 for tool in buildah debootstrap; do
   command -v "$tool" >/dev/null || { echo "SKIPPED: $tool not installed (apt-get install buildah debootstrap)"; exit 77; }
 done
-BASE_IMAGE=${BASE_IMAGE:-localhost/covplan-debian:bookworm}
+BASE_IMAGE=${BASE_IMAGE:-localhost/covplan-debian:bookworm-slim}
 IMAGE=${IMAGE:-localhost/covplan-server:test}
 MIRROR=${MIRROR:-http://deb.debian.org/debian}
 PORT=${PORT:-56400}
@@ -46,7 +47,17 @@ if ! buildah inspect --type image "$BASE_IMAGE" >/dev/null 2>&1; then
   # apt in the image: the same suites as the host, no caches in the base.
   printf 'deb %s bookworm main\ndeb %s bookworm-updates main\ndeb http://deb.debian.org/debian-security bookworm-security main\n' \
     "$MIRROR" "$MIRROR" >"$WORK/rootfs/etc/apt/sources.list"
-  rm -rf "$WORK/rootfs/var/cache/apt/"*.bin "$WORK/rootfs/var/lib/apt/lists/"*
+  # Slim like debian:12-slim: no docs, man pages or translations, now or in
+  # packages installed later (dpkg path excludes).
+  mkdir -p "$WORK/rootfs/etc/dpkg/dpkg.cfg.d"
+  printf '%s\n' 'path-exclude /usr/share/doc/*' 'path-include /usr/share/doc/*/copyright' \
+    'path-exclude /usr/share/man/*' 'path-exclude /usr/share/info/*' \
+    'path-exclude /usr/share/locale/*' 'path-exclude /usr/share/lintian/*' \
+    >"$WORK/rootfs/etc/dpkg/dpkg.cfg.d/covplan-slim"
+  find "$WORK/rootfs/usr/share/doc" -type f ! -name copyright -delete
+  rm -rf "$WORK/rootfs/usr/share/man/"* "$WORK/rootfs/usr/share/info/"* "$WORK/rootfs/usr/share/locale/"* \
+    "$WORK/rootfs/var/cache/apt/"*.bin "$WORK/rootfs/var/cache/apt/archives/"*.deb \
+    "$WORK/rootfs/var/lib/apt/lists/"* "$WORK/rootfs/var/log/"*.log
   base=$(buildah from scratch)
   buildah copy "$base" "$WORK/rootfs" / >/dev/null
   buildah config --env PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
