@@ -2,6 +2,7 @@
 """Checks the Grafana dashboard against what covplan-server exports.
 
     /usr/bin/python3 scripts/check_dashboard.py [DASHBOARD] [--rules RULES] [--source DIR]
+        [--prometheus http://127.0.0.1:56190]
 
 Structure: a JSON object with a uid, a title, panels each with a unique id,
 a title, a gridPos and at least one target with a refId and an expr.
@@ -9,7 +10,9 @@ Metrics: every metric name in every expr is one the server exports (the
 names registered in server/*.cc, with _bucket/_sum/_count for histograms),
 a recording rule defined in the rules file, or Prometheus' own `up`.
 Also the panels cover the required topics (latency, throughput, deadline
-misses, cache hit rate, queue depth, memory). Exits 1 naming each problem.
+misses, cache hit rate, queue depth, memory). With --prometheus (a live
+one, e.g. scripts/cluster.sh's), every query is also run there and must
+return data. Exits 1 naming each problem.
 """
 
 import argparse
@@ -17,6 +20,8 @@ import json
 import os
 import re
 import sys
+import urllib.parse
+import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -77,6 +82,7 @@ def main():
     ap.add_argument("dashboard", nargs="?", default=os.path.join(ROOT, "deploy/grafana/covplan-dashboard.json"))
     ap.add_argument("--rules", default=os.path.join(ROOT, "deploy/prometheus/covplan-rules.yml"))
     ap.add_argument("--source", default=ROOT)
+    ap.add_argument("--prometheus", help="base URL of a live Prometheus to run every query on")
     args = ap.parse_args()
     problems = []
     try:
@@ -111,6 +117,15 @@ def main():
             for n in names:
                 if n not in known:
                     problems.append("%s: %r is not exported by the server nor a recording rule" % (where, n))
+            if args.prometheus and expr:
+                url = args.prometheus.rstrip("/") + "/api/v1/query?" + urllib.parse.urlencode({"query": expr})
+                try:
+                    reply = json.load(urllib.request.urlopen(url, timeout=10))
+                except (OSError, ValueError) as e:
+                    problems.append("%s: %r: query failed: %s" % (where, expr, e))
+                    continue
+                if reply.get("status") != "success" or not reply["data"]["result"]:
+                    problems.append("%s: %r returns no data on %s" % (where, expr, args.prometheus))
     for word, topic in TOPICS.items():
         if not any(word in t for t in titles):
             problems.append("no panel for %s (a title containing %r)" % (topic, word))
