@@ -21,6 +21,13 @@ case "${1:-}" in
     ;;
   dashboard)
     /usr/bin/python3 scripts/check_dashboard.py || exit 1
+    # The checker must catch a metric the server does not export.
+    tmp=$(mktemp)
+    sed 's/covplan_worker_queue_depth/covplan_worker_queue_dpth/' deploy/grafana/covplan-dashboard.json >"$tmp"
+    if /usr/bin/python3 scripts/check_dashboard.py "$tmp" >/dev/null; then
+      rm -f "$tmp"; echo "checker accepted an unknown metric"; exit 1
+    fi
+    rm -f "$tmp"
     ;;
   kubernetes)
     command -v kubectl >/dev/null || skip "kubectl (for kustomize rendering) not installed; Debian 12 ships neither kubectl nor kustomize"
@@ -33,6 +40,11 @@ case "${1:-}" in
       out=$(kubectl kustomize "$dir" 2>&1) || { echo "kustomize failed: $out"; rc=1; continue; }
       printf '%s\n' "$out" | node deploy/kubernetes/validator/validate.mjs || rc=1
     done
+    # The validator must reject what the API server would: a wrong type.
+    if printf 'apiVersion: apps/v1\nkind: Deployment\nmetadata: {name: x}\nspec: {replicas: "3", selector: {}, template: {}}\n' |
+        node deploy/kubernetes/validator/validate.mjs >/dev/null; then
+      echo "validator accepted replicas: \"3\""; rc=1
+    fi
     [ "$rc" = 0 ] || exit 1
     ;;
   router)
