@@ -87,6 +87,7 @@ hit_table rr
 
 echo "== failover: affine, replica2 SIGKILL at ${KILL_AT}s, restarted at ${RESTART_AT}s"
 restart_replicas
+T0=$(date +%s)
 ( sleep "$KILL_AT"; $CLUSTER kill 2; sleep "$((RESTART_AT - KILL_AT))"; $CLUSTER start 2 ) &
 KILLER=$!
 printf 'failover '; load "127.0.0.1:$BASE"
@@ -103,6 +104,27 @@ for n in 1 2 3; do
   awk -v n="$n" -v h=$((h - h0)) -v m=$((m - m0)) -v p=$((p - p0)) 'BEGIN {
     printf "recovered replica%d  plans %5d  lookups %6d  hit rate %.3f\n", n, p, h + m, (h + m) ? h / (h + m) : 0 }'
 done
+sleep 4  # one more scrape
+echo "== timeline from Prometheus (10 s windows, every 5 s; t from the failover run's start)"
+/usr/bin/python3 - "http://127.0.0.1:$((BASE + 90))" "$T0" "$(date +%s)" <<'PY'
+import json, sys, urllib.parse, urllib.request
+url, t0, t1 = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+def series(q):
+    args = urllib.parse.urlencode({"query": q, "start": t0, "end": t1, "step": 5})
+    data = json.load(urllib.request.urlopen(url + "/api/v1/query_range?" + args, timeout=10))
+    return {r["metric"].get("instance", "all"): {int(float(t)): float(v) for t, v in r["values"]}
+            for r in data["data"]["result"]}
+plans = series('sum by (instance) (rate(covplan_requests_total{job="covplan",method="Plan"}[10s]))')
+hits = 'sum(rate(covplan_artifact_cache_hits_total{job="covplan"}[10s]))'
+miss = 'sum(rate(covplan_artifact_cache_misses_total{job="covplan"}[10s]))'
+ratio = series("%s / (%s + %s)" % (hits, hits, miss)).get("all", {})
+instances = sorted(plans)
+print("t_s  " + "  ".join("%s plans/s" % i.split(":")[-1] for i in instances) + "  hit_ratio")
+for t in range(t0, t1 + 1, 5):
+    row = ["%4d" % (t - t0)] + ["%14.1f" % plans[i][t] if t in plans[i] else "%14s" % "-" for i in instances]
+    row.append("%9.3f" % ratio[t] if t in ratio else "%9s" % "-")
+    print("  ".join(row))
+PY
 if [ -S "$COVPLAN_CLUSTER_DIR/pg/.s.PGSQL.$((BASE + 50))" ]; then
   AS=""; [ "$(id -u)" = 0 ] && AS="runuser -u postgres --"
   intact=$($AS psql -h "$COVPLAN_CLUSTER_DIR/pg" -p $((BASE + 50)) -U covplan -d covplan -Atc \
