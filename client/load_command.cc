@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <random>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
 #include "client/args.h"
@@ -18,9 +22,33 @@ namespace covplan {
 namespace {
 
 constexpr char kUsage[] =
-    "usage: covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S]\n"
+    "usage: covplan load --server HOST:PORT (--map FILE | --maps DIR|F1,F2,...)\n"
+    "                    [--concurrency N] [--duration S] [--requests N]\n"
     "                    [--deadline-ms D] [--resolution M] [--tool-width M]\n"
-    "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n";
+    "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n"
+    "                    [--zipf S] [--seed N] [--inline]\n"
+    "--maps: every *.yaml and *.geojson in DIR (sorted), or a comma list; each\n"
+    "request picks one, map k (0-based, in that order) with weight 1/(k+1)^S\n"
+    "(--zipf 0: uniform). --inline sends the map in every request instead of\n"
+    "PutMap once and plan by id (any replica can then serve any map).\n"
+    "--requests N stops after N requests (or --duration, whichever is first).\n";
+
+// The files of --maps: a directory's *.yaml / *.geojson (sorted) or a list.
+absl::StatusOr<std::vector<std::string>> MapFiles(const std::string& spec) {
+  std::vector<std::string> files;
+  std::error_code error;
+  if (std::filesystem::is_directory(spec, error)) {
+    for (const auto& entry : std::filesystem::directory_iterator(spec, error)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext == ".yaml" || ext == ".geojson") files.push_back(entry.path().string());
+    }
+    std::sort(files.begin(), files.end());
+  } else {
+    for (absl::string_view f : absl::StrSplit(spec, ',', absl::SkipEmpty())) files.emplace_back(f);
+  }
+  if (files.empty()) return absl::InvalidArgumentError(absl::StrCat("--maps ", spec, ": no map files"));
+  return files;
+}
 
 double Percentile(std::vector<double> sorted, double q) {
   if (sorted.empty()) return 0.0;
@@ -31,11 +59,19 @@ double Percentile(std::vector<double> sorted, double q) {
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args,
-                             {"server", "map", "concurrency", "duration", "deadline-ms",
-                              "resolution", "tool-width", "time-limit", "tour", "backoff-ms"},
-                             {}));
+                             {"server", "map", "maps", "concurrency", "duration", "deadline-ms",
+                              "resolution", "tool-width", "time-limit", "tour", "backoff-ms",
+                              "zipf", "seed", "requests"},
+                             {"inline"}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
-  if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
+  if (!a.Get("map") == !a.Get("maps")) {
+    return absl::InvalidArgumentError("exactly one of --map FILE or --maps DIR|LIST is required");
+  }
+  ASSIGN_OR_RETURN(std::optional<double> zipf, a.GetDouble("zipf"));
+  ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
+  ASSIGN_OR_RETURN(std::optional<int64_t> max_requests, a.GetInt("requests"));
+  if (zipf && !(*zipf >= 0 && *zipf <= 10)) return absl::InvalidArgumentError("--zipf must be in [0, 10]");
+  if (max_requests && *max_requests <= 0) return absl::InvalidArgumentError("--requests must be positive");
   ASSIGN_OR_RETURN(std::optional<int64_t> concurrency, a.GetInt("concurrency"));
   ASSIGN_OR_RETURN(std::optional<double> duration, a.GetDouble("duration"));
   ASSIGN_OR_RETURN(std::optional<int64_t> deadline_ms, a.GetInt("deadline-ms"));
@@ -52,34 +88,67 @@ absl::Status Run(const std::vector<std::string>& args) {
   if (deadline <= 0) return absl::InvalidArgumentError("--deadline-ms must be positive");
 
   const std::string server = *a.Get("server");
-  ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(*a.Get("map"), overrides, InputLimits()));
-  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(server);
-  v1::PutMapRequest put;
-  *put.mutable_map() = map;
-  put.set_name(*a.Get("map"));
-  absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
-  if (!stored.ok()) {
-    return absl::Status(stored.status().code(),
-                        absl::StrCat("PutMap to ", server, " failed: ",
-                                     absl::StatusCodeToString(stored.status().code()), ": ",
-                                     stored.status().message()));
+  std::vector<std::string> files;
+  if (a.Get("map")) {
+    files.push_back(*a.Get("map"));
+  } else {
+    ASSIGN_OR_RETURN(files, MapFiles(*a.Get("maps")));
   }
-  v1::PlanRequest request;
-  request.set_map_id(stored->map_id());
-  request.mutable_robot()->set_tool_width_m(tool.value_or(0.8));
-  if (limit) request.set_time_limit_s(*limit);
-  if (auto t = a.Get("tour")) request.set_tour_solver(*t == "greedy" ? v1::GREEDY : v1::GTSP);
+  const bool send_inline = a.Has("inline");
+  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(server);
+  // One prepared request per map.
+  std::vector<v1::PlanRequest> requests;
+  std::vector<std::string> acknowledged;
+  for (const std::string& file : files) {
+    ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, overrides, InputLimits()));
+    v1::PlanRequest request;
+    if (send_inline) {
+      *request.mutable_map() = std::move(map);
+    } else {
+      v1::PutMapRequest put;
+      *put.mutable_map() = std::move(map);
+      put.set_name(file);
+      absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
+      if (!stored.ok()) {
+        return absl::Status(stored.status().code(),
+                            absl::StrCat("PutMap of ", file, " to ", server, " failed: ",
+                                         absl::StatusCodeToString(stored.status().code()), ": ",
+                                         stored.status().message()));
+      }
+      request.set_map_id(stored->map_id());
+      acknowledged.push_back(stored->map_id());
+    }
+    request.mutable_robot()->set_tool_width_m(tool.value_or(0.8));
+    if (limit) request.set_time_limit_s(*limit);
+    if (auto t = a.Get("tour")) request.set_tour_solver(*t == "greedy" ? v1::GREEDY : v1::GTSP);
+    requests.push_back(std::move(request));
+  }
+  std::vector<double> weights;
+  for (size_t k = 0; k < requests.size(); ++k) {
+    weights.push_back(1.0 / std::pow(static_cast<double>(k + 1), zipf.value_or(0.0)));
+  }
 
   LoadReport report;
   report.concurrency = threads;
   report.deadline_ms = deadline;
+  report.maps = static_cast<int>(requests.size());
+  report.map_ids = acknowledged;
   absl::Mutex mu;
+  int64_t issued = 0;  // guarded by mu
   const absl::Time start = absl::Now();
   const absl::Time end = start + absl::Seconds(seconds);
   std::vector<std::thread> workers;
   for (int t = 0; t < threads; ++t) {
-    workers.emplace_back([&] {
+    workers.emplace_back([&, t] {
+      std::mt19937_64 rng(static_cast<uint64_t>(seed.value_or(1)) * 1000003u + t);
+      std::discrete_distribution<size_t> pick(weights.begin(), weights.end());
       while (absl::Now() < end) {
+        if (max_requests) {
+          absl::MutexLock lock(&mu);
+          if (issued >= *max_requests) break;
+          ++issued;
+        }
+        const v1::PlanRequest& request = requests[pick(rng)];
         const absl::Time sent = absl::Now();
         absl::StatusOr<v1::PlanResponse> reply = remote->Plan(request, absl::Milliseconds(deadline));
         const double ms = absl::ToDoubleMilliseconds(absl::Now() - sent);
@@ -117,13 +186,17 @@ std::string LoadReport::ToJson() const {
   for (const auto& [code, count] : codes) {
     absl::StrAppend(&codes_json, codes_json.empty() ? "" : ", ", "\"", code, "\": ", count);
   }
+  std::string ids_json;
+  if (!map_ids.empty()) ids_json = absl::StrCat(", \"map_ids\": [\"", absl::StrJoin(map_ids, "\", \""), "\"]");
   return absl::StrFormat(
       "{\"requests\": %d, \"ok\": %d, \"codes\": {%s}, \"p50_ms\": %.2f, \"p95_ms\": %.2f, "
       "\"p99_ms\": %.2f, \"max_ms\": %.2f, \"late\": %d, \"cut_short\": %d, "
-      "\"concurrency\": %d, \"deadline_ms\": %d, \"duration_s\": %.2f, \"throughput_rps\": %.2f}",
+      "\"concurrency\": %d, \"maps\": %d, \"deadline_ms\": %d, \"duration_s\": %.2f, "
+      "\"throughput_rps\": %.2f%s}",
       requests, ok, codes_json, Percentile(sorted, 0.50), Percentile(sorted, 0.95),
       Percentile(sorted, 0.99), sorted.empty() ? 0.0 : sorted.back(), late, cut_short,
-      concurrency, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0);
+      concurrency, maps, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0,
+      ids_json);
 }
 
 int RunLoadCommand(const std::vector<std::string>& args) {

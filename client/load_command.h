@@ -4,6 +4,7 @@
 //
 //   covplan load --server 127.0.0.1:50051 --map maps/sample_office.yaml
 //       --concurrency 4 --duration 10 --deadline-ms 500
+//   covplan load --server 127.0.0.1:8080 --maps /tmp/load-maps --zipf 1 --inline
 //
 // Thread-safety: not applicable (command entry point).
 #ifndef COVPLAN_CLIENT_LOAD_COMMAND_H_
@@ -27,6 +28,8 @@ struct LoadReport {
   std::vector<double> latencies_ms;      // every reply
   double duration_s = 0;
   int concurrency = 0;
+  int maps = 1;  // distinct maps the requests were spread over
+  std::vector<std::string> map_ids;  // acknowledged by PutMap (empty with --inline)
   int64_t deadline_ms = 0;
 
   std::string ToJson() const;  // percentiles are computed here

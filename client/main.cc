@@ -16,6 +16,7 @@
 
 #include "client/compare_command.h"
 #include "client/gtsp_command.h"
+#include "client/health_command.h"
 #include "client/load_command.h"
 #include "client/plan_command.h"
 #include "client/replan_command.h"
@@ -34,6 +35,7 @@ constexpr char kUsage[] =
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
     "  simulate  drive a plan through the true map, replanning on new obstacles; prints JSON\n"
     "  compare   plan one map with several planners and print one table (and JSON)\n"
+    "  health exit 0 when a server's gRPC health check reports SERVING\n"
     "Run 'covplan <command> --help' for its flags.\n";
 
 }  // namespace
@@ -52,6 +54,7 @@ int main(int argc, char** argv) {
   if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "simulate") return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
   if (command == "compare") return covplan::RunCompareCommand(args);
+  if (command == "health") return covplan::RunHealthCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

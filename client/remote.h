@@ -1,6 +1,8 @@
 // A small synchronous client of covplan.v1.CoveragePlanner, the only client
 // unit that includes gRPC headers (each costs seconds to compile).
 // gRPC errors come back as absl::Status with the same code and message.
+// Every call carries the map it is about as `x-covplan-map-id` metadata (an
+// inline map: its content hash), the key a map-affine router hashes on.
 //
 //   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect("127.0.0.1:50051");
 //   ASSIGN_OR_RETURN(v1::PutMapResponse put, remote->PutMap(request, absl::Seconds(30)));
@@ -30,8 +32,10 @@ class RemotePlanner {
   // No timeout: the call has no deadline (the server's default budget applies).
   absl::StatusOr<v1::PlanResponse> Plan(const v1::PlanRequest& request,
                                         std::optional<absl::Duration> timeout);
+  // `map_id` (optional) is sent as routing metadata for a replan by plan_id.
   absl::StatusOr<v1::ReplanResponse> Replan(const v1::ReplanRequest& request,
-                                            std::optional<absl::Duration> timeout);
+                                            std::optional<absl::Duration> timeout,
+                                            const std::string& map_id = "");
   absl::StatusOr<v1::ReplanResponse> Resume(const v1::ResumeRequest& request,
                                             std::optional<absl::Duration> timeout);
 

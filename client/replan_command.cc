@@ -24,6 +24,7 @@ constexpr char kUsage[] =
     "                      [--obstacle AREA]... [--obstacle-cell ROW,COL]... [--obstacle-point X,Y]...\n"
     "                      [--method auto|ilp1|ilp2|greedy_detour|full] [--seed N]\n"
     "                      [--server HOST:PORT] [--deadline-ms D] [--out plan.json]\n"
+    "                      [--map-id ID]   (routing metadata for a map-affine router)\n"
     "Reports obstacles the robot found while driving plan P (retained by the server)\n"
     "and prints the new plan for what is left, starting at the robot. --waypoint K is\n"
     "the segment being driven (the one ending at path[K]) and --at the robot's position\n"
@@ -126,7 +127,7 @@ absl::Status WriteReply(const ParsedArgs& a, const std::string& server,
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args, {"plan-id", "waypoint", "at", "distance", "method", "seed", "server",
-                                    "deadline-ms", "out"},
+                                    "deadline-ms", "out", "map-id"},
                              {}, {"obstacle", "obstacle-cell", "obstacle-point"}));
   v1::ReplanRequest request;
   if (!a.Get("plan-id")) return absl::InvalidArgumentError("--plan-id P is required");
@@ -153,7 +154,8 @@ absl::Status Run(const std::vector<std::string>& args) {
   if (seed) request.set_seed(static_cast<uint32_t>(*seed));
   ASSIGN_OR_RETURN(std::optional<absl::Duration> timeout, ParseDeadlineFlag(a));
   const std::string server = a.Get("server").value_or("127.0.0.1:50051");
-  return WriteReply(a, server, RemotePlanner::Connect(server)->Replan(request, timeout));
+  return WriteReply(a, server,
+                    RemotePlanner::Connect(server)->Replan(request, timeout, a.Get("map-id").value_or("")));
 }
 
 constexpr char kResumeUsage[] =

@@ -8,14 +8,30 @@ PKGS=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev libglpk-dev glpk-utils libeigen3-dev libboost-graph-dev
   libyaml-cpp-dev libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
-  prometheus-cpp-dev curl python3
+  prometheus-cpp-dev libpq-dev curl python3
   openssl  # test certificates for server_tls_test
 )
 # Optional tools for fuzzing / sanitizer builds (clang + libFuzzer runtime).
 OPTIONAL=(clang libclang-rt-14-dev)
+# COVPLAN_MINIMAL=1 (the container's build stage): only what the build needs.
+[ "${COVPLAN_MINIMAL:-0}" = 1 ] && OPTIONAL=()
+# Optional tools for the deploy checks (tests deploy.*: promtool, haproxy -c,
+# the manifest validator's npm packages; each check skips without them).
+# Only in CI (CI=true) or when asked (COVPLAN_DEPLOY_TOOLS=1): the Debian
+# prometheus package starts a daemon where systemd runs, which the README's
+# first command must not do.
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+DEPLOY_TOOLS=()
+if [ "${CI:-}" = true ] || [ "${COVPLAN_DEPLOY_TOOLS:-0}" = 1 ]; then
+  DEPLOY_TOOLS=(prometheus haproxy)
+  if command -v npm >/dev/null && [ ! -d "$ROOT/deploy/kubernetes/validator/node_modules" ]; then
+    (cd "$ROOT/deploy/kubernetes/validator" && npm ci --no-audit --no-fund --silent) ||
+      echo "install-deps: npm ci in deploy/kubernetes/validator failed; deploy.kubernetes will skip"
+  fi
+fi
 
 missing=()
-for p in "${PKGS[@]}" "${OPTIONAL[@]}"; do
+for p in "${PKGS[@]}" "${OPTIONAL[@]}" "${DEPLOY_TOOLS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then
@@ -29,6 +45,8 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${PKGS[@]}" >/dev/null
 # Optional packages: do not fail the install if unavailable.
-$SUDO apt-get install -y -qq --no-install-recommends "${OPTIONAL[@]}" >/dev/null || \
+[ ${#OPTIONAL[@]} -eq 0 ] || $SUDO apt-get install -y -qq --no-install-recommends "${OPTIONAL[@]}" >/dev/null || \
   echo "install-deps: optional packages (${OPTIONAL[*]}) not installed; fuzz target disabled"
+[ ${#DEPLOY_TOOLS[@]} -eq 0 ] || $SUDO apt-get install -y -qq --no-install-recommends "${DEPLOY_TOOLS[@]}" >/dev/null || \
+  echo "install-deps: ${DEPLOY_TOOLS[*]} not installed; the deploy.rules and deploy.router checks skip"
 echo "install-deps: done"

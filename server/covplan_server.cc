@@ -15,6 +15,11 @@
 #include "prometheus/exposer.h"
 #include "server/log.h"
 #include "server/malformed_request_interceptor.h"
+#include "server/map_store.h"
+#ifdef COVPLAN_HAVE_POSTGRES
+#include "server/pg_map_store.h"
+#endif
+#include "server/process_metrics.h"
 
 namespace covplan {
 namespace {
@@ -62,14 +67,34 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(const Se
   return grpc::SslServerCredentials(options);
 }
 
+absl::StatusOr<std::unique_ptr<MapRepository>> OpenMapStore(const ServerConfig& config) {
+  if (config.map_store == "disk") {
+    absl::StatusOr<std::unique_ptr<MapStore>> store =
+        MapStore::OpenLocked(config.store_dir, /*index=*/!config.index_in_background);
+    if (!store.ok()) return store.status();
+    return std::unique_ptr<MapRepository>(std::move(*store));
+  }
+  if (config.map_store == "postgres") {
+#ifdef COVPLAN_HAVE_POSTGRES
+    absl::StatusOr<std::unique_ptr<PgMapStore>> store = PgMapStore::Open(config.pg_conninfo);
+    if (!store.ok()) return store.status();
+    return std::unique_ptr<MapRepository>(std::move(*store));
+#else
+    return absl::InvalidArgumentError(
+        "--map_store=postgres: this covplan-server was built without libpq (install libpq-dev)");
+#endif
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--map_store must be disk or postgres, not \"", config.map_store, "\""));
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const ServerConfig& config) {
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
   std::unique_ptr<CovplanServer> server(new CovplanServer());
   server->drain_notice_ = config.drain_notice;
-  absl::StatusOr<std::unique_ptr<MapStore>> store =
-      MapStore::OpenLocked(config.store_dir, /*index=*/!config.index_in_background);
+  absl::StatusOr<std::unique_ptr<MapRepository>> store = OpenMapStore(config);
   if (!store.ok()) return store.status();
   server->store_ = std::move(*store);
   if (!config.index_in_background) server->LogIndexed(absl::ZeroDuration());
@@ -86,6 +111,8 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
           absl::StrCat("cannot serve /metrics on ", bind, " (port in use?): ", e.what()));
     }
     server->exposer_->RegisterCollectable(server->metrics_->registry());
+    server->process_metrics_ = std::make_shared<ProcessMetrics>();
+    server->exposer_->RegisterCollectable(server->process_metrics_);
     const std::vector<int> ports = server->exposer_->GetListeningPorts();
     server->metrics_port_ = ports.empty() ? config.metrics_port : ports.front();
   }

@@ -27,6 +27,7 @@ namespace grpc {
 class Server;
 }
 namespace prometheus {
+class Collectable;
 class Exposer;
 }
 
@@ -38,6 +39,10 @@ struct ServerConfig {
   std::string metrics_address = "127.0.0.1";
   int metrics_port = 9464;           // 0: pick a free port; -1: no metrics endpoint
   std::string store_dir = "./covplan-data/maps";
+  // "disk" (the embedded store in store_dir, default) or "postgres" (shared
+  // by replicas; pg_conninfo is a libpq connection string).
+  std::string map_store = "disk";
+  std::string pg_conninfo;
   int max_message_bytes = 80 << 20;  // largest request accepted
   // On Drain, how long health reports NOT_SERVING (and new work is refused)
   // before the listener closes, so load balancers see it.
@@ -87,11 +92,12 @@ class CovplanServer {
   // Probes the store every `interval` until Drain.
   void ProbeStoreLoop(absl::Duration interval);
 
-  std::unique_ptr<MapStore> store_;
+  std::unique_ptr<MapRepository> store_;
   std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<prometheus::Exposer> exposer_;
+  std::shared_ptr<prometheus::Collectable> process_metrics_;  // registered weakly
   absl::Duration drain_notice_;
   int port_ = 0;
   int metrics_port_ = -1;

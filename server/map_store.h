@@ -34,10 +34,11 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "covplan/v1/covplan.pb.h"
+#include "server/map_repository.h"
 
 namespace covplan {
 
-class MapStore {
+class MapStore : public MapRepository {
  public:
   // Creates `dir` if needed, locks it and indexes (and verifies) the maps in
   // it. FailedPrecondition if another process holds the lock.
@@ -47,8 +48,8 @@ class MapStore {
   // has run, the map methods return Unavailable.
   static absl::StatusOr<std::unique_ptr<MapStore>> OpenLocked(const std::string& dir, bool index);
   // Reads and verifies every map file; `stop` (optional) ends it early.
-  absl::Status LoadIndex(const std::atomic<bool>* stop);
-  bool loading() const;
+  absl::Status LoadIndex(const std::atomic<bool>* stop) override;
+  bool loading() const override;
   ~MapStore();
   MapStore(const MapStore&) = delete;
   MapStore& operator=(const MapStore&) = delete;
@@ -56,51 +57,51 @@ class MapStore {
   // Stores the map under info.map_id(). Returns false when an intact copy was
   // already stored (idempotent); a corrupted or missing copy is replaced,
   // even one that was intact when indexed.
-  absl::StatusOr<bool> Put(const v1::MapInfo& info, const v1::Map& map);
+  absl::StatusOr<bool> Put(const v1::MapInfo& info, const v1::Map& map) override;
 
   // NotFound for an unknown id, DataLoss for a damaged file.
-  absl::StatusOr<v1::GetMapResponse> Get(const std::string& map_id) const;
+  absl::StatusOr<v1::GetMapResponse> Get(const std::string& map_id) const override;
 
   // Metadata of every intact map (sorted by id); `corrupted` (optional)
   // receives the ids of damaged files.
-  std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const;
+  std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const override;
   // At most `limit` maps with ids after `after` ("" = from the start);
   // `more` says whether any follow.
   absl::StatusOr<std::vector<v1::MapInfo>> ListPage(const std::string& after, int limit, bool* more,
-                                                    std::vector<std::string>* corrupted) const;
+                                                    std::vector<std::string>* corrupted) const override;
 
   // Returns false if there was no such map. The map stays indexed when the
   // file cannot be removed.
-  absl::StatusOr<bool> Delete(const std::string& map_id);
+  absl::StatusOr<bool> Delete(const std::string& map_id) override;
 
   // From the in-memory index only (no disk access): OK if the map is
   // indexed and not known to be damaged, else NotFound / DataLoss.
-  absl::Status Check(const std::string& map_id) const;
+  absl::Status Check(const std::string& map_id) const override;
 
   // Writes and renames a small probe file; updates writable().
-  absl::Status ProbeWritable();
+  absl::Status ProbeWritable() override;
   // False after a write failed for lack of space or permission, until one
   // succeeds again.
-  bool writable() const { return writable_.load(); }
+  bool writable() const override { return writable_.load(); }
 
-  int64_t size() const;
+  int64_t size() const override;
   const std::string& dir() const { return dir_; }
 
   // Small server state beside the maps (e.g. the replan estimator), written
   // atomically. `name` is [a-z_]+ with a ".txt" suffix. NotFound if absent.
-  absl::Status PutState(const std::string& name, absl::string_view contents);
-  absl::StatusOr<std::string> GetState(const std::string& name) const;
+  absl::Status PutState(const std::string& name, absl::string_view contents) override;
+  absl::StatusOr<std::string> GetState(const std::string& name) const override;
 
   // Retained plans, so a mission survives a restart: one file per plan id
   // under plans/, written atomically. `plan_id` is [a-z0-9-]{1,64}.
   // NotFound when absent. TrimPlans keeps the newest `keep` files.
-  absl::Status PutPlan(const std::string& plan_id, absl::string_view contents);
-  absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const;
-  int64_t TrimPlans(int64_t keep);
+  absl::Status PutPlan(const std::string& plan_id, absl::string_view contents) override;
+  absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const override;
+  int64_t TrimPlans(int64_t keep) override;
   // The robot's last reported progress on a plan (plans/<plan_id>.progress),
   // written atomically; NotFound when none was recorded.
-  absl::Status PutProgress(const std::string& plan_id, absl::string_view contents);
-  absl::StatusOr<std::string> GetProgress(const std::string& plan_id) const;
+  absl::Status PutProgress(const std::string& plan_id, absl::string_view contents) override;
+  absl::StatusOr<std::string> GetProgress(const std::string& plan_id) const override;
 
  private:
   explicit MapStore(std::string dir) : dir_(std::move(dir)) {}

@@ -36,6 +36,10 @@ ABSL_FLAG(int, port, 50051, "gRPC port (0 picks a free one)");
 ABSL_FLAG(std::string, metrics_address, "127.0.0.1", "Address of the /metrics endpoint");
 ABSL_FLAG(int, metrics_port, 9464, "Prometheus /metrics port (0 picks, -1 disables)");
 ABSL_FLAG(std::string, store_dir, "./covplan-data/maps", "Directory of the map registry");
+ABSL_FLAG(std::string, map_store, "disk",
+          "Map registry: disk (embedded, in --store_dir) or postgres (shared by replicas)");
+ABSL_FLAG(std::string, pg_conninfo, "",
+          "With --map_store=postgres: libpq connection string, e.g. \"host=/run/pg dbname=covplan\"");
 ABSL_FLAG(int, threads, 2, "Worker threads for planning");
 ABSL_FLAG(int, max_queue, 16, "Requests that may wait for a worker; beyond: RESOURCE_EXHAUSTED");
 ABSL_FLAG(int64_t, cache_mb, 256, "Per-map artifact cache budget in MiB (grids, coverage areas, partitions, transitions)");
@@ -165,6 +169,8 @@ int main(int argc, char** argv) {
   config.metrics_address = absl::GetFlag(FLAGS_metrics_address);
   config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
   config.store_dir = absl::GetFlag(FLAGS_store_dir);
+  config.map_store = absl::GetFlag(FLAGS_map_store);
+  config.pg_conninfo = absl::GetFlag(FLAGS_pg_conninfo);
   config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
   config.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
   config.tls_key_file = absl::GetFlag(FLAGS_tls_key);

@@ -121,7 +121,7 @@ absl::Status ServiceOptions::Validate() const {
   return absl::OkStatus();
 }
 
-CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, MapStore* store,
+CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, MapRepository* store,
                                                ServerMetrics* metrics)
     : options_(options),
       store_(store),

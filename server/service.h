@@ -46,6 +46,7 @@
 #include "planner/replan/replanner.h"
 #include "server/artifact_lru.h"
 #include "server/drive_session.h"
+#include "server/map_repository.h"
 #include "server/map_store.h"
 #include "server/metrics.h"
 #include "server/plan_registry.h"
@@ -90,7 +91,7 @@ std::string ReplanDetail(const v1::ReplanResponse& response);
 
 class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService {
  public:
-  CoveragePlannerService(const ServiceOptions& options, MapStore* store, ServerMetrics* metrics);
+  CoveragePlannerService(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics);
   ~CoveragePlannerService() override;
 
   grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
@@ -218,7 +219,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   void FlushProgress();
 
   const ServiceOptions options_;
-  MapStore* const store_;
+  MapRepository* const store_;
   ServerMetrics* const metrics_;
   ArtifactLru cache_;
   const PlannerRegistry registry_;

@@ -1,0 +1,91 @@
+// `covplan load --maps`: the requests spread over every map of the list, by
+// id (PutMap once) or inline, against an in-process server; each distinct
+// map is built once, so the cache sees exactly one miss set per map.
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "client/load_command.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/covplan_server.h"
+
+namespace covplan {
+namespace {
+
+using ::testing::HasSubstr;
+
+class LoadCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    store_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_load_", ::getpid()))
+                 .string();
+    ServerConfig config;
+    config.port = 0;
+    config.metrics_port = -1;
+    config.store_dir = store_;
+    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = std::move(*server);
+  }
+  void TearDown() override {
+    server_.reset();
+    std::filesystem::remove_all(store_);
+  }
+
+  std::string Run(std::vector<std::string> extra, int* exit_code) {
+    std::vector<std::string> args = {"--server", absl::StrCat("127.0.0.1:", server_->port()),
+                                     "--concurrency", "2", "--duration", "60", "--requests",
+                                     "8", "--deadline-ms", "20000", "--tour", "greedy"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    ::testing::internal::CaptureStdout();
+    *exit_code = RunLoadCommand(args);
+    return ::testing::internal::GetCapturedStdout();
+  }
+
+  int StoredMaps() const {
+    int n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(store_)) n += e.path().extension() == ".map";
+    return n;
+  }
+
+  std::string store_;
+  std::unique_ptr<CovplanServer> server_;
+};
+
+TEST_F(LoadCommandTest, MapsListSpreadsRequestsOverEveryMap) {
+  const std::string list = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml,",
+                                        COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
+  int code = -1;
+  const std::string json = Run({"--maps", list, "--seed", "5"}, &code);
+  EXPECT_EQ(code, 0);
+  EXPECT_THAT(json, HasSubstr("\"requests\": 8, \"ok\": 8,"));
+  EXPECT_THAT(json, HasSubstr("\"maps\": 2,"));
+  // Both maps were registered by PutMap and so built on first use.
+  EXPECT_EQ(StoredMaps(), 2);
+  // The acknowledged ids are listed, in --maps order.
+  EXPECT_THAT(json, ::testing::MatchesRegex(".*\"map_ids\": \\[\"[0-9a-f]{64}\", \"[0-9a-f]{64}\"\\]}\n"));
+}
+
+TEST_F(LoadCommandTest, InlineMapsNeedNoPutMap) {
+  int code = -1;
+  const std::string list = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml,",
+                                        COVPLAN_SOURCE_DIR, "/maps/sample_yard.geojson");
+  const std::string json = Run({"--maps", list, "--inline", "--zipf", "1"}, &code);
+  EXPECT_EQ(code, 0);
+  EXPECT_THAT(json, HasSubstr("\"requests\": 8, \"ok\": 8,"));
+  EXPECT_THAT(json, HasSubstr("\"maps\": 2,"));
+  EXPECT_EQ(StoredMaps(), 0);
+  EXPECT_THAT(json, ::testing::Not(HasSubstr("map_ids")));
+}
+
+TEST_F(LoadCommandTest, MapAndMapsAreExclusive) {
+  int code = -1;
+  Run({"--map", "a.yaml", "--maps", "b.yaml"}, &code);
+  EXPECT_NE(code, 0);
+}
+
+}  // namespace
+}  // namespace covplan
