@@ -329,6 +329,41 @@ TEST(Replan, ACellThatAnOldSegmentOnlyClipsIsAvoided) {
   }
 }
 
+// Resume: from a dock back to where the robot stopped, around furniture it
+// found since, then on over the rest; the whole plan passes the conformance
+// checks, and the mission's account adds up.
+TEST(Resume, DrivesBackToTheStopPointAndCoversTheRest) {
+  Mission m = Office();
+  const RobotProgress stopped = Early(m.plan.plan);
+  const Waypoint& start = m.plan.plan.path.front();
+  const Pose2 dock{start.x, start.y, 0.3};
+  ReplanOptions o;
+  o.stop = StopToken::WithTimeout(absl::Seconds(30));
+  ReplanEstimator estimator;
+  double rejoin_m = -1.0;
+  absl::StatusOr<ReplanResult> r = Resume(m.plan, stopped, dock, m.furniture, o, &estimator, &rejoin_m);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(testing::CheckPlanConformance(r->plan, *r->area, m.plan.request.common.robot), "");
+  EXPECT_EQ(testing::CheckPathStaysFree(*r->area->drive, r->plan.path), "");
+  EXPECT_NEAR(r->plan.path.front().x, dock.x, 1e-12);
+  EXPECT_NEAR(r->plan.path.front().y, dock.y, 1e-12);
+  EXPECT_GT(rejoin_m, 0.0);
+  // The drive back ends where the robot stopped: some waypoint is there.
+  bool passes_stop = false;
+  for (const Waypoint& w : r->plan.path) {
+    passes_stop |= std::hypot(w.x - stopped.position->x, w.y - stopped.position->y) < 1e-9;
+  }
+  EXPECT_TRUE(passes_stop);
+  EXPECT_EQ(r->plan.stats.covered_cells, r->stats.remaining_cells);
+  EXPECT_EQ(r->plan.stats.mission_covered_cells + r->stats.remaining_cells + r->plan.stats.mission_cut_off_cells +
+                r->plan.stats.mission_obstructed_cells,
+            m.plan.plan.stats.free_cells);
+  // A pose off the grid names the pose.
+  absl::StatusOr<ReplanResult> off = Resume(m.plan, stopped, Pose2{-50, -50, 0}, {}, o, &estimator);
+  EXPECT_EQ(off.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(off.status().message()), ::testing::HasSubstr("pose"));
+}
+
 TEST(Estimator, LearnsFromSolvesAndPersists) {
   ReplanEstimator e;
   const int64_t prior = e.Budget(0.5);
