@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Battery-constrained tours on every plain building of ../shared/data/maps/ipa
-# (0.05 m/px, tool 0.8 m, IPA colour rule free_thresh 0.021), for OARP and
-# boustrophedon plans, two battery capacities, energy = distance (m), reserve
+# (0.05 m/px, tool 0.8 m, IPA colour rule free_thresh 0.021), for OARP,
+# boustrophedon and STC plans (PLANNERS="oarp boustrophedon stc"), two battery capacities, energy = distance (m), reserve
 # 5 % of the capacity.
 # Prints first the unconstrained plans (turns, path length, estimated
 # duration, covered free-area ratio, planning time), then per map, planner
@@ -25,6 +25,7 @@ BUILD_DIR=${BUILD_DIR:-build-h}
 CLI="$BUILD_DIR/bin/covplan"
 [ -x "$CLI" ] || { echo "bench_battery: build $CLI first (ninja -C $BUILD_DIR covplan)" >&2; exit 2; }
 CAPS=("${1:-400}" "${2:-200}")
+read -r -a PLANNER_LIST <<< "${PLANNERS:-oarp boustrophedon stc}"
 PY=/usr/bin/python3
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
@@ -37,7 +38,7 @@ done
 printf '| map | planner | turns | length m | duration s | covered | planning ms |\n|---|---|---:|---:|---:|---:|---:|\n'
 for f in "${maps[@]}"; do
   name=$(basename "$f" .png)
-  for planner in oarp boustrophedon; do
+  for planner in "${PLANNER_LIST[@]}"; do
     "$CLI" plan --map "$f" "${common[@]}" --planner "$planner" --out "$TMP/$name.$planner.json" >/dev/null 2>&1 || continue
     $PY - "$TMP/$name.$planner.json" "$name" "$planner" <<'PYEOF'
 import json, sys
@@ -52,7 +53,7 @@ echo
 printf '| map | planner | station | capacity | cycles | energy | unconstrained | lower bound | gap |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n'
 for f in "${maps[@]}"; do
   name=$(basename "$f" .png)
-  for planner in oarp boustrophedon; do
+  for planner in "${PLANNER_LIST[@]}"; do
     extra=()
     [ "$planner" = boustrophedon ] && extra=(--interruptible)
     plain="$TMP/$name.$planner.json"
