@@ -1,5 +1,6 @@
 #include "planner/energy/charge_cycles.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -238,14 +239,23 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
   st.charge_cycles = static_cast<int64_t>(out.cycles.size());
   st.energy_total = split->total;
   st.energy_unconstrained = CycleEnergy(sp, 0, n - 1);
-  // A charge after piece k replaces link[k] by back[k] + out[k + 1].
-  double cheapest_visit = std::numeric_limits<double>::infinity();
-  for (int k = 0; k + 1 < n; ++k) {
-    cheapest_visit = std::min(cheapest_visit, sp.back[k] + sp.out[k + 1] - sp.link[k]);
-  }
-  const double charges = std::ceil(st.energy_unconstrained / battery.budget()) - 1;
-  st.energy_lower_bound =
-      st.energy_unconstrained + (charges > 0 && n > 1 ? charges * std::max(0.0, cheapest_visit) : 0.0);
+  // A charge after piece k replaces link[k] by back[k] + out[k + 1], which
+  // costs delta[k] more (negative when the plan's own move between the two
+  // pieces is longer than the way through the station, e.g. STC's walk).
+  // Any split with visits S costs E_u + sum of delta over S; it cannot cost
+  // less than E_u + every negative delta, so it needs at least
+  // c = ceil(that / budget) - 1 visits; the cheapest c visits are all the
+  // negative ones and then the smallest others.
+  std::vector<double> delta;
+  for (int k = 0; k + 1 < n; ++k) delta.push_back(sp.back[k] + sp.out[k + 1] - sp.link[k]);
+  std::sort(delta.begin(), delta.end());
+  double floor_energy = st.energy_unconstrained;
+  size_t negative = 0;
+  for (; negative < delta.size() && delta[negative] < 0; ++negative) floor_energy += delta[negative];
+  const double visits = std::max(0.0, std::ceil(floor_energy / battery.budget() - 1e-12) - 1);
+  double bound = floor_energy;
+  for (size_t k = negative; k < delta.size() && static_cast<double>(k) < visits; ++k) bound += delta[k];
+  st.energy_lower_bound = bound;
   return out;
 }
 

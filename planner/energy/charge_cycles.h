@@ -12,12 +12,14 @@
 //   ASSIGN_OR_RETURN(CoveragePlan split, SplitIntoChargeCycles(plan, *area.drive, battery, robot, stop));
 //   for (const ChargeCycle& c : split.cycles) { split.path[c.leave_waypoint] ... }
 //
-// stats.energy_lower_bound is E_u + (ceil(E_u / budget) - 1) * max(0, m),
-// where E_u is the unconstrained energy of the same tour from the station
-// and back and m the least extra energy of one station visit (return leg +
-// outbound leg - the tour move they replace): at least that many visits,
-// each at least that dear. A bound for splits of this tour order (m >= 0
-// holds for distance energy by the triangle inequality).
+// stats.energy_lower_bound bounds every split of this tour order from below:
+// E_u is the unconstrained energy of the tour from the station and back, and
+// a station visit after piece k costs delta_k more (return leg + outbound
+// leg - the tour's own move it replaces; negative when that move is longer
+// than the way through the station, as STC's walk can be). A split costs at
+// least E_u + every negative delta, so it makes at least
+// c = ceil((E_u + negatives) / budget) - 1 visits; the bound is E_u + the
+// negative deltas + the smallest remaining deltas up to c visits.
 //
 // Thread-safety: stateless.
 #ifndef COVPLAN_PLANNER_ENERGY_CHARGE_CYCLES_H_
