@@ -1,8 +1,14 @@
 // The battery of a simulated run: the driven path's energy under the plan's
 // energy model (PathEnergy's per-segment rule, SegmentEnergy), cut into the
-// charge cycles the robot actually drove. A cycle ends when the robot is
-// back at the station and leaves it again (or the run ends there); the
-// battery is then recharged to full, which takes `recharge_s`. The lowest
+// charge cycles the robot actually drove. A cycle ends when a kToStation
+// segment reaches the station and the robot then leaves on a segment of
+// another kind (kFromStation, normally), or when the path ends at the
+// station; the battery is then recharged to full, which takes `recharge_s`.
+// Passing the station's point on a coverage line, or on a greedy detour to
+// the station (its corners are cell centres, as the station may be), is not
+// docking. A station on a cell border whose outbound leg is blocked right
+// away could be passed without a charge being counted (the detour is then
+// kTransition); the cycle then shows as one too long, never as one too short. The lowest
 // charge seen shows a run that would have run the battery flat (it may be
 // negative: the simulated robot drives on, and says so).
 //

@@ -339,9 +339,10 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   auto station_visits = [&](const std::vector<Waypoint>& path, size_t from) {
     int n = 0;
     for (size_t i = std::max<size_t>(from, 1); i < path.size(); ++i) {
+      // Arrivals: a return leg reaching the station (its heading turn after it not counted again).
       const bool at_station = std::hypot(path[i].x - b.station.x, path[i].y - b.station.y) < 1e-9;
       const bool was = std::hypot(path[i - 1].x - b.station.x, path[i - 1].y - b.station.y) < 1e-9;
-      n += at_station && !was;
+      n += at_station && !was && path[i].kind == SegmentKind::kToStation;
     }
     return n;
   };
