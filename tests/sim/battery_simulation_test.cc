@@ -212,6 +212,29 @@ TEST(BatterySimulation, AStationOnTheCoverageLinesIsPassedWithoutCountingACharge
   DriveThroughClutter({1.5, 1.5, 0.0}, 60.0);
 }
 
+TEST(BatterySimulation, AStationTheTrueMapBlocksIsInvalidArgument) {
+  const OccupancyMap map = testing::LoadShippedMap(kMap);
+  SimulationOptions o = Options();
+  const Pose2 station = FreeStation(map);
+  o.plan.battery = Battery(station);
+  OccupancyMap truth = map;  // a box on the dock
+  for (int row = 0; row < map.height(); ++row) {
+    for (int col = 0; col < map.width(); ++col) {
+      const double x = map.origin().x + (col + 0.5) * map.resolution();
+      const double y = map.origin().y + (row + 0.5) * map.resolution();
+      if (std::abs(x - station.x) <= kTool / 2 && std::abs(y - station.y) <= kTool / 2) {
+        truth.set(row, col, CellState::kOccupied);
+      }
+    }
+  }
+  absl::StatusOr<SimulationResult> r = Simulate(map, truth, o);
+  EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(r.status().message()), HasSubstr("battery.station"));
+  EXPECT_THAT(std::string(r.status().message()), HasSubstr("free cell of the true map"));
+  o.recharge_s = -1;
+  EXPECT_THAT(std::string(Simulate(map, map, o).status().message()), HasSubstr("recharge_s"));
+}
+
 std::string MapPath(const std::string& name) { return std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name; }
 
 // A number after "key": in the JSON text.
