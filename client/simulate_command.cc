@@ -8,8 +8,13 @@
 #include <memory>
 #include <numeric>
 #include <optional>
+#include <utility>
+#include <vector>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "absl/strings/str_split.h"
 #include "absl/strings/str_format.h"
 #include "client/args.h"
 #include "planner/common/status_macros.h"
@@ -32,6 +37,10 @@ constexpr char kUsage[] =
     "                        [--no-offline-bound]\n"
     "                        [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                        [--free-thresh P] [--occupied-thresh P] [--negate]\n"
+    "                        [--planner oarp|stc|boustrophedon]\n"
+    "                        [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
+    "                         [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
+    "                         [--interruptible [--atomic-units ID,ID...]] [--recharge-s S]]\n"
     "Plans OARP on KNOWN, drives the plan through the true map (TRUE, or KNOWN with\n"
     "random rotated rectangles over PCT % of its free area, placed with --seed) with a\n"
     "radial line-of-sight sensor (default 5.6 m), replans with --method (default auto)\n"
@@ -55,7 +64,21 @@ constexpr char kUsage[] =
     "every replan is an observation; the compute time charged then includes the network\n"
     "and the server's queue (the offline bounds are still computed locally).\n"
     "--svg draws the true map, the driven path, the replan points (blue) and the\n"
-    "obstacle cells found (red).\n";
+    "obstacle cells found (red).\n"
+    "--planner plans with another registered planner (default oarp; the offline bounds\n"
+    "use it too).\n"
+    "With --battery-capacity and --station (as for covplan plan) the plan is split into\n"
+    "charge cycles; the robot drives to the station at the end of each, recharges for\n"
+    "--recharge-s seconds (default 0: give your dock's time) and resumes. The JSON adds\n"
+    "charge_cycles_driven, recharge_time_s (in total_time_s), energy_used (the driven\n"
+    "path under the energy model), min_battery_left (the lowest charge; below 0 the\n"
+    "battery would have run flat), below_reserve, cycles_over_budget and\n"
+    "cycle_energy. New obstacles on a battery plan are driven around by greedy_detour\n"
+    "only (the station legs are kept; --method must be greedy_detour or absent); the\n"
+    "cycles are not re-split, so a detour that makes a cycle too long shows in those\n"
+    "figures. Clutter never covers the station (its surroundings within a tool width\n"
+    "are kept as in KNOWN); the offline bounds include recharge-s per charge cycle.\n"
+    "Battery runs are local only (not with --server).\n";
 
 std::string JsonString(const std::string& s) {
   std::string out = "\"";
@@ -110,6 +133,85 @@ std::string RenderRunSvg(const OccupancyMap& truth, const Grid& grid, const Simu
   return svg;
 }
 
+// "X,Y[,THETA]" of --station.
+absl::StatusOr<Pose2> ParseStation(const std::string& text) {
+  std::vector<std::string> parts = absl::StrSplit(text, ',');
+  Pose2 p;
+  double* fields[] = {&p.x, &p.y, &p.theta};
+  bool ok = parts.size() == 2 || parts.size() == 3;
+  for (size_t i = 0; ok && i < parts.size(); ++i) ok = absl::SimpleAtod(parts[i], fields[i]) && std::isfinite(*fields[i]);
+  if (!ok) return absl::InvalidArgumentError(absl::StrCat("--station must be X,Y[,THETA] (numbers), got '", text, "'"));
+  return p;
+}
+
+// The battery flags; nullopt when none is given. Errors name the flag.
+absl::StatusOr<std::optional<BatteryOptions>> ParseBattery(const ParsedArgs& a) {
+  ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
+  const bool any = capacity || a.Get("station") || a.Get("reserve") || a.Get("energy-per-metre") ||
+                   a.Get("energy-per-turn") || a.Get("energy-per-second") || a.Has("interruptible") ||
+                   a.Get("atomic-units") || a.Get("recharge-s");
+  if (!any) return std::optional<BatteryOptions>();
+  if (!capacity || !a.Get("station")) {
+    return absl::InvalidArgumentError("a battery needs --battery-capacity E and --station X,Y[,THETA]");
+  }
+  BatteryOptions b;
+  b.capacity = *capacity;
+  ASSIGN_OR_RETURN(b.station, ParseStation(*a.Get("station")));
+  ASSIGN_OR_RETURN(std::optional<double> reserve, a.GetDouble("reserve"));
+  if (reserve) b.reserve = *reserve;
+  ASSIGN_OR_RETURN(std::optional<double> per_metre, a.GetDouble("energy-per-metre"));
+  if (per_metre) b.energy.per_metre = *per_metre;
+  ASSIGN_OR_RETURN(std::optional<double> per_turn, a.GetDouble("energy-per-turn"));
+  if (per_turn) b.energy.per_turn = *per_turn;
+  ASSIGN_OR_RETURN(std::optional<double> per_second, a.GetDouble("energy-per-second"));
+  if (per_second) b.energy.per_second = *per_second;
+  b.interruptible_units = a.Has("interruptible");
+  if (auto ids = a.Get("atomic-units")) {
+    for (absl::string_view id : absl::StrSplit(*ids, ',')) {
+      int value = 0;
+      if (!absl::SimpleAtoi(id, &value)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
+      }
+      b.atomic_units.push_back(value);
+    }
+  }
+  return std::optional<BatteryOptions>(b);
+}
+
+// The planner's field names in a battery error, as the flags that set them.
+absl::Status WithFlagNames(const absl::Status& status) {
+  if (!absl::IsInvalidArgument(status)) return status;
+  std::string m(status.message());
+  // Longest names first: "battery.energy" is a prefix of the per-field ones.
+  for (const auto& [field, flag] : std::vector<std::pair<std::string, std::string>>{
+           {"battery.energy.per_metre", "--energy-per-metre"},
+           {"battery.energy.per_turn", "--energy-per-turn"},
+           {"battery.energy.per_second", "--energy-per-second"},
+           {"battery.energy", "--energy-per-*"},
+           {"battery.capacity", "--battery-capacity"},
+           {"battery.reserve", "--reserve"},
+           {"battery.station", "--station"},
+           {"battery.atomic_units", "--atomic-units"},
+           {"battery.interruptible_units", "--interruptible"},
+           {"recharge_s", "--recharge-s"}}) {
+    m = absl::StrReplaceAll(m, {{field, flag}});
+  }
+  return absl::InvalidArgumentError(m);
+}
+
+// Clutter kept off the station: the pixels within a tool width of it as in `known`.
+void ClearAround(const OccupancyMap& known, const Pose2& station, double radius_m, OccupancyMap* truth) {
+  const double res = known.resolution();
+  const int c0 = static_cast<int>(std::floor((station.x - radius_m - known.origin().x) / res));
+  const int c1 = static_cast<int>(std::floor((station.x + radius_m - known.origin().x) / res));
+  const int r0 = static_cast<int>(std::floor((station.y - radius_m - known.origin().y) / res));
+  const int r1 = static_cast<int>(std::floor((station.y + radius_m - known.origin().y) / res));
+  for (int r = std::max(0, r0); r <= std::min(known.height() - 1, r1); ++r) {
+    for (int c = std::max(0, c0); c <= std::min(known.width() - 1, c1); ++c) truth->set(r, c, known.at(r, c));
+  }
+}
+
 }  // namespace
 
 absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
@@ -118,8 +220,10 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
                    ParseArgs(args,
                              {"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
                               "sensor-range", "svg", "time-limit", "step", "max-speed", "acceleration",
-                              "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit"},
-                             {"local", "negate", "clutter-may-disconnect", "no-offline-bound"}));
+                              "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit",
+                              "planner", "battery-capacity", "station", "reserve", "energy-per-metre",
+                              "energy-per-turn", "energy-per-second", "atomic-units", "recharge-s"},
+                             {"local", "negate", "clutter-may-disconnect", "no-offline-bound", "interruptible"}));
   if (a.Get("server") && a.Has("local")) return absl::InvalidArgumentError("give --local or --server, not both");
   if (a.Get("server") && a.Get("server")->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
   if (!a.Get("map")) return absl::InvalidArgumentError("--map KNOWN is required");
@@ -141,6 +245,22 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   o.seed = seed.value_or(1);
   if (auto m = a.Get("method")) {
     ASSIGN_OR_RETURN(o.method, ParseMethod(*m));
+  }
+  if (auto planner = a.Get("planner")) o.plan.planner = *planner;
+  ASSIGN_OR_RETURN(o.plan.battery, ParseBattery(a));
+  if (o.plan.battery) {
+    if (a.Get("server")) return absl::InvalidArgumentError("--battery-capacity: battery runs are local only, not with --server");
+    if (a.Get("method") && o.method != ReplanMethod::kGreedyDetour) {
+      return absl::InvalidArgumentError(
+          "--method: battery plans are replanned with greedy_detour only (the other methods drop the station legs)");
+    }
+    o.method = ReplanMethod::kGreedyDetour;
+    ASSIGN_OR_RETURN(std::optional<double> recharge, a.GetDouble("recharge-s"));
+    o.recharge_s = recharge.value_or(0.0);
+    if (!(o.recharge_s >= 0.0)) {
+      return absl::InvalidArgumentError(absl::StrFormat("--recharge-s must be >= 0 s, got %g", o.recharge_s));
+    }
+    RETURN_IF_ERROR(WithFlagNames(o.plan.battery->Validate()));
   }
   ASSIGN_OR_RETURN(std::optional<double> range, a.GetDouble("sensor-range"));
   if (range) o.sensor_range_m = *range;
@@ -175,6 +295,7 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     ClutterOptions clutter;
     if (!a.Has("clutter-may-disconnect")) clutter.keep_connected_cell_m = robot.tool_width_m;
     ASSIGN_OR_RETURN(truth, AddClutter(known, *percent, o.seed, clutter));
+    if (o.plan.battery) ClearAround(known, o.plan.battery->station, robot.tool_width_m, &truth);
     truth_name = absl::StrFormat("clutter %g %% seed %d", *percent, o.seed);
   }
   std::unique_ptr<PlanSource> remote;
@@ -187,13 +308,17 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     flags.negate = load.negate;
     ASSIGN_OR_RETURN(remote, make_remote(*server, *a.Get("map"), flags, o));
   }
-  ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o, remote.get()));
+  absl::StatusOr<SimulationResult> simulated = Simulate(known, truth, o, remote.get());
+  if (!simulated.ok()) return o.plan.battery ? WithFlagNames(simulated.status()) : simulated.status();
+  const SimulationResult& r = *simulated;
   OfflineBound bound, cell_bound;
   bound.duration_s = bound.covered_free_area_ratio = cell_bound.duration_s = std::nan("");
   if (!a.Has("no-offline-bound")) {
     ASSIGN_OR_RETURN(bound, OfflineLowerBound(truth, o.plan));
     ASSIGN_OR_RETURN(OccupancyMap cells, CellLevelTruth(known, truth, o.plan));
     ASSIGN_OR_RETURN(cell_bound, OfflineLowerBound(cells, o.plan));
+    bound.duration_s += o.recharge_s * bound.charge_cycles;
+    cell_bound.duration_s += o.recharge_s * cell_bound.charge_cycles;
   }
 
   if (auto svg_path = a.Get("svg")) {
@@ -241,6 +366,27 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   field("completed", r.completed ? "true" : "false");
   field("termination", JsonString(r.termination));
   field("problems", problems);
+  field("planner", JsonString(o.plan.planner));
+  if (r.battery) {
+    const BatteryRun& b = *r.battery;
+    std::string energies = "[";
+    for (size_t i = 0; i < b.cycle_energy.size(); ++i) absl::StrAppend(&energies, i ? "," : "", JsonNumber(b.cycle_energy[i]));
+    energies += "]";
+    field("battery_capacity", JsonNumber(o.plan.battery->capacity));
+    field("battery_reserve", JsonNumber(o.plan.battery->reserve));
+    field("recharge_s", JsonNumber(o.recharge_s));
+    field("planned_charge_cycles", absl::StrCat(b.charge_cycles_planned));
+    field("planned_energy", JsonNumber(b.energy_planned));
+    field("charge_cycles_driven", absl::StrCat(b.charge_cycles_driven));
+    field("recharge_time_s", JsonNumber(b.recharge_time_s));
+    field("energy_used", JsonNumber(b.energy_used));
+    field("extra_energy", JsonNumber(b.energy_used - b.energy_planned));
+    field("min_battery_left", JsonNumber(b.min_battery_left));
+    field("below_reserve", b.below_reserve ? "true" : "false");
+    field("cycles_over_budget", absl::StrCat(b.cycles_over_budget));
+    field("ended_at_station", b.ended_at_station ? "true" : "false");
+    field("cycle_energy", energies);
+  }
   return json + "}";
 }
 

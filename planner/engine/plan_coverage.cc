@@ -9,20 +9,23 @@ namespace covplan {
 
 PlanRequest PlanOptions::ToRequest() const {
   PlanRequest r;
-  r.planner = "oarp";
+  r.planner = planner;
   r.common.robot = robot;
   r.common.min_free_fraction = min_free_fraction;
   r.common.time_limit_s = time_limit_s;
   r.common.seed = seed;
   r.common.num_threads = num_threads;
   r.common.stop = stop;
-  auto oarp = std::make_shared<OarpOptions>();
-  oarp->partition_solver = partition_solver;
-  oarp->tour_solver = tour_solver;
-  oarp->tour_effort = tour_effort;
-  r.options = std::move(oarp);
+  if (planner == "oarp") {
+    auto oarp = std::make_shared<OarpOptions>();
+    oarp->partition_solver = partition_solver;
+    oarp->tour_solver = tour_solver;
+    oarp->tour_effort = tour_effort;
+    r.options = std::move(oarp);
+  }  // other planners: their defaults
   r.regions = regions;
   r.no_go = no_go;
+  r.battery = battery;
   return r;
 }
 

@@ -1,5 +1,7 @@
-// One call from a decoded map to an OARP plan, on the engine: for tests,
-// benchmarks and small tools that hold an OccupancyMap and want a plan.
+// One call from a decoded map to a plan (OARP unless `planner` names another
+// registered planner), on the engine: for tests, benchmarks and small tools
+// that hold an OccupancyMap and want a plan. With `battery` the engine splits
+// the plan into charge cycles (planner/energy), whatever the planner.
 //
 //   PlanOptions o; o.robot.tool_width_m = 0.8; o.no_go = {...};
 //   ASSIGN_OR_RETURN(CoveragePlan plan, PlanCoverage(map, o));
@@ -9,6 +11,7 @@
 #ifndef COVPLAN_PLANNER_ENGINE_PLAN_COVERAGE_H_
 #define COVPLAN_PLANNER_ENGINE_PLAN_COVERAGE_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +22,7 @@
 namespace covplan {
 
 struct PlanOptions {
+  std::string planner = PlannerRegistry::kDefault;  // a registered name; OARP fields apply to "oarp"
   RobotModel robot;
   PartitionSolver partition_solver = PartitionSolver::kMinCut;
   TourSolver tour_solver = TourSolver::kGtsp;
@@ -30,6 +34,7 @@ struct PlanOptions {
   StopToken stop;
   std::vector<PolygonInput> regions;
   std::vector<PolygonInput> no_go;
+  std::optional<BatteryOptions> battery;  // a battery-constrained tour (PlanRequest::battery)
 
   PlanRequest ToRequest() const;
 };

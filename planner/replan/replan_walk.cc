@@ -235,13 +235,18 @@ Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>
     return c.ok() ? *c : drive.CellAt(p);
   };
   AnyAngleSearch search(drive);
-  auto detour = [&](Point2 from, Point2 to) {
+  // A detour that rejoins a station leg is part of that leg (battery plans:
+  // the trip to or from the station goes on, only around the obstacle).
+  auto detour = [&](Point2 from, Point2 to, SegmentKind rejoined) {
+    const SegmentKind kind =
+        rejoined == SegmentKind::kToStation || rejoined == SegmentKind::kFromStation ? rejoined
+                                                                                      : SegmentKind::kTransition;
     const CellIndex a = join(from), b = join(to);
     search.Run(a, StopToken());
     std::vector<CellIndex> corners = search.PathTo(b);
-    emit(drive.CellCenter(a), SegmentKind::kTransition, {}, cur_heading);
-    for (const CellIndex& c : corners) emit(drive.CellCenter(c), SegmentKind::kTransition, {}, cur_heading);
-    emit(to, SegmentKind::kTransition, {}, cur_heading);
+    emit(drive.CellCenter(a), kind, {}, cur_heading);
+    for (const CellIndex& c : corners) emit(drive.CellCenter(c), kind, {}, cur_heading);
+    emit(to, kind, {}, cur_heading);
   };
   const double step = drive.cell_size() / 8.0;
   bool blocked = false;
@@ -274,7 +279,7 @@ Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>
         blocked = true;
       } else if (open && drive.IsFree(cell)) {
         // Out of it (drive' is one component: every free cell is reachable).
-        detour(last_free, p);
+        detour(last_free, p, leg.kind);
         blocked = false;
         run_start = last_free_t = t;
       }

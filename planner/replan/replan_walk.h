@@ -54,7 +54,10 @@ bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<b
 
 // The greedy walk over `legs`: drives the old path and, around every
 // stretch that touches a cell the new obstacles closed (free on old_drive,
-// not on drive), detours over `drive` and finishes the interrupted leg. It
+// not on drive), detours over `drive` and finishes the interrupted leg (a
+// detour back onto a kToStation / kFromStation leg takes that leg's kind, so
+// a battery plan's station legs stay recognisable; other detours are
+// kTransition). It
 // records where it stood at each encounter, so the prefix up to encounter k
 // is Prefix(k) without walking again.
 struct Walk {

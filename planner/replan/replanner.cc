@@ -254,11 +254,20 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   if (old.area == nullptr || old.plan.grid == nullptr || old.area->drive == nullptr) {
     return absl::FailedPreconditionError("the plan has no coverage area to replan on");
   }
-  if (!old.plan.cycles.empty()) {
-    // The remainder would lose its charge stops; the battery state at the
-    // robot is not known here.
-    return absl::FailedPreconditionError(
-        "replanning a battery plan (charge cycles) is not supported yet: plan again with the battery");
+  // A battery plan (or a greedy replan of one, which keeps its station legs
+  // but not its cycle table): only the greedy detour keeps the station legs.
+  // The ILP methods and kFull re-tour the remainder without charge stops, and
+  // the battery state at the robot is not known here to split it again.
+  const bool battery_plan =
+      !old.plan.cycles.empty() ||
+      std::any_of(old.plan.path.begin(), old.plan.path.end(), [](const Waypoint& w) {
+        return w.kind == SegmentKind::kToStation || w.kind == SegmentKind::kFromStation;
+      });
+  if (battery_plan && options.method != ReplanMethod::kGreedyDetour) {
+    return absl::FailedPreconditionError(absl::StrFormat(
+        "a battery plan (charge cycles) can only be replanned with method greedy_detour, got %s: the other "
+        "methods would drop its station legs; plan again with the battery",
+        ReplanMethodName(options.method)));
   }
   Context c;
   c.old = &old;

@@ -105,7 +105,11 @@ struct ReplanResult {
 // InvalidArgument for malformed progress (index past the end, a position off
 // the path, NaN) or observations (cells outside the grid, NaN points, bad
 // polygons), naming the field; FailedPrecondition when the old plan is not
-// an OARP plan with its coverage area. Running out of time is not an error:
+// an OARP plan with its coverage area, or is a battery plan (charge cycles or
+// station legs) and the method is not kGreedyDetour. The greedy detour of a
+// battery plan drives its old legs, station legs included, around the new
+// obstacles; the result has no `cycles` and no energy figures (its energy
+// is not re-checked against the battery: the caller knows the charge). Running out of time is not an error:
 // the greedy detour answers.
 absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress& progress,
                                     const Observations& observations, const ReplanOptions& options,

@@ -12,6 +12,7 @@
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
 #include "planner/engine/engine.h"
+#include "planner/sim/battery_run.h"
 #include "planner/tour/path_timing.h"
 
 namespace covplan {
@@ -88,6 +89,7 @@ class Simulation {
         grid_(true_grid),
         options_(options),
         robot_(options.plan.robot),
+        method_(options.plan.battery ? ReplanMethod::kGreedyDetour : options.method),
         plan_(std::move(plan)),
         candidate_(std::move(candidate)),
         found_(candidate_.size(), 0),
@@ -119,6 +121,8 @@ class Simulation {
   const Grid& grid_;  // the true grid (same frame as the plan's grid)
   const SimulationOptions& options_;
   const RobotModel robot_;
+  // Battery plans keep their station legs only under the greedy detour.
+  const ReplanMethod method_;
   RetainedPlan plan_;
   std::vector<uint8_t> candidate_;     // free on the planned drive grid, blocked on the true one
   std::vector<uint8_t> found_;         // candidates the robot has found
@@ -384,6 +388,8 @@ absl::Status Simulation::HandleViolation(CellIndex cell) {
 absl::StatusOr<SimulationResult> Simulation::Run() {
   IndexSweeps();
   r_.planned_duration_s = plan_.plan.stats.estimated_duration_s;
+  const int planned_cycles = static_cast<int>(plan_.plan.cycles.size());
+  const double planned_energy = plan_.plan.stats.energy_total;
   const double time_cap = options_.max_time_factor * r_.planned_duration_s + 3600.0;
   pos_ = At(path()[0]);
   here_ = grid_.CellAt(pos_);
@@ -397,7 +403,7 @@ absl::StatusOr<SimulationResult> Simulation::Run() {
           r_.termination = absl::StrFormat("stopped: %d replans", r_.num_replans);
           break;
         }
-        RETURN_IF_ERROR(DoReplan(options_.method));
+        RETURN_IF_ERROR(DoReplan(method_));
         continue;
       }
       pending_checked_ = true;
@@ -463,6 +469,12 @@ absl::StatusOr<SimulationResult> Simulation::Run() {
   const PlanStats s = ComputePathStats(r_.driven, robot_);
   r_.drive_time_s = s.estimated_duration_s;
   r_.total_time_s = r_.drive_time_s + r_.stoppage_s;
+  if (options_.plan.battery) {
+    r_.battery = DriveBattery(r_.driven, *options_.plan.battery, robot_, options_.recharge_s);
+    r_.battery->charge_cycles_planned = planned_cycles;
+    r_.battery->energy_planned = planned_energy;
+    r_.total_time_s += r_.battery->recharge_time_s;
+  }
   r_.num_turns = static_cast<int>(s.num_turns);
   r_.path_length_m = s.coverage_length_m + s.transition_length_m;
   return r_;
@@ -486,6 +498,10 @@ absl::Status SimulationOptions::Validate() const {
   if (!(max_time_factor > 0.0 && std::isfinite(max_time_factor))) {
     return absl::InvalidArgumentError("max_time_factor must be a positive number");
   }
+  if (!(recharge_s >= 0.0 && std::isfinite(recharge_s))) {
+    return absl::InvalidArgumentError(absl::StrFormat("recharge_s must be a finite value >= 0 s, got %g", recharge_s));
+  }
+  if (plan.battery) RETURN_IF_ERROR(plan.battery->Validate());
   return plan.robot.Validate();
 }
 
@@ -578,6 +594,15 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
   ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(truth, go));
   const std::vector<double> fractions = CellFreeFractions(truth, frame);
   ASSIGN_OR_RETURN(Grid true_grid, BuildGridFromFractions(truth, go, frame, fractions));
+  if (options.plan.battery) {
+    // The robot must be able to dock: nothing the sensor could find there.
+    const Pose2& st = options.plan.battery->station;
+    const CellIndex cell = true_grid.CellAt({st.x, st.y});
+    if (!true_grid.InBounds(cell.row, cell.col) || !true_grid.IsFree(cell)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "battery.station (%.3f, %.3f) is not in a free cell of the true map", st.x, st.y));
+    }
+  }
   const Grid& drive = retained.area != nullptr ? *retained.area->drive : *retained.plan.grid;
   if (drive.rows() != true_grid.rows() || drive.cols() != true_grid.cols()) {
     return absl::InternalError("the plan's grid and the true grid differ in shape");
@@ -623,6 +648,7 @@ absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth, const 
   b.duration_s = plan.stats.estimated_duration_s;
   b.covered_free_area_ratio = plan.stats.covered_free_area_ratio;
   b.num_ranks = plan.stats.num_ranks;
+  b.charge_cycles = static_cast<int>(plan.cycles.size());
   return b;
 }
 

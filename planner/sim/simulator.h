@@ -14,6 +14,22 @@
 //   r.total_time_s, r.stoppage_s, r.covered_free_area_ratio, r.driven ...
 //   ASSIGN_OR_RETURN(OfflineBound lb, OfflineLowerBound(truth, o.plan));  // OARP knowing everything
 //
+// Battery plans (options.plan.battery): the plan is split into charge
+// cycles on the known map (planner/energy; station legs are ordinary path
+// segments of kinds kToStation / kFromStation), the robot drives it, and
+// every time a cycle ends at the station it recharges for recharge_s
+// (counted for the last cycle too: the robot ends docked and charged).
+// SimulationResult::battery tracks the charge along the driven path with the
+// plan's energy model (battery_run.h). New obstacles on a battery plan are
+// driven around by the greedy detour only, whatever `method` says: it follows
+// the old legs, station legs included, and detours around what the sensor
+// finds; the other methods would re-tour the remainder without its charge
+// stops. The detours cost energy the split did not plan for, and no cycle is
+// re-split: battery.cycle_energy, cycles_over_budget, min_battery_left and
+// below_reserve report a cycle that no longer fits as it is (the simulated
+// robot drives on with a negative charge rather than stop, so the whole run
+// stays comparable). The station must lie in a free cell of the true map.
+//
 // Time is simulated; only the replans' compute time is measured (wall
 // clock), so stoppage, and with it the plans Algorithm 1 picks, varies a
 // little from run to run and with the machine.
@@ -22,6 +38,7 @@
 #define COVPLAN_PLANNER_SIM_SIMULATOR_H_
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +48,7 @@
 #include "planner/grid/occupancy_map.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"
+#include "planner/sim/battery_run.h"
 
 namespace covplan {
 
@@ -49,13 +67,15 @@ struct SimulationOptions {
   // max_time_factor x the initial plan's duration + 3600 s of driving.
   int max_replans = 10'000;
   double max_time_factor = 20.0;
+  // Battery plans (plan.battery): seconds at the station per charge cycle.
+  double recharge_s = 0.0;
 
   // InvalidArgument naming the field.
   absl::Status Validate() const;
 };
 
 struct SimulationResult {
-  double total_time_s = 0.0;  // drive_time_s + stoppage_s
+  double total_time_s = 0.0;  // drive_time_s + stoppage_s (+ battery->recharge_time_s)
   double drive_time_s = 0.0;  // the driven path under the robot model
   double stoppage_s = 0.0;    // waiting for replans
   int num_replans = 0;        // Replan calls (one per event of new obstacles on the path)
@@ -87,6 +107,7 @@ struct SimulationResult {
   std::vector<std::string> problems;
   bool completed = true;  // false: a bound of SimulationOptions stopped the run
   std::string termination;
+  std::optional<BatteryRun> battery;  // battery plans only
 };
 
 // Where the simulated robot's plans come from. The default plans and
@@ -107,18 +128,23 @@ class PlanSource {
                                               const Observations& seen, const ReplanOptions& options) = 0;
 };
 
-// InvalidArgument when the options are bad or the maps differ in size,
-// resolution or origin; errors of the initial plan are passed on. `source`
+// InvalidArgument when the options are bad, the maps differ in size,
+// resolution or origin, or the battery's station is not in a free cell of
+// the true map; errors of the initial plan are passed on. `source`
 // (optional, not owned): where plans come from; default in process.
 absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
                                           const SimulationOptions& options, PlanSource* source = nullptr);
 
-// The offline lower bound of the evaluation: OARP planned on the true map,
-// as if the robot had known it from the start.
+// The offline lower bound of the evaluation: the plan (options.planner, with
+// options.battery when given) of the true map, as if the robot had known it
+// from the start.
 struct OfflineBound {
   double duration_s = 0.0;  // the plan's estimated duration
   double covered_free_area_ratio = 0.0;
   int64_t num_ranks = 0;
+  // Battery plans: the offline plan's charge cycles (duration_s has no
+  // recharge time in it; add recharge_s for each).
+  int charge_cycles = 0;
 };
 absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth, const PlanOptions& options);
 

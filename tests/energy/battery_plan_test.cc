@@ -4,6 +4,7 @@
 // battery plan sweeps exactly what the unconstrained plan sweeps, atomic
 // units are never interrupted, and bad battery input is refused with a
 // reason naming the field.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -319,6 +320,40 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   absl::StatusOr<ReplanResult> replanned = Replan(retained, at, seen, ReplanOptions(), nullptr);
   EXPECT_EQ(replanned.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(replanned.status().message()), HasSubstr("battery plan"));
+  EXPECT_THAT(std::string(replanned.status().message()), HasSubstr("greedy_detour"));
+
+  // The greedy detour drives the old legs around the obstacle, keeping every
+  // station visit still ahead (the return legs' kinds, ending at the station).
+  ReplanOptions greedy;
+  greedy.method = ReplanMethod::kGreedyDetour;
+  size_t hit = res->plan.path.size() / 2;
+  while (hit + 1 < res->plan.path.size() &&
+         (res->plan.path[hit].kind != SegmentKind::kCoverage ||
+          std::hypot(res->plan.path[hit].x - b.station.x, res->plan.path[hit].y - b.station.y) < 2.0)) {
+    ++hit;
+  }
+  seen.points = {{res->plan.path[hit].x, res->plan.path[hit].y}};  // a swept cell away from the station
+  absl::StatusOr<ReplanResult> detoured = Replan(retained, at, seen, greedy, nullptr);
+  ASSERT_TRUE(detoured.ok()) << detoured.status();
+  auto station_visits = [&](const std::vector<Waypoint>& path, size_t from) {
+    int n = 0;
+    for (size_t i = std::max<size_t>(from, 1); i < path.size(); ++i) {
+      // Arrivals: a return leg reaching the station (its heading turn after it not counted again).
+      const bool at_station = std::hypot(path[i].x - b.station.x, path[i].y - b.station.y) < 1e-9;
+      const bool was = std::hypot(path[i - 1].x - b.station.x, path[i - 1].y - b.station.y) < 1e-9;
+      n += at_station && !was && path[i].kind == SegmentKind::kToStation;
+    }
+    return n;
+  };
+  // The robot is 5 m along the first cycle: every station arrival is ahead of it.
+  ASSERT_GT(res->plan.cycles.front().leave_waypoint, 2);
+  EXPECT_EQ(station_visits(detoured->plan.path, 1), station_visits(res->plan.path, 1));
+  EXPECT_EQ(station_visits(res->plan.path, 1), static_cast<int>(res->plan.cycles.size()));
+  EXPECT_TRUE(detoured->plan.cycles.empty());  // the cycle table is the caller's to recompute
+  EXPECT_EQ(detoured->stats.method, "greedy_detour");
+  // A replan of the replan is a battery plan too: its station legs survive only the greedy detour.
+  RetainedPlan again{"q", "m", detoured->plan, r, detoured->area};
+  EXPECT_EQ(Replan(again, at, seen, ReplanOptions(), nullptr).status().code(), absl::StatusCode::kFailedPrecondition);
 }
 
 TEST_F(BatteryPlans, TheSvgColoursEachCycle) {

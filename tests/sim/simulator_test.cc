@@ -20,9 +20,13 @@
 #include "planner/grid/map_io.h"
 #include "tests/testing/shipped_maps.h"
 #include "planner/sim/clutter.h"
+#include "tests/sim/sim_checks.h"
 
 namespace covplan {
 namespace {
+
+using testing::FirstBlockedPoint;
+using testing::TrueGrid;
 
 using ::testing::HasSubstr;
 
@@ -36,39 +40,6 @@ SimulationOptions Options(ReplanMethod method) {
   o.plan.robot.tool_width_m = 0.8;
   o.plan.time_limit_s = 0.5;
   return o;
-}
-
-Grid TrueGrid(const OccupancyMap& truth) {
-  GridOptions go;
-  go.cell_size = 0.8;
-  absl::StatusOr<Grid> g = BuildGrid(truth, go);
-  EXPECT_TRUE(g.ok()) << g.status();
-  return *g;
-}
-
-// First driven point (every 1 % of a cell) strictly inside a cell the true grid
-// blocks, after the robot has left the cell it started in; "" if none.
-std::string FirstBlockedPoint(const Grid& grid, const std::vector<Waypoint>& path) {
-  const CellIndex start = path.empty() ? CellIndex{} : grid.CellAt({path[0].x, path[0].y});
-  bool left_start = false;
-  for (size_t i = 1; i < path.size(); ++i) {
-    const Waypoint& a = path[i - 1];
-    const Waypoint& b = path[i];
-    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / (grid.cell_size() / 100))));
-    for (int k = 0; k <= n; ++k) {
-      const Point2 p{a.x + (b.x - a.x) * k / n, a.y + (b.y - a.y) * k / n};
-      const double fx = (p.x - grid.origin().x) / grid.cell_size(), fy = (p.y - grid.origin().y) / grid.cell_size();
-      const double border = std::min({fx - std::floor(fx), std::ceil(fx) - fx, fy - std::floor(fy), std::ceil(fy) - fy});
-      if (border < 1e-6) continue;  // on a cell border: in no cell
-      const CellIndex c = grid.CellAt(p);
-      if (c != start) left_start = true;
-      if ((c != start || left_start) && !grid.IsFree(c)) {
-        return "segment " + std::to_string(i) + " enters blocked cell (" + std::to_string(c.row) + ", " +
-               std::to_string(c.col) + ") at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")";
-      }
-    }
-  }
-  return "";
 }
 
 class EveryReplanMethod : public ::testing::TestWithParam<ReplanMethod> {};
