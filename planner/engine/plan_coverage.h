@@ -20,7 +20,7 @@ namespace covplan {
 
 struct PlanOptions {
   RobotModel robot;
-  PartitionSolver partition_solver = PartitionSolver::kMinCut;
+  PartitionSolver partition_solver = PartitionSolver::kMatching;
   TourSolver tour_solver = TourSolver::kGtsp;
   double min_free_fraction = 0.5;
   double time_limit_s = 1.0;
