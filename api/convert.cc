@@ -261,11 +261,15 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
     auto oarp = std::make_shared<OarpOptions>();
     switch (partition) {
       case v1::PARTITION_SOLVER_UNSPECIFIED:
+        break;  // the planner's default (matching)
       case v1::MINCUT:
         oarp->partition_solver = PartitionSolver::kMinCut;
         break;
       case v1::LP:
         oarp->partition_solver = PartitionSolver::kLp;
+        break;
+      case v1::MATCHING:
+        oarp->partition_solver = PartitionSolver::kMatching;
         break;
       default:
         return absl::InvalidArgumentError(

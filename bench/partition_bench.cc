@@ -1,7 +1,8 @@
-// Partition time: min-cut (Boost BK) vs the thesis LP (GLPK simplex) on
-// building-like grids of 10^4, 10^5 and 10^6 cells.
+// Partition time: min-cut (Boost BK), bipartite matching (Hopcroft-Karp)
+// and the thesis LP (GLPK simplex) on building-like grids and open fields of
+// 10^4, 10^5 and 10^6 cells.
 //
-//   build/bin/partition_bench --benchmark_filter=MinCut
+//   build/bin/partition_bench --benchmark_filter='MinCut|Matching'
 //   build/bin/partition_bench --benchmark_filter='Lp/10000'
 #include <cmath>
 #include <random>
@@ -9,6 +10,7 @@
 
 #include "benchmark/benchmark.h"
 #include "planner/partition/lp_partitioner.h"
+#include "planner/partition/matching_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
 
 namespace covplan {
@@ -79,9 +81,38 @@ void BM_MinCutField(benchmark::State& state) {
     ranks = static_cast<int64_t>(p->ranks.size());
   }
   state.counters["cells"] = static_cast<double>(grid.size());
+  state.counters["free_cells"] = static_cast<double>(grid.CountFree());
   state.counters["ranks"] = static_cast<double>(ranks);
 }
-BENCHMARK(BM_MinCutField)->Args({1'000'000, 0})->Args({1'000'000, 1})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_MinCutField)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// Matching: /0 = multi-source BFS with grafting, /1 = Hopcroft-Karp, /2 =
+// multi-source BFS without the greedy initial matching, /3 = Pothen-Fan (PF+).
+template <Grid (*MakeGrid)(int64_t, uint32_t)>
+void BM_Matching(benchmark::State& state) {
+  const Grid grid = MakeGrid(state.range(0), 42);
+  int64_t ranks = 0;
+  for (auto _ : state) {
+    const int variant = static_cast<int>(state.range(1));
+    const MatchingPartitioner partitioner(variant == 1   ? MatchingAlgorithm::kHopcroftKarp
+                                          : variant == 3 ? MatchingAlgorithm::kPothenFan
+                                                         : MatchingAlgorithm::kMultiSourceBfs,
+                                          variant != 2);
+    auto p = partitioner.Partition(grid, StopToken());
+    if (!p.ok()) {
+      state.SkipWithError(std::string(p.status().message()).c_str());
+      break;
+    }
+    ranks = static_cast<int64_t>(p->ranks.size());
+  }
+  state.counters["cells"] = static_cast<double>(grid.size());
+  state.counters["free_cells"] = static_cast<double>(grid.CountFree());
+  state.counters["ranks"] = static_cast<double>(ranks);
+}
+BENCHMARK_TEMPLATE(BM_Matching, BuildingGrid)->Name("BM_MatchingBuilding")
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_TEMPLATE(BM_Matching, FieldGrid)->Name("BM_MatchingField")
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_Lp(benchmark::State& state) {
   const Grid grid = BuildingGrid(state.range(0), 42);

@@ -20,7 +20,8 @@ const OarpOptions& Options(const PlanContext& ctx) {
 }  // namespace
 
 absl::Status OarpOptions::Validate() const {
-  if (partition_solver != PartitionSolver::kMinCut && partition_solver != PartitionSolver::kLp) {
+  if (partition_solver != PartitionSolver::kMinCut && partition_solver != PartitionSolver::kLp &&
+      partition_solver != PartitionSolver::kMatching) {
     return absl::InvalidArgumentError("oarp.partition_solver: unknown solver");
   }
   if (tour_solver != TourSolver::kGreedy && tour_solver != TourSolver::kGtsp) {

@@ -28,7 +28,7 @@ namespace covplan {
 enum class TourSolver { kGreedy, kGtsp };
 
 struct OarpOptions final : PlannerOptions {
-  PartitionSolver partition_solver = PartitionSolver::kMinCut;
+  PartitionSolver partition_solver = PartitionSolver::kMatching;  // fastest exact (docs/benchmarks.md §1)
   TourSolver tour_solver = TourSolver::kGtsp;
   // kFast/kDefault stop by themselves when the search converges (often well
   // within the budget); kThorough keeps improving until the budget is spent.

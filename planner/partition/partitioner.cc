@@ -1,6 +1,7 @@
 #include "planner/partition/partitioner.h"
 
 #include "planner/partition/lp_partitioner.h"
+#include "planner/partition/matching_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
 
 namespace covplan {
@@ -8,6 +9,7 @@ namespace covplan {
 std::unique_ptr<RankPartitioner> MakePartitioner(PartitionSolver solver) {
   switch (solver) {
     case PartitionSolver::kLp: return std::make_unique<LpPartitioner>();
+    case PartitionSolver::kMatching: return std::make_unique<MatchingPartitioner>();
     case PartitionSolver::kMinCut: break;
   }
   return std::make_unique<MinCutPartitioner>();

@@ -1,9 +1,10 @@
 // Minimum rank partition (OARP, thesis ch. 3): orient every free cell H or V
-// so that the number of ranks is minimal. Two exact solvers share this
-// interface: the s-t minimum cut (default, fast) and the thesis's GLPK LP
-// (reference). Both return an optimal partition; ties may differ.
+// so that the number of ranks is minimal. Three exact solvers share this
+// interface: the s-t minimum cut, a maximum bipartite matching on the
+// conflict graph (König), and the thesis's GLPK LP (reference). All return
+// an optimal partition; ties may differ.
 //
-//   std::unique_ptr<RankPartitioner> p = MakePartitioner(PartitionSolver::kMinCut);
+//   std::unique_ptr<RankPartitioner> p = MakePartitioner(PartitionSolver::kMatching);
 //   absl::StatusOr<RankPartition> part = p->Partition(grid, StopToken());
 //
 // Thread-safety: implementations are stateless; Partition() is reentrant.
@@ -20,7 +21,7 @@
 
 namespace covplan {
 
-enum class PartitionSolver { kMinCut, kLp };
+enum class PartitionSolver { kMinCut, kLp, kMatching };
 
 class RankPartitioner {
  public:

@@ -83,15 +83,20 @@ TEST(PlanCoverage, OfficeMapConforms) {
   }
 }
 
-TEST(PlanCoverage, LpAndMinCutGiveSameRankCount) {
-  PlanOptions a, b;
-  a.tour_solver = b.tour_solver = TourSolver::kGreedy;
+TEST(PlanCoverage, ExactSolversGiveSameRankCount) {
+  PlanOptions a, b, c;  // a: the default (matching)
+  a.tour_solver = b.tour_solver = c.tour_solver = TourSolver::kGreedy;
   b.partition_solver = PartitionSolver::kLp;
+  c.partition_solver = PartitionSolver::kMinCut;
   auto pa = PlanCoverage(OfficeMap(), a);
   auto pb = PlanCoverage(OfficeMap(), b);
-  ASSERT_TRUE(pa.ok() && pb.ok());
+  auto pc = PlanCoverage(OfficeMap(), c);
+  ASSERT_TRUE(pa.ok() && pb.ok() && pc.ok());
   EXPECT_EQ(pa->detail_as<OarpDetail>()->ranks.size(), pb->detail_as<OarpDetail>()->ranks.size());
+  EXPECT_EQ(pc->detail_as<OarpDetail>()->ranks.size(), pb->detail_as<OarpDetail>()->ranks.size());
+  EXPECT_EQ(pa->stats.partition_solver, "matching");
   EXPECT_EQ(pb->stats.partition_solver, "lp");
+  EXPECT_EQ(pc->stats.partition_solver, "mincut");
 }
 
 TEST(PlanCoverage, BadInputIsInvalidArgument) {

@@ -1,10 +1,12 @@
-// Every map shipped in maps/: the LP and the min-cut agree on the optimal
-// rank count (at several tool widths), and the full plan conforms.
+// Every map shipped in maps/: the LP, the min-cut and the matching agree on
+// the optimal rank count (at several tool widths, thin-wall barriers on), and
+// the full plan conforms.
 #include <string>
 
 #include "gtest/gtest.h"
 #include "planner/grid/map_io.h"
 #include "planner/partition/lp_partitioner.h"
+#include "planner/partition/matching_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
 #include "planner/engine/plan_coverage.h"
 #include "tests/testing/plan_conformance.h"
@@ -25,10 +27,14 @@ TEST_P(ShippedMap, LpEqualsMinCutAndPlanConforms) {
     ASSERT_TRUE(grid.ok()) << grid.status();
     auto cut = MinCutPartitioner().Partition(*grid, StopToken());
     auto lp = LpPartitioner().Partition(*grid, StopToken());
+    auto matching = MatchingPartitioner().Partition(*grid, StopToken());
     ASSERT_TRUE(cut.ok()) << cut.status();
     ASSERT_TRUE(lp.ok()) << lp.status();
+    ASSERT_TRUE(matching.ok()) << matching.status();
     EXPECT_EQ(cut->ranks.size(), lp->ranks.size()) << GetParam() << " tool " << tool;
+    EXPECT_EQ(matching->ranks.size(), lp->ranks.size()) << GetParam() << " tool " << tool;
     EXPECT_EQ(testing::CheckExactCover(*grid, cut->ranks), "");
+    EXPECT_EQ(testing::CheckExactCover(*grid, matching->ranks), "");
   }
   PlanOptions opt;
   opt.time_limit_s = 0.3;

@@ -156,6 +156,13 @@ TEST(PlanRequestFromProtoTest, ValidatesRobotAndSolvers) {
   EXPECT_DOUBLE_EQ(options->common.robot.tool_width_m, 0.5);
   EXPECT_EQ(options->common.seed, 11u);
 
+  request.set_partition_solver(v1::MATCHING);
+  options = PlanRequestFromProto(request);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(dynamic_cast<const OarpOptions*>(options->options.get())->partition_solver,
+            PartitionSolver::kMatching);
+  request.set_partition_solver(v1::LP);
+
   // The oneof wins over the top-level solver fields, and its errors name it.
   request.mutable_oarp()->set_partition_solver(v1::MINCUT);
   options = PlanRequestFromProto(request);

@@ -371,7 +371,7 @@ TEST_F(ServiceTest, RandomHostileRequestsAreAnsweredNeverCrash) {
     }
     request.set_time_limit_s(pick({0.01, 0.05, 0.2}));
     if (rng() % 3 == 0) request.set_min_free_fraction(pick({0.3, 0.5, 0.9, 1.0, 1.5}));
-    if (rng() % 5 == 0) request.set_partition_solver(static_cast<v1::PartitionSolver>(rng() % 4));
+    if (rng() % 5 == 0) request.set_partition_solver(static_cast<v1::PartitionSolver>(rng() % 5));
     if (rng() % 5 == 0) request.set_tour_solver(static_cast<v1::TourSolver>(rng() % 4));
     request.set_seed(rng());
 
