@@ -28,6 +28,7 @@ constexpr char kUsage[] =
     "                        (--true-map TRUE | --clutter PCT) [--seed N]\n"
     "                        [--method auto|ilp1|ilp2|greedy_detour|full] [--sensor-range M]\n"
     "                        [--local | --server HOST:PORT] [--svg run.svg] [--time-limit S] [--step S]\n"
+    "                        [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
     "                        [--replan-tour-limit S] [--clutter-may-disconnect]\n"
     "                        [--no-offline-bound]\n"
     "                        [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
@@ -116,9 +117,9 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
                                                 const RemotePlanSourceFactory& make_remote) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args,
-                             {"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
+                             WithConnectionFlags({"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
                               "sensor-range", "svg", "time-limit", "step", "max-speed", "acceleration",
-                              "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit"},
+                              "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit"}),
                              {"local", "negate", "clutter-may-disconnect", "no-offline-bound"}));
   if (a.Get("server") && a.Has("local")) return absl::InvalidArgumentError("give --local or --server, not both");
   if (a.Get("server") && a.Get("server")->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
@@ -185,7 +186,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     flags.free_thresh = free_thresh;
     flags.occupied_thresh = occupied_thresh;
     flags.negate = load.negate;
-    ASSIGN_OR_RETURN(remote, make_remote(*server, *a.Get("map"), flags, o));
+    ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, *server));
+    ASSIGN_OR_RETURN(remote, make_remote(connection, *a.Get("map"), flags, o));
   }
   ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o, remote.get()));
   OfflineBound bound, cell_bound;
