@@ -102,6 +102,12 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
     absl::StatusOr<std::unique_ptr<TenantTokens>> tokens = TenantTokens::Load(config.token_file);
     if (!tokens.ok()) return tokens.status();
     server->tokens_ = std::move(*tokens);
+    const bool loopback = config.address == "127.0.0.1" || config.address == "localhost" ||
+                          config.address == "::1" || config.address == "[::1]";
+    if (config.tls_cert_file.empty() && !loopback) {
+      LogLine("warn", "bearer tokens on a plaintext port beyond loopback travel in the clear; use --tls_cert",
+              {{"address", config.address}});
+    }
   }
   server->metrics_ = std::make_unique<ServerMetrics>();
   server->service_ = std::make_unique<CoveragePlannerService>(

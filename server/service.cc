@@ -391,7 +391,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerCon
         }
         // Another tenant's map answers as a missing one.
         absl::StatusOr<v1::GetMapResponse> stored = MapNotFound(request->map_id());
-        if (OwnsMap(call.tenant_tag, request->map_id())) stored = store_->Get(request->map_id());
+        if (OwnsMap(call.tenant_tag, request->map_id()) || !ValidateMapId(request->map_id()).ok()) {
+          stored = store_->Get(request->map_id());  // a malformed id: INVALID_ARGUMENT for all
+        }
         if (absl::IsNotFound(stored.status())) stored = MapNotFound(request->map_id());
         if (absl::IsDataLoss(stored.status())) cache_.EraseWithPrefix(request->map_id() + "/");
         if (stored.ok()) {
@@ -500,7 +502,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
         }
         // Another tenant's map answers as a missing one: nothing deleted.
         absl::StatusOr<bool> deleted = false;
-        if (OwnsMap(call.tenant_tag, request->map_id())) deleted = store_->Delete(request->map_id());
+        if (OwnsMap(call.tenant_tag, request->map_id()) || !ValidateMapId(request->map_id()).ok()) {
+          deleted = store_->Delete(request->map_id());
+        }
         if (deleted.ok()) {
           response->set_deleted(*deleted);
           cache_.EraseWithPrefix(request->map_id() + "/");

@@ -183,6 +183,7 @@ TEST_F(ServerAuthTest, TenantsSeeOnlyTheirOwnMapsAndPlans) {
   v1::PlanResponse foreign_plan, absent_plan;
   same_as_missing(Plan(kBeta, a, &foreign_plan), Plan(kBeta, missing, &absent_plan), a);
   EXPECT_TRUE(GetMap(kAlpha, a).ok());
+  EXPECT_EQ(GetMap(kBeta, "not-an-id").error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 
   // Plans: alpha's plan is not beta's.
   v1::PlanResponse plan;
