@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
@@ -228,6 +229,35 @@ TEST_F(ServerAuthTest, TenantsSeeOnlyTheirOwnMapsAndPlans) {
   }
   EXPECT_TRUE(GetMap(kAlpha, a).ok());
   EXPECT_EQ(GetMap(kBeta, b).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(ServerAuthTest, ListMapsPagesOverOnlyTheCallersMaps) {
+  StartServer();
+  std::set<std::string> alpha_maps;
+  for (int i = 0; i < 5; ++i) {  // interleaved: alpha 0, 2, 4; beta 1, 3
+    v1::PutMapRequest request;
+    *request.mutable_map() = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.05 + 0.01 * i);
+    v1::PutMapResponse response;
+    const std::string& token = i % 2 == 0 ? kAlpha : kBeta;
+    ASSERT_TRUE(stub_->PutMap(Ctx(token).get(), request, &response).ok());
+    if (i % 2 == 0) alpha_maps.insert(response.map_id());
+  }
+  std::set<std::string> seen;
+  std::string page_token;
+  int pages = 0;
+  do {
+    v1::ListMapsRequest request;
+    request.set_page_size(2);
+    request.set_page_token(page_token);
+    v1::ListMapsResponse response;
+    ASSERT_TRUE(stub_->ListMaps(Ctx(kAlpha).get(), request, &response).ok());
+    EXPECT_LE(response.maps_size(), 2);
+    for (const v1::MapInfo& info : response.maps()) EXPECT_TRUE(seen.insert(info.map_id()).second);
+    page_token = response.next_page_token();
+    ASSERT_LT(++pages, 10);
+  } while (!page_token.empty());
+  EXPECT_EQ(seen, alpha_maps);
+  EXPECT_EQ(pages, 2);
 }
 
 TEST_F(ServerAuthTest, SighupRereadsTheTokenFile) {
