@@ -216,6 +216,24 @@ TEST_F(ServerAuthTest, TenantsSeeOnlyTheirOwnMapsAndPlans) {
     EXPECT_EQ(stub_->Resume(Ctx(kBeta).get(), resume, &response).error_code(), grpc::StatusCode::NOT_FOUND);
   }
 
+  {  // Drive: alpha adopts its plan, beta's session on it ends NOT_FOUND
+    const auto drive = [&](const std::string& token, v1::DriveEvent* event) {
+      auto context = Ctx(token);
+      auto stream = stub_->Drive(context.get());
+      v1::DriveRequest first;
+      first.set_plan_id(plan.plan_id());
+      stream->Write(first);
+      const bool read = stream->Read(event);
+      if (read) context->TryCancel();
+      const grpc::Status status = stream->Finish();
+      return read ? grpc::Status::OK : status;
+    };
+    v1::DriveEvent event;
+    ASSERT_TRUE(drive(kAlpha, &event).ok());
+    EXPECT_EQ(event.ready().plan_id(), plan.plan_id());
+    EXPECT_EQ(drive(kBeta, &event).error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+
   // Beta cannot delete alpha's map (answered as for a missing map), but its own.
   {
     v1::DeleteMapRequest request;
