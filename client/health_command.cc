@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "client/args.h"
+#include "client/remote.h"
 #include "google/protobuf/io/coded_stream.h"
 #include "google/protobuf/io/zero_copy_stream_impl_lite.h"
 #include "google/protobuf/wire_format_lite.h"
@@ -18,6 +19,7 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: covplan health --server HOST:PORT [--service NAME] [--timeout-ms T]\n"
+    "                     [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
     "Prints the grpc.health.v1 status (SERVING, NOT_SERVING, ...); exit 0 only for SERVING.\n";
 
 // grpc.health.v1.HealthCheckRequest { string service = 1; } by hand: the
@@ -59,14 +61,16 @@ const char* StatusName(int status) {
 }
 
 absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, {"server", "service", "timeout-ms"}, {}));
+  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, WithConnectionFlags({"server", "service", "timeout-ms"}), {}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   ASSIGN_OR_RETURN(std::optional<int64_t> timeout_ms, a.GetInt("timeout-ms"));
   const int64_t timeout = timeout_ms.value_or(2000);
   if (timeout <= 0) return absl::InvalidArgumentError("--timeout-ms must be positive");
-  grpc::GenericStub stub(grpc::CreateChannel(*a.Get("server"), grpc::InsecureChannelCredentials()));
+  ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, *a.Get("server")));
+  grpc::GenericStub stub(ChannelFor(connection));
   grpc::CompletionQueue cq;
   grpc::ClientContext context;
+  AddCallCredentials(connection, &context);  // health is open; harmless
   const auto deadline = std::chrono::system_clock::now() + std::chrono::milliseconds(timeout);
   context.set_deadline(deadline);
   const std::string request = EncodeRequest(a.Get("service").value_or(""));

@@ -23,6 +23,7 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: covplan load --server HOST:PORT (--map FILE | --maps DIR|F1,F2,...)\n"
+    "                   [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
     "                    [--concurrency N] [--duration S] [--requests N]\n"
     "                    [--deadline-ms D] [--resolution M] [--tool-width M]\n"
     "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n"
@@ -59,9 +60,9 @@ double Percentile(std::vector<double> sorted, double q) {
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args,
-                             {"server", "map", "maps", "concurrency", "duration", "deadline-ms",
-                              "resolution", "tool-width", "time-limit", "tour", "backoff-ms",
-                              "zipf", "seed", "requests"},
+                             WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
+                                                  "deadline-ms", "resolution", "tool-width", "time-limit",
+                                                  "tour", "backoff-ms", "zipf", "seed", "requests"}),
                              {"inline"}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   if (!a.Get("map") == !a.Get("maps")) {
@@ -95,7 +96,8 @@ absl::Status Run(const std::vector<std::string>& args) {
     ASSIGN_OR_RETURN(files, MapFiles(*a.Get("maps")));
   }
   const bool send_inline = a.Has("inline");
-  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(server);
+  ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, server));
+  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(connection);
   // One prepared request per map.
   std::vector<v1::PlanRequest> requests;
   std::vector<std::string> acknowledged;

@@ -31,7 +31,8 @@ constexpr double kLocalDefaultBudgetS = 2.0;
 constexpr char kUsage[] =
     "usage: covplan plan --map FILE [--resolution M] [--tool-width M]\n"
     "                    [--local | --server HOST:PORT] [--out plan.json] [--svg plan.svg]\n"
-    "                    [--time-limit S] [--seed N] [--partition mincut|matching|lp] [--tour gtsp|greedy]\n"
+    "                    [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
+    "                    [--time-limit S] [--seed N] [--partition matching|mincut|lp] [--tour gtsp|greedy]\n"
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D]\n"
@@ -133,7 +134,7 @@ struct PlanCommand {
   MapFileOverrides overrides;
   v1::PlanRequest request;
   bool local = false;
-  std::string server = "127.0.0.1:50051";
+  Connection server;
   std::optional<std::string> out;
   std::optional<std::string> svg;
   std::optional<int64_t> deadline_ms;
@@ -143,12 +144,12 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   ASSIGN_OR_RETURN(
       ParsedArgs a,
       ParseArgs(args,
-                {"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
+                WithConnectionFlags({"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
                  "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
                  "energy-per-second", "atomic-units", "sweep-axis",
-                 "algorithm", "stc-tree", "sweep-direction", "stc-partial"},
+                 "algorithm", "stc-tree", "sweep-direction", "stc-partial"}),
                 {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -157,7 +158,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     return absl::InvalidArgumentError("--local and --server exclude each other");
   }
   c.local = a.Has("local");
-  if (a.Get("server")) c.server = *a.Get("server");
+  ASSIGN_OR_RETURN(c.server, ConnectionFromArgs(a, a.Get("server").value_or(kDefaultServer)));
   c.out = a.Get("out");
   c.svg = a.Get("svg");
   ASSIGN_OR_RETURN(c.overrides.resolution, a.GetDouble("resolution"));
@@ -289,13 +290,13 @@ absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& ma
   *put.mutable_map() = map;
   put.set_name(c.map_path);
   absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
-  if (!stored.ok()) return absl::Status(stored.status().code(), ServerError(c.server, stored.status()));
+  if (!stored.ok()) return absl::Status(stored.status().code(), ServerError(c.server.target, stored.status()));
   v1::PlanRequest request = c.request;
   request.set_map_id(stored->map_id());
   std::optional<absl::Duration> timeout;
   if (c.deadline_ms) timeout = absl::Milliseconds(*c.deadline_ms);
   absl::StatusOr<v1::PlanResponse> plan = remote->Plan(request, timeout);
-  if (!plan.ok()) return absl::Status(plan.status().code(), ServerError(c.server, plan.status()));
+  if (!plan.ok()) return absl::Status(plan.status().code(), ServerError(c.server.target, plan.status()));
   return plan;
 }
 

@@ -29,7 +29,29 @@ absl::Status FromGrpc(const grpc::Status& status) {
 
 }  // namespace
 
+std::shared_ptr<grpc::Channel> ChannelFor(const Connection& connection) {
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(256 << 20);
+  arguments.SetMaxSendMessageSize(256 << 20);
+  std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+  if (connection.tls) {
+    grpc::SslCredentialsOptions options;
+    options.pem_root_certs = connection.ca_pem;
+    options.pem_cert_chain = connection.cert_pem;
+    options.pem_private_key = connection.key_pem;
+    credentials = grpc::SslCredentials(options);
+  }
+  return grpc::CreateCustomChannel(connection.target, credentials, arguments);
+}
+
+void AddCallCredentials(const Connection& connection, grpc::ClientContext* context) {
+  // Plain metadata rather than gRPC call credentials, which refuse
+  // plaintext channels: a loopback server with tokens is served too.
+  if (!connection.token.empty()) context->AddMetadata("authorization", "Bearer " + connection.token);
+}
+
 struct RemotePlanner::Impl {
+  Connection connection;
   std::unique_ptr<v1::CoveragePlanner::Stub> stub;
 };
 
@@ -37,18 +59,22 @@ RemotePlanner::RemotePlanner(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 RemotePlanner::~RemotePlanner() = default;
 
 std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const std::string& target) {
-  grpc::ChannelArguments arguments;
-  arguments.SetMaxReceiveMessageSize(256 << 20);
-  arguments.SetMaxSendMessageSize(256 << 20);
+  Connection connection;
+  connection.target = target;
+  return Connect(connection);
+}
+
+std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const Connection& connection) {
   auto impl = std::make_unique<Impl>();
-  impl->stub = v1::CoveragePlanner::NewStub(
-      grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments));
+  impl->connection = connection;
+  impl->stub = v1::CoveragePlanner::NewStub(ChannelFor(connection));
   return std::unique_ptr<RemotePlanner>(new RemotePlanner(std::move(impl)));
 }
 
 absl::StatusOr<v1::PutMapResponse> RemotePlanner::PutMap(const v1::PutMapRequest& request,
                                                          absl::Duration timeout) {
   grpc::ClientContext context;
+  AddCallCredentials(impl_->connection, &context);
   context.set_deadline(absl::ToChronoTime(absl::Now() + timeout));
   SetMapId(&context, ComputeMapId(request.map()));
   v1::PutMapResponse response;
@@ -61,6 +87,7 @@ absl::StatusOr<v1::PutMapResponse> RemotePlanner::PutMap(const v1::PutMapRequest
 absl::StatusOr<v1::PlanResponse> RemotePlanner::Plan(const v1::PlanRequest& request,
                                                      std::optional<absl::Duration> timeout) {
   grpc::ClientContext context;
+  AddCallCredentials(impl_->connection, &context);
   if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
   SetMapId(&context, RoutingMapId(request));
   v1::PlanResponse response;
@@ -74,6 +101,7 @@ absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest
                                                          std::optional<absl::Duration> timeout,
                                                          const std::string& map_id) {
   grpc::ClientContext context;
+  AddCallCredentials(impl_->connection, &context);
   if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
   // A replan by plan_id names no map; the caller passes the map id when it
   // has it (the plan's map_id), otherwise the router picks any replica and
@@ -93,6 +121,7 @@ absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest
 absl::StatusOr<v1::ReplanResponse> RemotePlanner::Resume(const v1::ResumeRequest& request,
                                                          std::optional<absl::Duration> timeout) {
   grpc::ClientContext context;
+  AddCallCredentials(impl_->connection, &context);
   if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
   v1::ReplanResponse response;
   if (absl::Status s = FromGrpc(impl_->stub->Resume(&context, request, &response)); !s.ok()) {
@@ -117,6 +146,7 @@ RemotePlanner::DriveSession::~DriveSession() {
 
 absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(const v1::DriveRequest& first) {
   auto stream = std::make_unique<DriveSession::Stream>();
+  AddCallCredentials(impl_->connection, &stream->context);
   stream->rw = impl_->stub->Drive(&stream->context);
   std::unique_ptr<DriveSession> session(new DriveSession(std::move(stream)));
   v1::DriveEvent event;

@@ -5,6 +5,8 @@
 // inline map: its content hash), the key a map-affine router hashes on.
 //
 //   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect("127.0.0.1:50051");
+//   // or, with TLS and a bearer token (client/connection.h):
+//   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(connection);
 //   ASSIGN_OR_RETURN(v1::PutMapResponse put, remote->PutMap(request, absl::Seconds(30)));
 //   ASSIGN_OR_RETURN(v1::PlanResponse plan, remote->Plan(plan_request, absl::Seconds(5)));
 //
@@ -18,13 +20,25 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "client/connection.h"
 #include "covplan/v1/covplan.pb.h"
+
+namespace grpc {
+class Channel;
+class ClientContext;
+}  // namespace grpc
 
 namespace covplan {
 
+// A channel with the connection's transport security (plaintext, TLS or
+// mutual TLS), and the per-call metadata it needs (the bearer token).
+std::shared_ptr<grpc::Channel> ChannelFor(const Connection& connection);
+void AddCallCredentials(const Connection& connection, grpc::ClientContext* context);
+
 class RemotePlanner {
  public:
-  static std::unique_ptr<RemotePlanner> Connect(const std::string& target);
+  static std::unique_ptr<RemotePlanner> Connect(const std::string& target);  // plaintext, no token
+  static std::unique_ptr<RemotePlanner> Connect(const Connection& connection);
   ~RemotePlanner();
 
   absl::StatusOr<v1::PutMapResponse> PutMap(const v1::PutMapRequest& request,

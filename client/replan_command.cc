@@ -24,6 +24,7 @@ constexpr char kUsage[] =
     "                      [--obstacle AREA]... [--obstacle-cell ROW,COL]... [--obstacle-point X,Y]...\n"
     "                      [--method auto|ilp1|ilp2|greedy_detour|full] [--seed N]\n"
     "                      [--server HOST:PORT] [--deadline-ms D] [--out plan.json]\n"
+    "                      [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
     "                      [--map-id ID]   (routing metadata for a map-affine router)\n"
     "Reports obstacles the robot found while driving plan P (retained by the server)\n"
     "and prints the new plan for what is left, starting at the robot. --waypoint K is\n"
@@ -126,8 +127,8 @@ absl::Status WriteReply(const ParsedArgs& a, const std::string& server,
 
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
-                   ParseArgs(args, {"plan-id", "waypoint", "at", "distance", "method", "seed", "server",
-                                    "deadline-ms", "out", "map-id"},
+                   ParseArgs(args, WithConnectionFlags({"plan-id", "waypoint", "at", "distance", "method", "seed",
+                                                        "server", "deadline-ms", "out", "map-id"}),
                              {}, {"obstacle", "obstacle-cell", "obstacle-point"}));
   v1::ReplanRequest request;
   if (!a.Get("plan-id")) return absl::InvalidArgumentError("--plan-id P is required");
@@ -153,8 +154,8 @@ absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
   if (seed) request.set_seed(static_cast<uint32_t>(*seed));
   ASSIGN_OR_RETURN(std::optional<absl::Duration> timeout, ParseDeadlineFlag(a));
-  const std::string server = a.Get("server").value_or("127.0.0.1:50051");
-  return WriteReply(a, server,
+  ASSIGN_OR_RETURN(Connection server, ConnectionFromArgs(a, a.Get("server").value_or(kDefaultServer)));
+  return WriteReply(a, server.target,
                     RemotePlanner::Connect(server)->Replan(request, timeout, a.Get("map-id").value_or("")));
 }
 
@@ -164,6 +165,7 @@ constexpr char kResumeUsage[] =
     "                      [--obstacle AREA]... [--obstacle-cell ROW,COL]... [--obstacle-point X,Y]...\n"
     "                      [--method auto|ilp1|ilp2|greedy_detour|full] [--seed N]\n"
     "                      [--server HOST:PORT] [--deadline-ms D] [--out plan.json]\n"
+    "                      [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
     "Continues plan P after an interruption (battery swap, e-stop, restart): the robot\n"
     "is now at --at (e.g. on its dock); the new plan drives back to where it stopped and\n"
     "on over what it had not covered. Where it stopped: --waypoint K --stopped-at X,Y\n"
@@ -174,8 +176,8 @@ constexpr char kResumeUsage[] =
 
 absl::Status RunResume(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
-                   ParseArgs(args, {"plan-id", "at", "waypoint", "stopped-at", "distance", "method", "seed",
-                                    "server", "deadline-ms", "out"},
+                   ParseArgs(args, WithConnectionFlags({"plan-id", "at", "waypoint", "stopped-at", "distance",
+                                                        "method", "seed", "server", "deadline-ms", "out"}),
                              {}, {"obstacle", "obstacle-cell", "obstacle-point"}));
   v1::ResumeRequest request;
   if (!a.Get("plan-id")) return absl::InvalidArgumentError("--plan-id P is required");
@@ -212,8 +214,8 @@ absl::Status RunResume(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
   if (seed) request.set_seed(static_cast<uint32_t>(*seed));
   ASSIGN_OR_RETURN(std::optional<absl::Duration> timeout, ParseDeadlineFlag(a));
-  const std::string server = a.Get("server").value_or("127.0.0.1:50051");
-  return WriteReply(a, server, RemotePlanner::Connect(server)->Resume(request, timeout));
+  ASSIGN_OR_RETURN(Connection server, ConnectionFromArgs(a, a.Get("server").value_or(kDefaultServer)));
+  return WriteReply(a, server.target, RemotePlanner::Connect(server)->Resume(request, timeout));
 }
 
 }  // namespace

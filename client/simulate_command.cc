@@ -33,6 +33,7 @@ constexpr char kUsage[] =
     "                        (--true-map TRUE | --clutter PCT) [--seed N]\n"
     "                        [--method auto|ilp1|ilp2|greedy_detour|full] [--sensor-range M]\n"
     "                        [--local | --server HOST:PORT] [--svg run.svg] [--time-limit S] [--step S]\n"
+    "                        [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
     "                        [--replan-tour-limit S] [--clutter-may-disconnect]\n"
     "                        [--no-offline-bound]\n"
     "                        [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
@@ -218,11 +219,11 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
                                                 const RemotePlanSourceFactory& make_remote) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args,
-                             {"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
+                             WithConnectionFlags({"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
                               "sensor-range", "svg", "time-limit", "step", "max-speed", "acceleration",
                               "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit",
                               "planner", "battery-capacity", "station", "reserve", "energy-per-metre",
-                              "energy-per-turn", "energy-per-second", "atomic-units", "recharge-s"},
+                              "energy-per-turn", "energy-per-second", "atomic-units", "recharge-s"}),
                              {"local", "negate", "clutter-may-disconnect", "no-offline-bound", "interruptible"}));
   if (a.Get("server") && a.Has("local")) return absl::InvalidArgumentError("give --local or --server, not both");
   if (a.Get("server") && a.Get("server")->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
@@ -306,7 +307,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     flags.free_thresh = free_thresh;
     flags.occupied_thresh = occupied_thresh;
     flags.negate = load.negate;
-    ASSIGN_OR_RETURN(remote, make_remote(*server, *a.Get("map"), flags, o));
+    ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, *server));
+    ASSIGN_OR_RETURN(remote, make_remote(connection, *a.Get("map"), flags, o));
   }
   absl::StatusOr<SimulationResult> simulated = Simulate(known, truth, o, remote.get());
   if (!simulated.ok()) return o.plan.battery ? WithFlagNames(simulated.status()) : simulated.status();

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "client/connection.h"
 #include "planner/sim/simulator.h"
 
 namespace covplan {
@@ -31,11 +32,12 @@ struct SimulateMapFlags {
   std::optional<double> resolution, free_thresh, occupied_thresh;
   bool negate = false;
 };
-// Makes the PlanSource of --server HOST:PORT for the known map file. The
+// Makes the PlanSource of --server HOST:PORT (with the connection flags,
+// client/connection.h) for the known map file. The
 // covplan binary passes client/simulate_remote.h's; without one, --server is
 // refused. (This unit stays free of gRPC: the simulator tests compile it.)
 using RemotePlanSourceFactory = std::function<absl::StatusOr<std::unique_ptr<PlanSource>>(
-    const std::string& target, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
     const SimulationOptions& options)>;
 
 // Returns the process exit code; the JSON goes to stdout, errors to stderr.

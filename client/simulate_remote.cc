@@ -143,7 +143,7 @@ class ServerPlanSource final : public PlanSource {
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const std::string& target,
+absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const Connection& server,
                                                                     const std::string& known_map_path,
                                                                     const SimulateMapFlags& flags,
                                                                     const SimulationOptions& options) {
@@ -154,7 +154,7 @@ absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const std::s
   if (flags.negate) overrides.negate = true;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(known_map_path, overrides, InputLimits()));
   return std::unique_ptr<PlanSource>(
-      new ServerPlanSource(RemotePlanner::Connect(target), std::move(map), options));
+      new ServerPlanSource(RemotePlanner::Connect(server), std::move(map), options));
 }
 
 }  // namespace covplan

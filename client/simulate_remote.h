@@ -24,7 +24,7 @@
 namespace covplan {
 
 // A RemotePlanSourceFactory (client/simulate_command.h).
-absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const std::string& target,
+absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const Connection& server,
                                                                     const std::string& known_map_path,
                                                                     const SimulateMapFlags& flags,
                                                                     const SimulationOptions& options);

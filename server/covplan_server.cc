@@ -98,9 +98,20 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   if (!store.ok()) return store.status();
   server->store_ = std::move(*store);
   if (!config.index_in_background) server->LogIndexed(absl::ZeroDuration());
+  if (!config.token_file.empty()) {
+    absl::StatusOr<std::unique_ptr<TenantTokens>> tokens = TenantTokens::Load(config.token_file);
+    if (!tokens.ok()) return tokens.status();
+    server->tokens_ = std::move(*tokens);
+    const bool loopback = config.address == "127.0.0.1" || config.address == "localhost" ||
+                          config.address == "::1" || config.address == "[::1]";
+    if (config.tls_cert_file.empty() && !loopback) {
+      LogLine("warn", "bearer tokens on a plaintext port beyond loopback travel in the clear; use --tls_cert",
+              {{"address", config.address}});
+    }
+  }
   server->metrics_ = std::make_unique<ServerMetrics>();
   server->service_ = std::make_unique<CoveragePlannerService>(
-      config.service, server->store_.get(), server->metrics_.get());
+      config.service, server->store_.get(), server->metrics_.get(), server->tokens_.get());
 
   if (config.metrics_port >= 0) {
     const std::string bind = absl::StrCat(config.metrics_address, ":", config.metrics_port);
@@ -171,8 +182,21 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
            {"store_dir", config.store_dir},
            {"maps", absl::StrCat(server->store_->size())},
            {"workers", absl::StrCat(config.service.worker_threads)},
+           {"tokens", server->tokens_ == nullptr ? "off" : absl::StrCat(server->tokens_->size())},
            {"queue", absl::StrCat(config.service.max_queue)}});
   return server;
+}
+
+absl::Status CovplanServer::ReloadTokens() {
+  if (tokens_ == nullptr) return absl::OkStatus();
+  absl::StatusOr<size_t> loaded = tokens_->Reload();
+  if (!loaded.ok()) {
+    LogLine("error", "token file not reloaded; the previous tokens stay in force",
+            {{"detail", std::string(loaded.status().message())}});
+    return loaded.status();
+  }
+  LogLine("info", "token file reloaded", {{"tokens", absl::StrCat(*loaded)}});
+  return absl::OkStatus();
 }
 
 void CovplanServer::LogIndexed(absl::Duration took) {

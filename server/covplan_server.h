@@ -60,6 +60,10 @@ struct ServerConfig {
   std::string tls_cert_file;
   std::string tls_key_file;
   std::string tls_client_ca_file;
+  // Bearer tokens (server/tenant_tokens.h): with a file, every
+  // CoveragePlanner call needs a token of a tenant (health and reflection
+  // stay open) and sees only that tenant's maps and plans. Empty: open.
+  std::string token_file;
   ServiceOptions service;
 };
 
@@ -85,6 +89,10 @@ class CovplanServer {
   // cancels what is left (health Watch streams included) and stops.
   void Drain(absl::Duration grace);
 
+  // Rereads the token file (SIGHUP); on error the previous tokens stay and
+  // the error is returned. OK and nothing done without a token file.
+  absl::Status ReloadTokens();
+
  private:
   CovplanServer() = default;
   // Logs the corrupted maps and the size of the index.
@@ -93,6 +101,7 @@ class CovplanServer {
   void ProbeStoreLoop(absl::Duration interval);
 
   std::unique_ptr<MapRepository> store_;
+  std::unique_ptr<TenantTokens> tokens_;  // null without --token_file
   std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;

@@ -32,8 +32,12 @@ struct DriveSession::Actions {
 };
 
 DriveSession::DriveSession(CoveragePlannerService* service, grpc::CallbackServerContext* context,
-                           SessionRegistry* registry, std::string session_id)
-    : service_(service), context_(context), registry_(registry), session_id_(std::move(session_id)) {}
+                           SessionRegistry* registry, std::string session_id, std::string tenant_tag)
+    : service_(service),
+      context_(context),
+      registry_(registry),
+      session_id_(std::move(session_id)),
+      tenant_tag_(std::move(tenant_tag)) {}
 
 void DriveSession::Start() {
   {
@@ -296,7 +300,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
   std::shared_ptr<const Grid> grid;
   std::string adopted;
   if (job.start) {
-    absl::StatusOr<CoveragePlannerService::AdoptedPlan> plan = service_->AdoptPlan(first, stop);
+    absl::StatusOr<CoveragePlannerService::AdoptedPlan> plan = service_->AdoptPlan(first, stop, tenant_tag_);
     status = plan.status();
     if (plan.ok()) {
       adopted = plan->plan_id;
@@ -317,6 +321,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     call.method = "Drive.Replan";
     call.start = absl::Now();
     call.request_id = absl::StrCat(session_id_, "/", job.sequence);
+    call.tenant_tag = tenant_tag_;
     status = service_->RunReplan(call, request, stop, event.mutable_replan());
     service_->RecordCall(call, status,
                          status.ok() ? ReplanDetail(event.replan()) : std::string(status.message()));

@@ -3,6 +3,7 @@
 //   covplan-server --address=127.0.0.1 --port=50051 --metrics_port=9464
 //                  --store_dir=./covplan-data/maps --threads=2
 //
+// SIGHUP: rereads --token_file (a bad file keeps the previous tokens).
 // SIGTERM / SIGINT: health goes NOT_SERVING, new work is refused, in-flight
 // calls get --drain_grace_s to finish (then running plans answer with their
 // best so far), and the process exits 0 within the grace plus 1.5 s. A signal
@@ -59,6 +60,10 @@ ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain for TLS on the gRPC 
 ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 ABSL_FLAG(std::string, tls_client_ca, "",
           "PEM CA that client certificates must chain to (mutual TLS); empty = no client certificates");
+ABSL_FLAG(std::string, token_file, "",
+          "File of \"<sha256 hex of a bearer token> <tenant>\" lines; every call then needs "
+          "\"authorization: Bearer <token>\" and sees only its tenant's maps and plans (health and "
+          "reflection stay open). Reread on SIGHUP. Empty = no tokens");
 ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
@@ -119,15 +124,27 @@ int main(int argc, char** argv) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   // 0 until a signal arrives; -1 once the server runs (the main thread then
   // owns the drain).
   static std::atomic<int> received{0};
   static std::atomic<bool> started{false};
   static absl::Mutex signal_mu;
+  // The running server, for SIGHUP (null before start and once draining).
+  static covplan::CovplanServer* running = nullptr;  // guarded by signal_mu
   std::thread([] {
     int signal_number = 0;
-    sigwait(&signals, &signal_number);
+    while (true) {
+      sigwait(&signals, &signal_number);
+      if (signal_number != SIGHUP) break;
+      absl::MutexLock lock(&signal_mu);
+      if (running == nullptr) {
+        covplan::LogLine("info", "SIGHUP ignored: server not running");
+      } else {
+        (void)running->ReloadTokens();  // logs its outcome
+      }
+    }
     absl::MutexLock lock(&signal_mu);
     received.store(signal_number);
     if (!started.load()) {
@@ -175,6 +192,7 @@ int main(int argc, char** argv) {
   config.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
   config.tls_key_file = absl::GetFlag(FLAGS_tls_key);
   config.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
+  config.token_file = absl::GetFlag(FLAGS_token_file);
   // The port opens at once; health says NOT_SERVING until the store is indexed.
   config.index_in_background = true;
   covplan::ServiceOptions& service = config.service;
@@ -202,12 +220,17 @@ int main(int argc, char** argv) {
   {
     absl::MutexLock lock(&signal_mu);
     started.store(true);
+    running = server->get();
   }
   // Wait for the signal thread to record a signal.
   {
     absl::MutexLock lock(&signal_mu);
     signal_mu.Await(absl::Condition(
         +[](std::atomic<int>* r) { return r->load() != 0; }, &received));
+  }
+  {
+    absl::MutexLock lock(&signal_mu);
+    running = nullptr;  // no reload while the server drains and is destroyed
   }
   covplan::LogLine("info", "signal received, shutting down",
                    {{"signal", absl::StrCat(received.load())}});

@@ -20,6 +20,15 @@ namespace {
 
 constexpr char kEstimatorFile[] = "replan_estimator.txt";
 
+// The answers for an id that does not exist, also given for another
+// tenant's id, so a caller cannot tell the two apart.
+absl::Status MapNotFound(const std::string& map_id) {
+  return absl::NotFoundError(absl::StrCat("unknown map_id ", map_id.substr(0, 80), "; PutMap it first"));
+}
+absl::Status PlanNotFound(const std::string& plan_id) {
+  return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", plan_id.substr(0, 80), "'"));
+}
+
 // Status messages are bounded (they travel in trailing metadata, whose size
 // the client limits; an over-long one would turn the real error into
 // RESOURCE_EXHAUSTED on the client).
@@ -122,9 +131,10 @@ absl::Status ServiceOptions::Validate() const {
 }
 
 CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, MapRepository* store,
-                                               ServerMetrics* metrics)
+                                               ServerMetrics* metrics, const TenantTokens* tokens)
     : options_(options),
       store_(store),
+      tokens_(tokens),
       metrics_(metrics),
       cache_(options.cache_budget_bytes, metrics),
       registry_(PlannerRegistry::WithBuiltins()),
@@ -183,6 +193,17 @@ CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
                                       next_id_.fetch_add(1, std::memory_order_relaxed));
   }
   context->AddInitialMetadata("x-request-id", call.request_id);
+  if (tokens_ != nullptr) {
+    auto it = metadata.find("authorization");
+    const absl::string_view authorization =
+        it == metadata.end() ? absl::string_view() : absl::string_view(it->second.data(), it->second.size());
+    absl::StatusOr<std::string> tenant = tokens_->Authenticate(authorization);
+    if (tenant.ok()) {
+      call.tenant_tag = TenantTag(*tenant);
+    } else {
+      call.auth = tenant.status();
+    }
+  }
   return call;
 }
 
@@ -273,7 +294,7 @@ void CoveragePlannerService::ReleaseSolve() { admitted_.fetch_sub(1); }
 
 void CoveragePlannerService::UpdateQueueGauges() { metrics_->queue_depth().Set(pool_.queued()); }
 
-std::string CoveragePlannerService::NewPlanId() {
+std::string CoveragePlannerService::NewPlanId(const std::string& tenant_tag) {
   // 128 bits from the kernel's CSPRNG: a plan id cannot be guessed from
   // another one.
   unsigned char bytes[16];
@@ -291,16 +312,18 @@ std::string CoveragePlannerService::NewPlanId() {
   }
   std::string id = "p-";
   for (unsigned char b : bytes) absl::StrAppendFormat(&id, "%02x", b);
-  return id;
+  return id + PlanIdSuffix(tenant_tag);
 }
 
 // ---------------------------------------------------------------- maps
 
 absl::Status CoveragePlannerService::RunPutMap(const v1::PutMapRequest& request,
+                                               const std::string& tenant_tag,
                                                v1::PutMapResponse* response) {
   ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), options_.limits));
   RETURN_IF_ERROR(CheckSiteGeometry(site));
-  const std::string map_id = ComputeMapId(request.map());
+  // Per tenant: the same content stored by two tenants is two maps.
+  const std::string map_id = ScopedMapId(ComputeMapId(request.map()), tenant_tag);
   v1::MapInfo info = MapInfoFor(site, map_id);
   info.set_name(request.name());
   ASSIGN_OR_RETURN(bool created, store_->Put(info, request.map()));
@@ -323,6 +346,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerCon
                                                          v1::PutMapResponse* response) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "PutMap");
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
@@ -334,7 +361,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::PutMap(grpc::CallbackServerCon
   if (!SubmitIo([this, reactor, call, request, response] {
         // Work whose caller gave up while it was queued is dropped unstarted.
         absl::Status status = QueuedTooLong(call, reactor->cancel());
-        if (status.ok()) status = RunPutMap(*request, response);
+        if (status.ok()) status = RunPutMap(*request, call.tenant_tag, response);
         FinishCall(reactor, call, status, response->map_id());
         MaybeTrimMemory(absl::Now() - call.start);
       })) {
@@ -348,6 +375,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerCon
                                                          v1::GetMapResponse* response) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "GetMap");
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
     FinishCall(reactor, call, s);
     return reactor;
@@ -358,7 +389,12 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetMap(grpc::CallbackServerCon
           FinishCall(reactor, call, s);
           return;
         }
-        absl::StatusOr<v1::GetMapResponse> stored = store_->Get(request->map_id());
+        // Another tenant's map answers as a missing one.
+        absl::StatusOr<v1::GetMapResponse> stored = MapNotFound(request->map_id());
+        if (OwnsMap(call.tenant_tag, request->map_id()) || !ValidateMapId(request->map_id()).ok()) {
+          stored = store_->Get(request->map_id());  // a malformed id: INVALID_ARGUMENT for all
+        }
+        if (absl::IsNotFound(stored.status())) stored = MapNotFound(request->map_id());
         if (absl::IsDataLoss(stored.status())) cache_.EraseWithPrefix(request->map_id() + "/");
         if (stored.ok()) {
           *response->mutable_info() = stored->info();
@@ -377,6 +413,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
                                                            v1::ListMapsResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "ListMaps");
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
     FinishCall(reactor, call, s);
     return reactor;
@@ -405,6 +445,29 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
     FinishCall(reactor, call, page.status());
     return reactor;
   }
+  if (!call.tenant_tag.empty()) {
+    // Only the caller's maps: keep reading pages until this one is full.
+    const auto foreign = [&](const std::string& id) { return !OwnsMap(call.tenant_tag, id); };
+    corrupted.erase(std::remove_if(corrupted.begin(), corrupted.end(), foreign), corrupted.end());
+    std::vector<v1::MapInfo> mine;
+    while (true) {
+      const std::string last = page->empty() ? "" : page->back().map_id();
+      for (v1::MapInfo& info : *page) {
+        if (!foreign(info.map_id())) mine.push_back(std::move(info));
+      }
+      if (!more || static_cast<int>(mine.size()) >= page_size || last.empty()) break;
+      page = store_->ListPage(last, page_size, &more, nullptr);
+      if (!page.ok()) {
+        FinishCall(reactor, call, page.status());
+        return reactor;
+      }
+    }
+    if (static_cast<int>(mine.size()) > page_size) {
+      mine.resize(page_size);
+      more = true;
+    }
+    *page = std::move(mine);
+  }
   for (v1::MapInfo& info : *page) {
     // Names are bounded at PutMap; older stores may hold longer ones.
     if (info.name().size() > kMapNameLimit) info.mutable_name()->resize(kMapNameLimit);
@@ -424,6 +487,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
                                                             v1::DeleteMapResponse* response) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "DeleteMap");
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
     FinishCall(reactor, call, s);
     return reactor;
@@ -433,7 +500,11 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
           FinishCall(reactor, call, s);
           return;
         }
-        absl::StatusOr<bool> deleted = store_->Delete(request->map_id());
+        // Another tenant's map answers as a missing one: nothing deleted.
+        absl::StatusOr<bool> deleted = false;
+        if (OwnsMap(call.tenant_tag, request->map_id()) || !ValidateMapId(request->map_id()).ok()) {
+          deleted = store_->Delete(request->map_id());
+        }
         if (deleted.ok()) {
           response->set_deleted(*deleted);
           cache_.EraseWithPrefix(request->map_id() + "/");
@@ -455,7 +526,10 @@ MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
   source.load = [this, map_id, inline_map]() -> absl::StatusOr<SiteMap> {
     v1::GetMapResponse stored;
     if (inline_map == nullptr) {
-      ASSIGN_OR_RETURN(stored, store_->Get(map_id));
+      absl::StatusOr<v1::GetMapResponse> got = store_->Get(map_id);
+      if (absl::IsNotFound(got.status())) return MapNotFound(map_id);
+      if (!got.ok()) return got.status();
+      stored = std::move(*got);
     }
     ASSIGN_OR_RETURN(SiteMap site,
                      SiteFromProto(inline_map != nullptr ? *inline_map : stored.map(), options_.limits));
@@ -521,8 +595,11 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     case v1::PlanRequest::kMapId:
       RETURN_IF_ERROR(ValidateMapId(request.map_id()));
       map_id = request.map_id();
+      if (!OwnsMap(call.tenant_tag, map_id)) return MapNotFound(map_id);
       // A deleted map, or one found damaged, is not planned from the cache.
-      RETURN_IF_ERROR(store_->Check(map_id));
+      if (absl::Status s = store_->Check(map_id); !s.ok()) {
+        return absl::IsNotFound(s) ? MapNotFound(map_id) : s;
+      }
       break;
     case v1::PlanRequest::kMap:
       map_id = ComputeMapId(request.map());
@@ -548,7 +625,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
                : result.status();
   }
   auto retained = std::make_shared<RetainedPlan>();
-  retained->plan_id = NewPlanId();
+  retained->plan_id = NewPlanId(call.tenant_tag);
   retained->map_id = map_id;
   retained->plan = std::move(result->plan);
   retained->area = std::move(result->area);
@@ -575,6 +652,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
                                                        v1::PlanResponse* response) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "Plan");
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
@@ -646,17 +727,19 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
                                                           v1::PlanResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   CallInfo call = StartCall(context, "GetPlan");
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
     FinishCall(reactor, call, s);
     return reactor;
   }
-  std::shared_ptr<const RetainedPlan> plan = plans_.Get(request->plan_id());
+  std::shared_ptr<const RetainedPlan> plan =
+      OwnsPlan(call.tenant_tag, request->plan_id()) ? plans_.Get(request->plan_id()) : nullptr;
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   if (plan == nullptr) {
-    FinishCall(
-        reactor, call,
-        absl::NotFoundError(
-            absl::StrCat("unknown or expired plan_id '", QuotePrefix(request->plan_id()), "'")));
+    FinishCall(reactor, call, PlanNotFound(request->plan_id()));
     return reactor;
   }
   RetainedPlanToProto(*plan, response);  // in memory, no blocking
@@ -743,25 +826,25 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
                      ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
                      : cancel.WithEarlierDeadline(start + options_.max_request_time);
   ResolvedPlan old;
-  RETURN_IF_ERROR(ResolvePlan(request.plan_id(),
+  RETURN_IF_ERROR(ResolvePlan(call.tenant_tag, request.plan_id(),
                               request.plan_ref_case() == v1::ReplanRequest::kPlan ? &request.plan() : nullptr,
                               options.stop, &old));
   ASSIGN_OR_RETURN(ReplanResult result,
                    covplan::Replan(*old.plan, progress, ObstaclesFromProto(request.obstacles()), options,
                                    &estimator_));
   if (request.plan_ref_case() == v1::ReplanRequest::kPlanId) RecordProgress(request.plan_id(), request.progress());
-  KeepReplan(std::move(result), old, response);
+  KeepReplan(std::move(result), old, call.tenant_tag, response);
   return absl::OkStatus();
 }
 
-absl::Status CoveragePlannerService::ResolvePlan(const std::string& plan_id, const v1::InlinePlan* inline_plan,
-                                                 const StopToken& stop, ResolvedPlan* out) {
+absl::Status CoveragePlannerService::ResolvePlan(const std::string& tenant_tag, const std::string& plan_id,
+                                                 const v1::InlinePlan* inline_plan, const StopToken& stop,
+                                                 ResolvedPlan* out) {
   if (inline_plan == nullptr) {
     if (plan_id.empty()) return absl::InvalidArgumentError("needs plan_id or an inline plan");
+    if (!OwnsPlan(tenant_tag, plan_id)) return PlanNotFound(plan_id);
     out->plan = FindPlan(plan_id, stop, &out->origin);
-    if (out->plan == nullptr) {
-      return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", plan_id.substr(0, 80), "'"));
-    }
+    if (out->plan == nullptr) return PlanNotFound(plan_id);
     out->has_origin = out->origin.map_ref_case() == v1::PlanRequest::kMapId;
     return absl::OkStatus();
   }
@@ -771,6 +854,7 @@ absl::Status CoveragePlannerService::ResolvePlan(const std::string& plan_id, con
   if (pr.map_ref_case() == v1::PlanRequest::kMapId) {
     RETURN_IF_ERROR(ValidateMapId(pr.map_id()));
     map_id = pr.map_id();
+    if (!OwnsMap(tenant_tag, map_id)) return MapNotFound(map_id);
   } else if (pr.map_ref_case() == v1::PlanRequest::kMap) {
     map_id = ComputeMapId(pr.map());
     inline_map = std::make_shared<const v1::Map>(pr.map());
@@ -786,9 +870,9 @@ absl::Status CoveragePlannerService::ResolvePlan(const std::string& plan_id, con
 }
 
 void CoveragePlannerService::KeepReplan(ReplanResult result, const ResolvedPlan& old,
-                                        v1::ReplanResponse* response) {
+                                        const std::string& tenant_tag, v1::ReplanResponse* response) {
   auto retained = std::make_shared<RetainedPlan>();
-  retained->plan_id = NewPlanId();
+  retained->plan_id = NewPlanId(tenant_tag);
   retained->map_id = old.plan->map_id;
   retained->plan = std::move(result.plan);
   retained->area = result.area;
@@ -819,6 +903,10 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
     std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, method);
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
@@ -900,7 +988,7 @@ absl::Status CoveragePlannerService::RunResume(const CallInfo& call, const v1::R
                      ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
                      : cancel.WithEarlierDeadline(start + options_.max_request_time);
   ResolvedPlan old;
-  RETURN_IF_ERROR(ResolvePlan(request.plan_id(), nullptr, options.stop, &old));
+  RETURN_IF_ERROR(ResolvePlan(call.tenant_tag, request.plan_id(), nullptr, options.stop, &old));
   v1::RobotProgress at;
   std::string source;
   if (request.has_progress()) {
@@ -928,7 +1016,7 @@ absl::Status CoveragePlannerService::RunResume(const CallInfo& call, const v1::R
                      result.status().message()));
   }
   RecordProgress(request.plan_id(), at);
-  KeepReplan(std::move(*result), old, response);
+  KeepReplan(std::move(*result), old, call.tenant_tag, response);
   response->mutable_replan()->set_progress_source(source);
   response->mutable_replan()->set_rejoin_m(rejoin_m);
   return absl::OkStatus();
@@ -950,11 +1038,16 @@ grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* CoveragePlannerServic
   const CallInfo call = StartCall(context, "Drive");
   // A session is not a unary call the drain waits for: StartDraining ends it.
   active_calls_.fetch_sub(1);
+  if (!call.auth.ok()) {
+    RecordCall(call, call.auth);
+    return new RefusedDrive(ToGrpc(call.auth));
+  }
   if (draining()) {
     metrics_->RecordRequest("Drive", "UNAVAILABLE", 0.0);
     return new RefusedDrive(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
   }
-  auto* session = new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id));
+  auto* session =
+      new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id), call.tenant_tag);
   if (!sessions_.Add(session)) {
     session->Unref();
     metrics_->RecordRequest("Drive", "RESOURCE_EXHAUSTED", 0.0);
@@ -970,10 +1063,10 @@ grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* CoveragePlannerServic
 }
 
 absl::StatusOr<CoveragePlannerService::AdoptedPlan> CoveragePlannerService::AdoptPlan(
-    const v1::DriveRequest& first, const StopToken& stop) {
+    const v1::DriveRequest& first, const StopToken& stop, const std::string& tenant_tag) {
   const StopToken bounded = stop.WithEarlierDeadline(absl::Now() + options_.max_request_time);
   ResolvedPlan resolved;
-  RETURN_IF_ERROR(ResolvePlan(first.plan_id(),
+  RETURN_IF_ERROR(ResolvePlan(tenant_tag, first.plan_id(),
                               first.plan_ref_case() == v1::DriveRequest::kPlan ? &first.plan() : nullptr, bounded,
                               &resolved));
   AdoptedPlan out;
@@ -984,7 +1077,7 @@ absl::StatusOr<CoveragePlannerService::AdoptedPlan> CoveragePlannerService::Adop
   }
   // An inline plan: retained under a new id so the session's replans name it.
   auto retained = std::make_shared<RetainedPlan>(*resolved.plan);
-  retained->plan_id = NewPlanId();
+  retained->plan_id = NewPlanId(tenant_tag);
   out.plan_id = retained->plan_id;
   if (resolved.has_origin) {
     v1::PlanResponse proto;

@@ -50,6 +50,7 @@
 #include "server/map_store.h"
 #include "server/metrics.h"
 #include "server/plan_registry.h"
+#include "server/tenant_tokens.h"
 #include "server/worker_pool.h"
 
 namespace covplan {
@@ -84,6 +85,10 @@ struct CallInfo {
   std::string request_id;
   absl::Time start;
   absl::Time deadline = absl::InfiniteFuture();
+  // With --token_file: the caller's tenant tag (server/tenant_tokens.h), or
+  // `auth` says why the call is refused. Empty tag and OK without one.
+  std::string tenant_tag;
+  absl::Status auth;
 };
 
 // One log line's summary of a replan reply.
@@ -91,7 +96,10 @@ std::string ReplanDetail(const v1::ReplanResponse& response);
 
 class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService {
  public:
-  CoveragePlannerService(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics);
+  // `tokens` (optional, outlives the service): every call must carry a
+  // bearer token of a tenant, and sees only that tenant's maps and plans.
+  CoveragePlannerService(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics,
+                         const TenantTokens* tokens = nullptr);
   ~CoveragePlannerService() override;
 
   grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
@@ -162,7 +170,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
     std::string plan_id;
     std::shared_ptr<const Grid> grid;
   };
-  absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first, const StopToken& stop);
+  absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first, const StopToken& stop,
+                                        const std::string& tenant_tag);
   // Runs `work` on the solve pool under the same admission bound as unary
   // solves; false (and `work` dropped) when the server is full or draining.
   bool SubmitSolve(std::function<void()> work);
@@ -188,13 +197,14 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // free.
   bool TryAdmitSolve();
   void ReleaseSolve();
-  absl::Status RunPutMap(const v1::PutMapRequest& request, v1::PutMapResponse* response);
+  absl::Status RunPutMap(const v1::PutMapRequest& request, const std::string& tenant_tag,
+                         v1::PutMapResponse* response);
   // The map, inline or from the store, loaded only when an artifact is built.
   MapSource SourceFor(const std::string& map_id, std::shared_ptr<const v1::Map> inline_map);
   // Queues the artifacts of `request` on the background pool (dropped when
   // it is full).
   void WarmInBackground(const MapSource& source, PlanRequest request);
-  std::string NewPlanId();
+  std::string NewPlanId(const std::string& tenant_tag);
   // Writes the plan (with the original request it continues) to the store;
   // best effort: a failure is logged and counted, the call still succeeds.
   void PersistPlan(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
@@ -208,10 +218,11 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
     v1::PlanRequest origin;
     bool has_origin = false;  // on a stored map: its replans are persisted
   };
-  absl::Status ResolvePlan(const std::string& plan_id, const v1::InlinePlan* inline_plan,
-                           const StopToken& stop, ResolvedPlan* out);
+  absl::Status ResolvePlan(const std::string& tenant_tag, const std::string& plan_id,
+                           const v1::InlinePlan* inline_plan, const StopToken& stop, ResolvedPlan* out);
   // Retains (and persists) a replan's result and fills the reply.
-  void KeepReplan(ReplanResult result, const ResolvedPlan& old, v1::ReplanResponse* response);
+  void KeepReplan(ReplanResult result, const ResolvedPlan& old, const std::string& tenant_tag,
+                  v1::ReplanResponse* response);
   // A unary solve (Replan, Resume): admission, the pool, the reply.
   grpc::ServerUnaryReactor* ServeSolve(
       grpc::CallbackServerContext* context, const char* method, const google::protobuf::Message* request,
@@ -220,6 +231,7 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
 
   const ServiceOptions options_;
   MapRepository* const store_;
+  const TenantTokens* const tokens_;
   ServerMetrics* const metrics_;
   ArtifactLru cache_;
   const PlannerRegistry registry_;
