@@ -348,7 +348,10 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   // The robot is 5 m along the first cycle: every station arrival is ahead of it.
   ASSERT_GT(res->plan.cycles.front().leave_waypoint, 2);
   EXPECT_EQ(station_visits(detoured->plan.path, 1), station_visits(res->plan.path, 1));
-  EXPECT_EQ(station_visits(res->plan.path, 1), static_cast<int>(res->plan.cycles.size()));
+  // Every cycle but the last ends on a return leg; the last one may reach
+  // the station on the tour's own last segment (when the tour ends there).
+  EXPECT_GE(station_visits(res->plan.path, 1), static_cast<int>(res->plan.cycles.size()) - 1);
+  EXPECT_LE(station_visits(res->plan.path, 1), static_cast<int>(res->plan.cycles.size()));
   EXPECT_TRUE(detoured->plan.cycles.empty());  // the cycle table is the caller's to recompute
   EXPECT_EQ(detoured->stats.method, "greedy_detour");
   // A replan of the replan is a battery plan too: its station legs survive only the greedy detour.
