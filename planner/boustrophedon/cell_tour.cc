@@ -130,18 +130,7 @@ double CellTourModel::Between(int u, int v) const {
 
 void CellTourModel::BuildPath(const std::vector<int>& vertices, std::vector<Waypoint>* path,
                               std::vector<CoverageSweep>* sweeps) const {
-  Point2 at{start_.x, start_.y};
-  double heading = start_.theta;
-  path->push_back({at.x, at.y, heading, SegmentKind::kStart, -1});
-  auto transit = [&](const std::vector<Point2>& pts) {
-    for (size_t i = 1; i < pts.size(); ++i) {
-      const double dx = pts[i].x - at.x, dy = pts[i].y - at.y;
-      if (std::hypot(dx, dy) < kMinSegmentM) continue;
-      heading = std::atan2(dy, dx);
-      at = pts[i];
-      path->push_back({at.x, at.y, heading, SegmentKind::kTransition, -1});
-    }
-  };
+  PolylinePathWriter writer(start_, path, sweeps);
   std::vector<Point2> pts;
   for (size_t i = 0; i < vertices.size(); ++i) {
     const int v = vertices[i];
@@ -150,24 +139,10 @@ void CellTourModel::BuildPath(const std::vector<int>& vertices, std::vector<Wayp
     } else {
       TransitionPoints(vertices[i - 1], v, &pts);
     }
-    transit(pts);
-    const PolylineElement& el = Element(v);
-    const bool forward = v % 2 == 0;
-    const int segs = static_cast<int>(el.kinds.size());
-    heading = heading_in_[v];
-    for (int k = 0; k < segs; ++k) {
-      const int s = forward ? k : segs - 1 - k;
-      const Point2 to = forward ? el.points[s + 1] : el.points[s];
-      const double dx = to.x - at.x, dy = to.y - at.y;
-      const bool coverage = el.kinds[s] == SegmentKind::kCoverage;
-      if (std::hypot(dx, dy) < kMinSegmentM && !coverage) continue;
-      if (std::hypot(dx, dy) >= kMinSegmentM) heading = std::atan2(dy, dx);
-      at = to;
-      path->push_back({at.x, at.y, heading, el.kinds[s], coverage ? el.tags[s] : -1});
-      if (coverage) sweeps->push_back({static_cast<int>(path->size()) - 1, el.sweeps[s]});
-    }
+    writer.Transit(pts);
+    writer.Drive(Element(v), v % 2 == 0, heading_in_[v]);
   }
-  if (!vertices.empty()) transit(end_paths_[vertices.back()]);
+  if (!vertices.empty()) writer.Transit(end_paths_[vertices.back()]);
 }
 
 }  // namespace covplan

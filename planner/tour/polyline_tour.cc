@@ -151,18 +151,7 @@ double PolylineTourModel::Between(int u, int v) const {
 
 void PolylineTourModel::BuildPath(const std::vector<int>& vertices, std::vector<Waypoint>* path,
                                   std::vector<CoverageSweep>* sweeps) const {
-  Point2 at{start_.x, start_.y};
-  double heading = start_.theta;
-  path->push_back({at.x, at.y, heading, SegmentKind::kStart, -1});
-  auto transit = [&](const std::vector<Point2>& pts) {
-    for (size_t i = 1; i < pts.size(); ++i) {
-      const double dx = pts[i].x - at.x, dy = pts[i].y - at.y;
-      if (std::hypot(dx, dy) < kMinSegmentM) continue;
-      heading = std::atan2(dy, dx);
-      at = pts[i];
-      path->push_back({at.x, at.y, heading, SegmentKind::kTransition, -1});
-    }
-  };
+  PolylinePathWriter writer(start_, path, sweeps);
   std::vector<Point2> pts;
   for (size_t i = 0; i < vertices.size(); ++i) {
     const int v = vertices[i];
@@ -171,26 +160,42 @@ void PolylineTourModel::BuildPath(const std::vector<int>& vertices, std::vector<
     } else {
       TransitionPoints(vertices[i - 1], v, &pts);
     }
-    transit(pts);
-    const PolylineElement& el = elements_[v / 2];
-    const bool forward = v % 2 == 0;
-    const int segs = static_cast<int>(el.kinds.size());
-    heading = HeadingIn(v);
-    for (int k = 0; k < segs; ++k) {
-      const int s = forward ? k : segs - 1 - k;
-      const Point2 to = forward ? el.points[s + 1] : el.points[s];
-      const double dx = to.x - at.x, dy = to.y - at.y;
-      const bool coverage = el.kinds[s] == SegmentKind::kCoverage;
-      if (std::hypot(dx, dy) < kMinSegmentM && !coverage) continue;
-      if (std::hypot(dx, dy) >= kMinSegmentM) heading = std::atan2(dy, dx);
-      at = to;
-      path->push_back({at.x, at.y, heading, el.kinds[s], coverage ? el.tags[s] : -1});
-      if (coverage) {
-        sweeps->push_back({static_cast<int>(path->size()) - 1, el.sweeps[s]});
-      }
-    }
+    writer.Transit(pts);
+    writer.Drive(elements_[v / 2], v % 2 == 0, HeadingIn(v));
   }
-  if (!vertices.empty()) transit(end_paths_[vertices.back()]);
+  if (!vertices.empty()) writer.Transit(end_paths_[vertices.back()]);
+}
+
+PolylinePathWriter::PolylinePathWriter(const Pose2& start, std::vector<Waypoint>* path,
+                                       std::vector<CoverageSweep>* sweeps)
+    : at_{start.x, start.y}, heading_(start.theta), path_(path), sweeps_(sweeps) {
+  path_->push_back({at_.x, at_.y, heading_, SegmentKind::kStart, -1});
+}
+
+void PolylinePathWriter::Transit(const std::vector<Point2>& pts) {
+  for (size_t i = 1; i < pts.size(); ++i) {
+    const double dx = pts[i].x - at_.x, dy = pts[i].y - at_.y;
+    if (std::hypot(dx, dy) < kMinSegmentM) continue;
+    heading_ = std::atan2(dy, dx);
+    at_ = pts[i];
+    path_->push_back({at_.x, at_.y, heading_, SegmentKind::kTransition, -1});
+  }
+}
+
+void PolylinePathWriter::Drive(const PolylineElement& el, bool forward, double heading_in) {
+  const int segs = static_cast<int>(el.kinds.size());
+  heading_ = heading_in;
+  for (int k = 0; k < segs; ++k) {
+    const int s = forward ? k : segs - 1 - k;
+    const Point2 to = forward ? el.points[s + 1] : el.points[s];
+    const double dx = to.x - at_.x, dy = to.y - at_.y;
+    const bool coverage = el.kinds[s] == SegmentKind::kCoverage;
+    if (std::hypot(dx, dy) < kMinSegmentM && !coverage) continue;
+    if (std::hypot(dx, dy) >= kMinSegmentM) heading_ = std::atan2(dy, dx);
+    at_ = to;
+    path_->push_back({at_.x, at_.y, heading_, el.kinds[s], coverage ? el.tags[s] : -1});
+    if (coverage) sweeps_->push_back({static_cast<int>(path_->size()) - 1, el.sweeps[s]});
+  }
 }
 
 }  // namespace covplan

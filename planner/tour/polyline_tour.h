@@ -91,6 +91,24 @@ class PolylineTourModel final : public TourModel {
   double transitions_ms_ = 0.0;
 };
 
+// Writes a tour's waypoints: transitions given as point lists, and polyline
+// elements driven forwards or backwards (coverage segments keep their tags
+// and sweeps). Shared by the tour models whose elements are polylines.
+class PolylinePathWriter {
+ public:
+  PolylinePathWriter(const Pose2& start, std::vector<Waypoint>* path, std::vector<CoverageSweep>* sweeps);
+  // Drives pts[1..] as transition segments (pts[0] is where the robot is).
+  void Transit(const std::vector<Point2>& pts);
+  // Drives `el` from the end it is entered at, heading `heading_in` there.
+  void Drive(const PolylineElement& el, bool forward, double heading_in);
+
+ private:
+  Point2 at_;
+  double heading_;
+  std::vector<Waypoint>* path_;
+  std::vector<CoverageSweep>* sweeps_;
+};
+
 }  // namespace covplan
 
 #endif  // COVPLAN_PLANNER_TOUR_POLYLINE_TOUR_H_
