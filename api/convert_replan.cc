@@ -74,6 +74,8 @@ void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1:
   o->set_total_ms(s.total_ms);
   o->set_complete(s.newly_unreachable_cells == 0);
   o->set_end_moved(s.end_moved);
+  o->set_robot_cell_blocked(s.robot_cell_blocked);
+  o->set_robot_cell_kept_free(s.robot_cell_kept_free);
   for (const CellIndex& c : result.unreachable) {
     v1::CellRef* r = out->add_unreachable();
     r->set_row(c.row);

@@ -59,6 +59,8 @@ ReplanStats StatsFromProto(const v1::ReplanStats& s) {
   out.tour_ms = s.tour_ms();
   out.total_ms = s.total_ms();
   out.end_moved = s.end_moved();
+  out.robot_cell_blocked = s.robot_cell_blocked();
+  out.robot_cell_kept_free = s.robot_cell_kept_free();
   return out;
 }
 

@@ -83,11 +83,10 @@ absl::StatusOr<Located> Locate(const CoveragePlan& plan, const RobotProgress& pr
   return at;
 }
 
-absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Observations& obs,
-                                                  CellIndex robot_cell) {
+absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Observations& obs) {
   std::vector<uint8_t> blocked(static_cast<size_t>(drive.size()), 0);
   auto block = [&](int r, int c) {
-    if (drive.IsFree(r, c) && !(CellIndex{r, c} == robot_cell)) blocked[drive.Index(r, c)] = 1;
+    if (drive.IsFree(r, c)) blocked[drive.Index(r, c)] = 1;
   };
   for (size_t k = 0; k < obs.cells.size(); ++k) {
     const CellIndex c = obs.cells[k];

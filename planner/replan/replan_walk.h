@@ -37,10 +37,9 @@ struct Located {
 
 absl::StatusOr<Located> Locate(const CoveragePlan& plan, const RobotProgress& progress);
 
-// Per drive-grid cell: 1 when a new obstacle blocks a free cell. The robot's
-// own cell is never blocked (it stands there).
-absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Observations& obs,
-                                                  CellIndex robot_cell);
+// Per drive-grid cell: 1 when a new obstacle blocks a free cell (the robot's
+// own cell included: Replan lets the robot leave it, as a dock cell).
+absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Observations& obs);
 
 // The old path from the robot on, as legs; `covered` gets 1 for every cell
 // swept before the robot's position.

@@ -288,8 +288,7 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
         c.at.at.x, c.at.at.y));
   }
   const CellIndex robot_cell = *joined;
-  ASSIGN_OR_RETURN(std::vector<uint8_t> blocked,
-                   replan_internal::BlockedCells(old_drive, observations, robot_cell));
+  ASSIGN_OR_RETURN(std::vector<uint8_t> blocked, replan_internal::BlockedCells(old_drive, observations));
   std::vector<uint8_t> covered;
   c.legs = replan_internal::RemainingLegs(old.plan, c.at, &covered);
   const Waypoint& last = old.plan.path.back();
@@ -305,9 +304,26 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   }
   {
     const Grid all = old_drive.WithFreeFlags(free);
+    // The robot's own cell reported blocked (it stands in the obstacle's
+    // cell): blocked for the rest of the mission, like a dock's cell, which
+    // the robot leaves by its first move to the nearest free neighbour. Only
+    // a robot walled in on every side keeps its cell (and says so).
+    CellIndex keep_cell = robot_cell;
+    if (blocked[old_drive.Index(robot_cell.row, robot_cell.col)]) {
+      absl::StatusOr<CellIndex> exit = JoinCell(all, Pose2{probe.x, probe.y, 0}, "robot");
+      if (exit.ok()) {
+        keep_cell = *exit;
+        st.robot_cell_blocked = true;
+      } else {
+        const int64_t i = old_drive.Index(robot_cell.row, robot_cell.col);
+        blocked[i] = 0, free[i] = 1, --st.newly_blocked_cells;
+        st.robot_cell_kept_free = true;
+      }
+    }
+    const Grid kept = old_drive.WithFreeFlags(free);
     int32_t num = 0;
-    const std::vector<int32_t> comp = FreeComponents(all, &num);
-    const int32_t keep = comp[all.Index(robot_cell.row, robot_cell.col)];
+    const std::vector<int32_t> comp = FreeComponents(kept, &num);
+    const int32_t keep = comp[kept.Index(keep_cell.row, keep_cell.col)];
     for (size_t i = 0; i < free.size(); ++i) free[i] = free[i] && comp[i] == keep;
   }
   c.drive = std::make_shared<const Grid>(old_drive.WithFreeFlags(free));
@@ -528,7 +544,7 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
 }
 
 absl::Status ValidateObservations(const Grid& grid, const Observations& observations) {
-  return replan_internal::BlockedCells(grid, observations, CellIndex{-1, -1}).status();
+  return replan_internal::BlockedCells(grid, observations).status();
 }
 
 absl::StatusOr<ReplanResult> Resume(const RetainedPlan& old, const RobotProgress& stopped_at,

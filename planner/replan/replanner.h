@@ -93,6 +93,12 @@ struct ReplanStats {
   double total_ms = 0.0;
   bool rank_lp_integral = true;          // the RANK-REPLAN relaxation was integral
   bool end_moved = false;                // the old end was cut off: the plan ends at the nearest reachable cell
+  // The robot's own cell was reported blocked: it is blocked from now on and
+  // the plan leaves it first (robot_cell_blocked), or, when every cell around
+  // is blocked too, it stays free so that the robot can move at all
+  // (robot_cell_kept_free).
+  bool robot_cell_blocked = false;
+  bool robot_cell_kept_free = false;
 };
 
 struct ReplanResult {

@@ -94,6 +94,7 @@ class Simulation {
         candidate_(std::move(candidate)),
         found_(candidate_.size(), 0),
         pending_flag_(candidate_.size(), 0),
+        reported_(candidate_.size(), 0),
         swept_(candidate_.size(), 0) {}
 
   absl::StatusOr<SimulationResult> Run();
@@ -115,6 +116,8 @@ class Simulation {
   absl::Status HandleViolation(CellIndex cell);
   void PushDriven(const Waypoint& w);
   void IndexSweeps();
+  // A problem line if `path` enters a cell already given to a replan.
+  std::optional<std::string> CrossesReported(const std::vector<Waypoint>& path) const;
 
   PlanSource* const source_;
   const OccupancyMap& truth_;
@@ -127,6 +130,7 @@ class Simulation {
   std::vector<uint8_t> candidate_;     // free on the planned drive grid, blocked on the true one
   std::vector<uint8_t> found_;         // candidates the robot has found
   std::vector<uint8_t> pending_flag_;  // found, not yet given to a replan
+  std::vector<uint8_t> reported_;      // given to a replan
   std::vector<CellIndex> pending_;
   bool pending_checked_ = true;        // no pending cell added since PendingOnPath() said no
   std::vector<uint8_t> swept_;
@@ -292,7 +296,9 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
   seen.cells = std::move(pending_);
   pending_.clear();
   std::vector<uint8_t> flags(found_.size(), 0);
-  for (const CellIndex& c : seen.cells) flags[Index(c)] = 1, pending_flag_[Index(c)] = 0;
+  for (const CellIndex& c : seen.cells) {
+    flags[Index(c)] = 1, pending_flag_[Index(c)] = 0, reported_[Index(c)] = 1;
+  }
   pending_checked_ = true;
 
   ReplanOptions ro;
@@ -347,6 +353,12 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
     PushDriven(cut);
     junction_ = true;
   }
+  // Every replanned path is checked whole, not only the part the robot
+  // drives before the next replan.
+  if (std::optional<std::string> crossing = CrossesReported(result->plan.path)) {
+    r_.problems.push_back(absl::StrFormat("the plan from replan %d (%s) %s", r_.num_replans,
+                                          st.method, *crossing));
+  }
   plan_.plan = std::move(result->plan);
   plan_.area = std::move(result->area);
   IndexSweeps();
@@ -354,6 +366,26 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
   t_seg_ = d_seg_ = 0.0;
   if (!path().empty()) pos_ = At(path()[0]);
   return absl::OkStatus();
+}
+
+std::optional<std::string> Simulation::CrossesReported(const std::vector<Waypoint>& path) const {
+  bool leaving = true;  // the path may start in the robot's cell, not come back to it
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Point2 a = At(path[i - 1]), b = At(path[i]);
+    std::optional<CellIndex> hit;
+    TraverseCells(grid_, a, b, [&](CellIndex c) {
+      if (leaving && c == here_) return false;
+      leaving = false;
+      if (!grid_.InBounds(c.row, c.col) || !reported_[Index(c)]) return false;
+      hit = c;
+      return true;
+    });
+    if (hit) {
+      return absl::StrFormat("crosses cell (%d, %d), reported blocked, on segment %d (%.4f, %.4f) -> (%.4f, %.4f)",
+                             hit->row, hit->col, i, a.x, a.y, b.x, b.y);
+    }
+  }
+  return std::nullopt;
 }
 
 // The path enters a cell the replanner was told is blocked (or one its drive

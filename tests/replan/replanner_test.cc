@@ -389,5 +389,68 @@ TEST(Estimator, LearnsFromSolvesAndPersists) {
   EXPECT_FALSE(restored.Parse("covplan.replan_estimator.v1\n-1 2\n").ok());
 }
 
+// The robot reports its own cell blocked (it stands where an obstacle now
+// is, e.g. clutter around a parked robot). The cell stays blocked: the plan
+// leaves it with its first move and never comes back to it, so a later replan
+// that is told nothing new cannot route through it either.
+TEST(Replan, TheRobotsOwnCellReportedBlockedIsLeftAndNeverEnteredAgain) {
+  const Mission m = Office();
+  const RobotProgress at = Early(m.plan.plan);
+  const Waypoint& a = m.plan.plan.path[at.waypoint - 1];
+  const Waypoint& b = m.plan.plan.path[at.waypoint];
+  const double len = std::hypot(b.x - a.x, b.y - a.y);
+  // A hair behind the robot along its segment: the cell it stands in.
+  const Point2 inside{at.position->x - 1e-4 * (b.x - a.x) / len, at.position->y - 1e-4 * (b.y - a.y) / len};
+  const Grid& old_drive = *m.plan.area->drive;
+  const CellIndex robot_cell = old_drive.CellAt(inside);
+  ASSERT_TRUE(old_drive.IsFree(robot_cell));
+  Observations seen;
+  seen.points = {inside};
+  for (ReplanMethod method : {ReplanMethod::kGreedyDetour, ReplanMethod::kIlp1, ReplanMethod::kIlp2,
+                              ReplanMethod::kAuto, ReplanMethod::kFull}) {
+    SCOPED_TRACE(ReplanMethodName(method));
+    ReplanOptions options;
+    options.method = method;
+    absl::StatusOr<ReplanResult> r = Replan(m.plan, at, seen, options, nullptr);
+    ASSERT_TRUE(r.ok()) << r.status();
+    EXPECT_TRUE(r->stats.robot_cell_blocked);
+    EXPECT_FALSE(r->stats.robot_cell_kept_free);
+    EXPECT_EQ(r->stats.newly_blocked_cells, 1);
+    const Grid& drive = *r->area->drive;
+    EXPECT_FALSE(drive.IsFree(robot_cell));
+    EXPECT_EQ(r->plan.stats.covered_cells, r->stats.remaining_cells);
+    // Sample the path: it may start in the robot's cell; once out, every
+    // point lies in a free cell of the new drive grid.
+    bool left = false;
+    const std::vector<Waypoint>& path = r->plan.path;
+    for (size_t i = 1; i < path.size(); ++i) {
+      const Waypoint& p = path[i - 1];
+      const Waypoint& q = path[i];
+      const int steps = std::max(1, static_cast<int>(std::ceil(std::hypot(q.x - p.x, q.y - p.y) / 0.01)));
+      for (int k = 0; k <= steps; ++k) {
+        const double t = static_cast<double>(k) / steps;
+        const CellIndex c = drive.CellAt({p.x + t * (q.x - p.x), p.y + t * (q.y - p.y)});
+        if (!left && c == robot_cell) continue;
+        left = true;
+        ASSERT_TRUE(drive.IsFree(c)) << "segment " << i << " enters (" << c.row << ", " << c.col << ")";
+      }
+    }
+    EXPECT_TRUE(left);
+    // Replanned again, with nothing new: still around the cell.
+    RetainedPlan next = m.plan;
+    next.plan = r->plan;
+    next.area = r->area;
+    RobotProgress later;
+    later.waypoint = static_cast<int>(next.plan.path.size()) / 2;
+    later.position = Point2{next.plan.path[later.waypoint - 1].x, next.plan.path[later.waypoint - 1].y};
+    Observations other;
+    other.cells = {m.furniture.cells.back()};
+    absl::StatusOr<ReplanResult> r2 = Replan(next, later, other, options, nullptr);
+    ASSERT_TRUE(r2.ok()) << r2.status();
+    EXPECT_FALSE(r2->area->drive->IsFree(robot_cell));
+    EXPECT_EQ(testing::CheckPathStaysFree(*r2->area->drive, r2->plan.path), "");
+  }
+}
+
 }  // namespace
 }  // namespace covplan
