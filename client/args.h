@@ -39,6 +39,9 @@ absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
                                      const std::set<std::string>& bool_flags,
                                      const std::set<std::string>& repeatable_flags = {});
 
+// `s` as a JSON string literal (quotes, backslashes and control characters escaped).
+std::string JsonString(const std::string& s);
+
 // Shared main of a subcommand: prints `usage` for --help/-h, else runs
 // `run(args)` and maps its status to an exit code (errors on stderr, prefixed
 // with "covplan <name>: ").

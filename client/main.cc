@@ -8,6 +8,7 @@
 //   covplan gtsp ...
 //   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local | --server H:P]
 //   covplan compare --map FILE [--algorithms oarp,stc] [--tool-width M] [--json out.json]
+//   covplan partition --map FILE [--resolution M] [--tool-width M] [--solver NAME]
 //
 // Subcommands parse their own flags (client/args.h); no global flags.
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "client/compare_command.h"
+#include "client/partition_command.h"
 #include "client/gtsp_command.h"
 #include "client/health_command.h"
 #include "client/load_command.h"
@@ -35,6 +37,7 @@ constexpr char kUsage[] =
     "  gtsp   solve a GTSPLIB instance with the tour solver\n"
     "  simulate  drive a plan through the true map, replanning on new obstacles; prints JSON\n"
     "  compare   plan one map with several planners and print one table (and JSON)\n"
+    "  partition time the minimum rank partition alone on a map (one JSON object)\n"
     "  health exit 0 when a server's gRPC health check reports SERVING\n"
     "Run 'covplan <command> --help' for its flags.\n";
 
@@ -54,6 +57,7 @@ int main(int argc, char** argv) {
   if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "simulate") return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
   if (command == "compare") return covplan::RunCompareCommand(args);
+  if (command == "partition") return covplan::RunPartitionCommand(args);
   if (command == "health") return covplan::RunHealthCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);

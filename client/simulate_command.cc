@@ -81,21 +81,6 @@ constexpr char kUsage[] =
     "are kept as in KNOWN); the offline bounds include recharge-s per charge cycle.\n"
     "Battery runs are local only (not with --server).\n";
 
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    const unsigned char c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\', out += ch;
-    } else if (c < 0x20) {
-      absl::StrAppendFormat(&out, "\\u%04x", c);
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
 std::string JsonNumber(double v) { return std::isfinite(v) ? absl::StrFormat("%.6f", v) : "null"; }
 
 absl::StatusOr<ReplanMethod> ParseMethod(const std::string& name) {
