@@ -51,7 +51,9 @@ constexpr char kUsage[] =
     "on the known map with the cells the true map blocks filled: the bound of the cell\n"
     "model the replanner and the simulated robot work in, which ignores new obstacles\n"
     "smaller than half a cell; length_in_obstacles_m says how far the robot drove\n"
-    "through such).\n"
+    "through such). Nothing stands where the robot starts and ends: the true map is\n"
+    "taken as KNOWN within a tool width of the plan's start and end poses\n"
+    "(truth_cleared_px counts the pixels this freed; the bounds use that map too).\n"
     "Clutter rectangles have sides of 0.3-1.5 m and any orientation; one that would cut\n"
     "free cells of the tool-width grid off the rest is redrawn, unless\n"
     "--clutter-may-disconnect. --time-limit is the initial plan's search budget (default\n"
@@ -186,18 +188,6 @@ absl::Status WithFlagNames(const absl::Status& status) {
   return absl::InvalidArgumentError(m);
 }
 
-// Clutter kept off the station: the pixels within a tool width of it as in `known`.
-void ClearAround(const OccupancyMap& known, const Pose2& station, double radius_m, OccupancyMap* truth) {
-  const double res = known.resolution();
-  const int c0 = static_cast<int>(std::floor((station.x - radius_m - known.origin().x) / res));
-  const int c1 = static_cast<int>(std::floor((station.x + radius_m - known.origin().x) / res));
-  const int r0 = static_cast<int>(std::floor((station.y - radius_m - known.origin().y) / res));
-  const int r1 = static_cast<int>(std::floor((station.y + radius_m - known.origin().y) / res));
-  for (int r = std::max(0, r0); r <= std::min(known.height() - 1, r1); ++r) {
-    for (int c = std::max(0, c0); c <= std::min(known.width() - 1, c1); ++c) truth->set(r, c, known.at(r, c));
-  }
-}
-
 }  // namespace
 
 absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
@@ -281,7 +271,10 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     ClutterOptions clutter;
     if (!a.Has("clutter-may-disconnect")) clutter.keep_connected_cell_m = robot.tool_width_m;
     ASSIGN_OR_RETURN(truth, AddClutter(known, *percent, o.seed, clutter));
-    if (o.plan.battery) ClearAround(known, o.plan.battery->station, robot.tool_width_m, &truth);
+    if (o.plan.battery) {
+      const Pose2& st = o.plan.battery->station;
+      ClearAround(known, {st.x, st.y}, robot.tool_width_m, &truth);  // clutter kept off the station
+    }
     truth_name = absl::StrFormat("clutter %g %% seed %d", *percent, o.seed);
   }
   std::unique_ptr<PlanSource> remote;
@@ -298,6 +291,9 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   absl::StatusOr<SimulationResult> simulated = Simulate(known, truth, o, remote.get());
   if (!simulated.ok()) return o.plan.battery ? WithFlagNames(simulated.status()) : simulated.status();
   const SimulationResult& r = *simulated;
+  // The bounds and the picture use the true map the run drove (nothing on
+  // the start and end poses: see SimulationResult::truth_cleared_px).
+  if (r.truth_used != nullptr) truth = *r.truth_used;
   OfflineBound bound, cell_bound;
   bound.duration_s = bound.covered_free_area_ratio = cell_bound.duration_s = std::nan("");
   if (!a.Has("no-offline-bound")) {
@@ -345,6 +341,7 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   field("max_replan_ms", JsonNumber(max_ms));
   field("obstacle_cells_found", absl::StrCat(r.obstacles_found.size()));
   field("touch_detections", absl::StrCat(r.num_touch_detections));
+  field("truth_cleared_px", absl::StrCat(r.truth_cleared_px));
   field("planned_duration_s", JsonNumber(r.planned_duration_s));
   field("offline_lower_bound_s", JsonNumber(bound.duration_s));
   field("offline_covered_free_area_ratio", JsonNumber(bound.covered_free_area_ratio));

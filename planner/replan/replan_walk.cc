@@ -157,37 +157,6 @@ std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
   return legs;
 }
 
-bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed) {
-  const double s = frame.cell_size();
-  const double ax = (a.x - frame.origin().x) / s, ay = (a.y - frame.origin().y) / s;
-  const double bx = (b.x - frame.origin().x) / s, by = (b.y - frame.origin().y) / s;
-  int cx = static_cast<int>(std::floor(ax)), cy = static_cast<int>(std::floor(ay));
-  const int ex = static_cast<int>(std::floor(bx)), ey = static_cast<int>(std::floor(by));
-  if (closed(cy, cx)) return true;
-  const double dx = bx - ax, dy = by - ay;
-  const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
-  const double inf = std::numeric_limits<double>::infinity();
-  double tx = dx != 0 ? ((sx > 0 ? cx + 1 : cx) - ax) / dx : inf;
-  double ty = dy != 0 ? ((sy > 0 ? cy + 1 : cy) - ay) / dy : inf;
-  const double dtx = dx != 0 ? sx / dx : inf, dty = dy != 0 ? sy / dy : inf;
-  for (int guard = std::abs(ex - cx) + std::abs(ey - cy) + 2; guard > 0 && (cx != ex || cy != ey); --guard) {
-    if (std::abs(tx - ty) <= 1e-12) {
-      if (tx > 1.0) break;
-      // Exactly through a grid corner: all four cells around it are touched.
-      if (closed(cy, cx + sx) || closed(cy + sy, cx)) return true;
-      cx += sx, cy += sy, tx += dtx, ty += dty;
-    } else if (tx < ty) {
-      if (tx > 1.0) break;
-      cx += sx, tx += dtx;
-    } else {
-      if (ty > 1.0) break;
-      cy += sy, ty += dty;
-    }
-    if (closed(cy, cx)) return true;
-  }
-  return false;
-}
-
 Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs, Point2 robot,
                 double heading) {
   // A cell the walk must not touch: free on the old drive grid, not on the

@@ -15,6 +15,7 @@
 #include "planner/engine/site.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"
+#include "planner/tour/grid_paths.h"
 
 namespace covplan::replan_internal {
 
@@ -46,10 +47,7 @@ absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Obser
 std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
                                std::vector<uint8_t>* covered);
 
-// True when the straight segment a-b (map frame) touches a cell for which
-// closed(row, col) holds: cells entered, clipped, or met at an exact grid
-// corner (all four cells around it count, as in LineOfSight).
-bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed);
+using ::covplan::SegmentTouches;  // planner/tour/grid_paths.h
 
 // The greedy walk over `legs`: drives the old path and, around every
 // stretch that touches a cell the new obstacles closed (free on old_drive,

@@ -127,4 +127,20 @@ absl::StatusOr<OccupancyMap> AddClutter(const OccupancyMap& map, double percent,
   return out;
 }
 
+int64_t ClearAround(const OccupancyMap& known, Point2 at, double radius_m, OccupancyMap* truth) {
+  const double res = known.resolution();
+  const int c0 = static_cast<int>(std::floor((at.x - radius_m - known.origin().x) / res));
+  const int c1 = static_cast<int>(std::floor((at.x + radius_m - known.origin().x) / res));
+  const int r0 = static_cast<int>(std::floor((at.y - radius_m - known.origin().y) / res));
+  const int r1 = static_cast<int>(std::floor((at.y + radius_m - known.origin().y) / res));
+  int64_t freed = 0;
+  for (int r = std::max(0, r0); r <= std::min(known.height() - 1, r1); ++r) {
+    for (int col = std::max(0, c0); col <= std::min(known.width() - 1, c1); ++col) {
+      freed += !truth->IsFree(r, col) && known.IsFree(r, col);
+      truth->set(r, col, known.at(r, col));
+    }
+  }
+  return freed;
+}
+
 }  // namespace covplan

@@ -41,6 +41,11 @@ struct ClutterOptions {
 absl::StatusOr<OccupancyMap> AddClutter(const OccupancyMap& map, double percent, uint64_t seed,
                                         const ClutterOptions& options = {});
 
+// Sets the pixels of `truth` within the square of half-side `radius_m`
+// around `at` to those of `known` (same frame), e.g. to keep clutter off a
+// dock. Returns how many pixels that were not free in `truth` became free.
+int64_t ClearAround(const OccupancyMap& known, Point2 at, double radius_m, OccupancyMap* truth);
+
 }  // namespace covplan
 
 #endif  // COVPLAN_PLANNER_SIM_CLUTTER_H_

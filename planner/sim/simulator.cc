@@ -13,6 +13,7 @@
 #include "planner/common/status_macros.h"
 #include "planner/engine/engine.h"
 #include "planner/sim/battery_run.h"
+#include "planner/sim/clutter.h"
 #include "planner/tour/path_timing.h"
 
 namespace covplan {
@@ -622,10 +623,22 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
   if (retained.plan.grid == nullptr || retained.plan.path.empty()) {
     return absl::InternalError("the initial plan has no grid or no path");
   }
+  // Nothing stands where the robot starts or on its dock (the end pose).
+  // Battery runs start and end at the station, which the true map itself
+  // must leave free (checked below; the CLI keeps its clutter off it).
+  std::shared_ptr<OccupancyMap> cleared;
+  int64_t cleared_px = 0;
+  for (const Waypoint* w : {&retained.plan.path.front(), &retained.plan.path.back()}) {
+    if (options.plan.battery) break;
+    OccupancyMap probe = cleared != nullptr ? *cleared : truth;
+    const int64_t freed = ClearAround(known, {w->x, w->y}, options.plan.robot.tool_width_m, &probe);
+    if (freed > 0) cleared = std::make_shared<OccupancyMap>(std::move(probe)), cleared_px += freed;
+  }
+  const OccupancyMap& true_map = cleared != nullptr ? *cleared : truth;
   const GridOptions go = GridOf(options.plan);
-  ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(truth, go));
-  const std::vector<double> fractions = CellFreeFractions(truth, frame);
-  ASSIGN_OR_RETURN(Grid true_grid, BuildGridFromFractions(truth, go, frame, fractions));
+  ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(true_map, go));
+  const std::vector<double> fractions = CellFreeFractions(true_map, frame);
+  ASSIGN_OR_RETURN(Grid true_grid, BuildGridFromFractions(true_map, go, frame, fractions));
   if (options.plan.battery) {
     // The robot must be able to dock: nothing the sensor could find there.
     const Pose2& st = options.plan.battery->station;
@@ -643,16 +656,18 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
   for (int64_t i = 0; i < drive.size(); ++i) {
     candidate[i] = drive.free_flags()[i] && !true_grid.free_flags()[i];
   }
-  Simulation sim(truth, true_grid, options, std::move(retained), std::move(candidate), source);
+  Simulation sim(true_map, true_grid, options, std::move(retained), std::move(candidate), source);
   ASSIGN_OR_RETURN(SimulationResult result, sim.Run());
+  result.truth_cleared_px = cleared_px;
+  result.truth_used = cleared;
   // Coverage against the true map: its free area inside the swept cells.
-  const int64_t true_free = truth.CountFree();
+  const int64_t true_free = true_map.CountFree();
   double swept_free_px = 0.0;
   for (size_t i = 0; i < sim.swept().size(); ++i) {
     if (sim.swept()[i]) swept_free_px += fractions[i] * frame.px_per_cell * frame.px_per_cell;
   }
   result.covered_free_area_ratio = true_free > 0 ? swept_free_px / true_free : 0.0;
-  result.length_in_obstacles_m = LengthInObstacles(truth, result.driven);
+  result.length_in_obstacles_m = LengthInObstacles(true_map, result.driven);
   return result;
 }
 

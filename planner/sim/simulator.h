@@ -38,6 +38,7 @@
 #define COVPLAN_PLANNER_SIM_SIMULATOR_H_
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -102,6 +103,14 @@ struct SimulationResult {
   // Cells found by touch rather than sight: the next step would have
   // entered them while the sensor could not see their centre.
   int num_touch_detections = 0;
+  // Nothing can stand where the robot starts (it is there) or on its dock:
+  // the true map is taken as the known one within a tool width of the
+  // plan's start and end poses. truth_cleared_px counts the pixels that
+  // freed (clutter dropped onto the parked robot); truth_used is the true
+  // map the run drove when that changed anything (null otherwise). Not for
+  // battery runs: their station must be free in the true map.
+  int64_t truth_cleared_px = 0;
+  std::shared_ptr<const OccupancyMap> truth_used;
   // Replanner errors and paths that entered a cell reported blocked, with
   // the input that caused them; each was worked around by a greedy detour.
   std::vector<std::string> problems;

@@ -174,11 +174,42 @@ std::vector<CellIndex> AnyAngleSearch::PathTo(CellIndex target) const {
   return path;
 }
 
+bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed) {
+  const double s = frame.cell_size();
+  const double ax = (a.x - frame.origin().x) / s, ay = (a.y - frame.origin().y) / s;
+  const double bx = (b.x - frame.origin().x) / s, by = (b.y - frame.origin().y) / s;
+  int cx = static_cast<int>(std::floor(ax)), cy = static_cast<int>(std::floor(ay));
+  const int ex = static_cast<int>(std::floor(bx)), ey = static_cast<int>(std::floor(by));
+  if (closed(cy, cx)) return true;
+  const double dx = bx - ax, dy = by - ay;
+  const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  double tx = dx != 0 ? ((sx > 0 ? cx + 1 : cx) - ax) / dx : inf;
+  double ty = dy != 0 ? ((sy > 0 ? cy + 1 : cy) - ay) / dy : inf;
+  const double dtx = dx != 0 ? sx / dx : inf, dty = dy != 0 ? sy / dy : inf;
+  for (int guard = std::abs(ex - cx) + std::abs(ey - cy) + 2; guard > 0 && (cx != ex || cy != ey); --guard) {
+    if (std::abs(tx - ty) <= 1e-12) {
+      if (tx > 1.0) break;
+      // Exactly through a grid corner: all four cells around it are touched.
+      if (closed(cy, cx + sx) || closed(cy + sy, cx)) return true;
+      cx += sx, cy += sy, tx += dtx, ty += dty;
+    } else if (tx < ty) {
+      if (tx > 1.0) break;
+      cx += sx, tx += dtx;
+    } else {
+      if (ty > 1.0) break;
+      cy += sy, ty += dty;
+    }
+    if (closed(cy, cx)) return true;
+  }
+  return false;
+}
+
 absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& p, const char* what) {
   const CellIndex c = grid.CellAt({p.x, p.y});
   if (grid.IsFree(c)) return c;
-  std::optional<CellIndex> best;
-  double best_d2 = std::numeric_limits<double>::infinity();
+  // Free neighbours, nearest centre first.
+  std::vector<std::pair<double, CellIndex>> candidates;
   // Far outside the grid (CellAt clamps to -2 / n + 1): no free neighbour.
   const bool near_grid = c.row >= -1 && c.col >= -1 && c.row <= grid.rows() && c.col <= grid.cols();
   for (int dr = -1; near_grid && dr <= 1; ++dr) {
@@ -186,15 +217,25 @@ absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& p, const char*
       const CellIndex n{c.row + dr, c.col + dc};
       if (!grid.IsFree(n)) continue;
       const Point2 q = grid.CellCenter(n);
-      const double d2 = (q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y);
-      if (d2 < best_d2) best_d2 = d2, best = n;
+      candidates.push_back({(q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y), n});
     }
   }
-  if (best) return *best;
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "%s pose (%.3f, %.3f) is neither in nor next to a reachable free grid cell (cells of "
-      "%.3f m; only the largest connected free area is planned)",
-      what, p.x, p.y, grid.cell_size()));
+  if (candidates.empty()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "%s pose (%.3f, %.3f) is neither in nor next to a reachable free grid cell (cells of "
+        "%.3f m; only the largest connected free area is planned)",
+        what, p.x, p.y, grid.cell_size()));
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [d2, n] : candidates) {
+    // Only the pose's own cell may be blocked on the way.
+    const bool clear = !SegmentTouches(grid, {p.x, p.y}, grid.CellCenter(n), [&](int r, int col) {
+      return !(r == c.row && col == c.col) && !grid.IsFree(r, col);
+    });
+    if (clear) return n;
+  }
+  return candidates.front().second;
 }
 
 }  // namespace covplan

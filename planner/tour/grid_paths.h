@@ -20,6 +20,7 @@
 #define COVPLAN_PLANNER_TOUR_GRID_PATHS_H_
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -37,10 +38,18 @@ bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b);
 // boundaries (the moves the line-of-sight rule allows). Returns per-cell component id, -1 for blocked.
 std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components);
 
+// True when the straight segment a-b (map frame) touches a cell for which
+// closed(row, col) holds: cells entered, clipped, or met at an exact grid
+// corner (all four cells around it count, as in LineOfSight).
+bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed);
+
 // The free cell where a robot at `pose` joins the grid: its own cell, or,
 // when that cell is blocked (a dock against a wall stands in a cell that is
-// mostly wall), the adjacent free cell whose centre is nearest. `what` names
-// the pose in the InvalidArgument error ("start", "end").
+// mostly wall, or a new obstacle covers the robot's cell), the adjacent free
+// cell whose centre is nearest among those the straight move from the pose
+// reaches without touching another blocked cell (a diagonal move must not
+// cut a wall's corner); the nearest adjacent free cell if none does. `what`
+// names the pose in the InvalidArgument error ("start", "end").
 absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& pose, const char* what);
 
 class AnyAngleSearch {

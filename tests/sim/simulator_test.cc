@@ -269,8 +269,45 @@ TEST(Simulate, TenPercentClutterIsDrivenAroundByAuto) {
   EXPECT_TRUE(r->completed) << r->termination;
   EXPECT_THAT(r->problems, ::testing::IsEmpty());
   EXPECT_GT(r->num_replans, 0);
-  EXPECT_EQ(FirstBlockedPoint(TrueGrid(*truth), r->driven), "");
+  // Clutter on the start pose is taken off (see the test below).
+  EXPECT_EQ(FirstBlockedPoint(TrueGrid(r->truth_used != nullptr ? *r->truth_used : *truth), r->driven), "");
   EXPECT_NEAR(r->total_time_s, r->drive_time_s + r->stoppage_s, 1e-9 * r->total_time_s);
+}
+
+// Clutter dropped onto the parked robot: the true map blocks the cells
+// around the plan's start. The robot is there, so nothing is: the run takes
+// the true map as the known one within a tool width of the start (and end)
+// pose, says how many pixels that freed, and drives the rest as usual,
+// never entering a cell it reported blocked.
+TEST(Simulate, ClutterOnTheStartPoseIsTakenOffAndTheRunGoesOn) {
+  const OccupancyMap office = Load("sample_office.yaml");
+  SimulationOptions o = Options(ReplanMethod::kAuto);
+  o.replan_tour_time_limit_s = 0.2;
+  absl::StatusOr<CoveragePlan> planned = PlanCoverage(office, o.plan);
+  ASSERT_TRUE(planned.ok()) << planned.status();
+  const Waypoint start = planned->path.front();
+  OccupancyMap truth = office;
+  const double res = office.resolution();
+  int64_t blocked = 0;
+  for (int r = 0; r < office.height(); ++r) {
+    for (int c = 0; c < office.width(); ++c) {
+      const double x = office.origin().x + (c + 0.5) * res, y = office.origin().y + (r + 0.5) * res;
+      if (std::abs(x - start.x) <= 1.0 && std::abs(y - start.y) <= 1.0 && office.IsFree(r, c)) {
+        truth.set(r, c, CellState::kOccupied);
+        ++blocked;
+      }
+    }
+  }
+  ASSERT_GT(blocked, 100);
+  absl::StatusOr<SimulationResult> r = Simulate(office, truth, o);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_GT(r->truth_cleared_px, 0);
+  EXPECT_LT(r->truth_cleared_px, blocked);  // only within a tool width of the poses
+  ASSERT_NE(r->truth_used, nullptr);
+  EXPECT_TRUE(r->completed) << r->termination;
+  EXPECT_THAT(r->problems, ::testing::IsEmpty());
+  EXPECT_GT(r->covered_free_area_ratio, 0.8);
+  EXPECT_EQ(FirstBlockedPoint(TrueGrid(*r->truth_used), r->driven), "");
 }
 
 // A number after "key": in the JSON text.

@@ -84,6 +84,28 @@ TEST(LineOfSight, SmallObstacleInsideAFreeCellBlocksTheLineThroughIt) {
   EXPECT_LT(len, 3.5);
 }
 
+// A pose in a blocked cell joins the grid at the nearest free neighbour its
+// straight move reaches without cutting another blocked cell's corner.
+TEST(JoinCell, AMoveOutOfABlockedCellCutsNoCorner) {
+  Grid g = Grid::FromAscii({
+      "#..",
+      "##.",
+      "...",
+  });
+  // Rows count from the bottom: the pose's cell (1, 0) is blocked; (2, 0)
+  // and (1, 1) are blocked too. The pose sits near the top-right corner of
+  // its cell, so the diagonal neighbour (2, 1)'s centre is nearest, but
+  // that move would cut the corner between (2, 0) and (1, 1). Of the other
+  // free neighbours (0, 0) and (0, 1), (0, 0) is nearer and reached cleanly.
+  absl::StatusOr<CellIndex> c = JoinCell(g, Pose2{0.9, 1.9, 0.0}, "start");
+  ASSERT_TRUE(c.ok()) << c.status();
+  EXPECT_EQ(*c, (CellIndex{0, 0}));
+  // A free own cell is its own join cell; nothing free around is InvalidArgument.
+  EXPECT_EQ(*JoinCell(g, Pose2{2.5, 0.5, 0.0}, "start"), (CellIndex{0, 2}));
+  Grid walled = Grid::FromAscii({"###", "###", "###"});
+  EXPECT_EQ(JoinCell(walled, Pose2{1.5, 1.5, 0.0}, "end").status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 TEST(AnyAngleSearch, PathAroundWallIsShortAndFree) {
   Grid g = Grid::FromAscii({
       "..........",
