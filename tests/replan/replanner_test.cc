@@ -81,7 +81,9 @@ void ExpectGoodReplan(const ReplanResult& r, const RetainedPlan& old, const Robo
   EXPECT_NEAR(r.plan.path.back().y, old.plan.path.back().y, 1e-9);
   // No new obstacle is entered (the drive grid has them blocked; check the cells directly too).
   for (const CellIndex& c : seen.cells) EXPECT_FALSE(r.area->drive->IsFree(c));
-  EXPECT_EQ(testing::CheckPathStaysFree(*r.area->drive, r.plan.path), "");
+  // A robot standing in a cell reported blocked first leaves it (see
+  // TheRobotsOwnCellReportedBlockedIsLeftAndNeverEnteredAgain).
+  EXPECT_EQ(testing::CheckPathStaysFree(*r.area->drive, r.plan.path, r.stats.robot_cell_blocked), "");
   // Honest accounting: swept + remaining + unreachable add up.
   EXPECT_EQ(r.plan.stats.covered_cells, r.stats.remaining_cells);
   EXPECT_EQ(static_cast<int64_t>(r.unreachable.size()), r.stats.newly_unreachable_cells);
@@ -395,15 +397,25 @@ TEST(Estimator, LearnsFromSolvesAndPersists) {
 // that is told nothing new cannot route through it either.
 TEST(Replan, TheRobotsOwnCellReportedBlockedIsLeftAndNeverEnteredAgain) {
   const Mission m = Office();
-  const RobotProgress at = Early(m.plan.plan);
-  const Waypoint& a = m.plan.plan.path[at.waypoint - 1];
-  const Waypoint& b = m.plan.plan.path[at.waypoint];
-  const double len = std::hypot(b.x - a.x, b.y - a.y);
-  // A hair behind the robot along its segment: the cell it stands in.
-  const Point2 inside{at.position->x - 1e-4 * (b.x - a.x) / len, at.position->y - 1e-4 * (b.y - a.y) / len};
   const Grid& old_drive = *m.plan.area->drive;
+  // The robot halfway along a coverage segment early in the plan (those run
+  // through free cells); `inside` is a hair behind it: the cell it stands in.
+  const std::vector<Waypoint>& old_path = m.plan.plan.path;
+  RobotProgress at;
+  Point2 inside;
+  for (size_t k = old_path.size() / 6; k < old_path.size() && !at.position; ++k) {
+    const Waypoint& a = old_path[k - 1];
+    const Waypoint& b = old_path[k];
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    if (b.kind != SegmentKind::kCoverage || len < 2 * old_drive.cell_size()) continue;
+    const Point2 mid{(a.x + b.x) / 2, (a.y + b.y) / 2};
+    inside = Point2{mid.x - 1e-4 * (b.x - a.x) / len, mid.y - 1e-4 * (b.y - a.y) / len};
+    if (!old_drive.IsFree(old_drive.CellAt(inside))) continue;
+    at.waypoint = static_cast<int>(k);
+    at.position = mid;
+  }
+  ASSERT_TRUE(at.position.has_value());
   const CellIndex robot_cell = old_drive.CellAt(inside);
-  ASSERT_TRUE(old_drive.IsFree(robot_cell));
   Observations seen;
   seen.points = {inside};
   for (ReplanMethod method : {ReplanMethod::kGreedyDetour, ReplanMethod::kIlp1, ReplanMethod::kIlp2,

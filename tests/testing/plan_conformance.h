@@ -59,8 +59,14 @@ inline std::string CheckPathAvoidsMapObstacles(const OccupancyMap& map,
   return "";
 }
 
-inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoint>& path) {
+// `may_leave_start_cell`: the path may start in a blocked cell (a dock, or a
+// robot whose own cell was just reported blocked) and leave it; it may never
+// come back to it.
+inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoint>& path,
+                                      bool may_leave_start_cell = false) {
   CellIndex prev{-1, -1};
+  const CellIndex start = path.empty() ? CellIndex{-1, -1} : grid.CellAt({path[0].x, path[0].y});
+  bool leaving = may_leave_start_cell && !path.empty() && !grid.IsFree(start);
   for (size_t i = 0; i < path.size(); ++i) {
     const Waypoint& b = path[i];
     const Waypoint& a = i == 0 ? b : path[i - 1];
@@ -70,6 +76,8 @@ inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoi
       const double t = static_cast<double>(k) / steps;
       const Point2 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
       const CellIndex cell = grid.CellAt(p);
+      if (leaving && cell == start) continue;
+      leaving = false;
       if (!grid.IsFree(cell)) {
         return absl::StrFormat("segment %d passes (%.3f, %.3f) outside free cells", i, p.x, p.y);
       }
@@ -162,7 +170,7 @@ inline std::string CheckPlanConformance(const CoveragePlan& plan, const Coverage
   const Grid& drive = *area.drive;
   const Grid& cover = *area.cover;
   if (plan.grid.get() != area.drive.get()) return "plan grid is not the area's drive grid";
-  std::string err = CheckPathStaysFree(drive, plan.path);
+  std::string err = CheckPathStaysFree(drive, plan.path, /*may_leave_start_cell=*/true);
   if (!err.empty()) return err;
   err = CheckPathAvoidsZones(plan.path, no_go);
   if (!err.empty()) return err;
