@@ -24,8 +24,10 @@
 // another seed would, cold, search another way and may find another tour, so
 // it is not answered with this one; it warm-starts instead ("warm_start").
 //
-//   PlanMemoryKeys keys = PlanMemoryKeysFor(ctx.area_key, "oarp", *options, request_fields...);
-//   auto hit = FindRemembered<RememberedPlan>(cache, keys.exact);
+//   PlanMemoryKeys keys = PlanMemoryKeysFor(ctx.area_key, "oarp", *options, request.common,
+//                                           request.battery);
+//   std::shared_ptr<const RememberedPlan> hit = FindRemembered<RememberedPlan>(cache, keys.exact);
+//   if (hit != nullptr && hit->Answers(request.common.time_limit_s)) { ... hit->plan ... }
 //
 // Thread-safety: entries are immutable once put; the cache locks.
 #ifndef COVPLAN_PLANNER_ENGINE_PLAN_MEMORY_H_

@@ -106,7 +106,7 @@ struct OrdererOptions {
   // moved, the cycle between them did not) instead of the greedy tour, and
   // runs `warm_trials` warm trials (kEffortTrials: the effort's count; 0:
   // only the local step). Ignored when it does not fit the model.
-  std::vector<int> warm_order;
+  std::vector<int> warm_order = {};
   int warm_trials = 1;
   static constexpr int kEffortTrials = -1;
 };
