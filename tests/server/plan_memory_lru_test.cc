@@ -5,6 +5,8 @@
 // then no longer a hit).
 #include <memory>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "gtest/gtest.h"
 #include "planner/engine/engine.h"
@@ -100,6 +102,38 @@ TEST(PlanMemoryBudgetTest, RememberedPlansAreAccountedAndEvicted) {
   absl::StatusOr<EngineResult> evicted = engine.Plan(source, Request(1));
   ASSERT_TRUE(evicted.ok());
   EXPECT_NE(evicted->plan.stats.plan_source, PlanOrigin::kCacheHit);
+}
+
+// Identical requests planned at once on several threads: every one gets a
+// whole plan (cold or remembered), all are the same plan (the seed fixes a
+// converged search), and the one remembered afterwards is that plan.
+TEST(PlanMemoryBudgetTest, ConcurrentIdenticalRequestsShareOneAnswer) {
+  const OccupancyMap map = testing::LoadShippedMap("sample_office.yaml");
+  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const MapSource source = Office(&map);
+  ArtifactLru cache(256 << 20);
+  PlanningEngine engine(&registry, &cache, EngineLimits{});
+  constexpr int kThreads = 4;
+  std::vector<absl::StatusOr<EngineResult>> results(kThreads, absl::UnknownError("not run"));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] { results[t] = engine.Plan(source, Request(5)); });
+  }
+  for (std::thread& t : threads) t.join();
+  absl::StatusOr<EngineResult> after = engine.Plan(source, Request(5));
+  ASSERT_TRUE(after.ok()) << after.status();
+  EXPECT_EQ(after->plan.stats.plan_source, PlanOrigin::kCacheHit);
+  for (const absl::StatusOr<EngineResult>& r : results) {
+    ASSERT_TRUE(r.ok()) << r.status();
+    const PlanOrigin source_of = r->plan.stats.plan_source;
+    EXPECT_TRUE(source_of == PlanOrigin::kCold || source_of == PlanOrigin::kCacheHit);
+    ASSERT_EQ(r->plan.path.size(), after->plan.path.size());
+    for (size_t i = 0; i < r->plan.path.size(); ++i) {
+      EXPECT_EQ(r->plan.path[i].x, after->plan.path[i].x);
+      EXPECT_EQ(r->plan.path[i].y, after->plan.path[i].y);
+    }
+    EXPECT_EQ(r->plan.stats.covered_cells, r->plan.stats.free_cells);
+  }
 }
 
 }  // namespace
