@@ -339,6 +339,7 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
   // 0 means "default" for both (proto3 scalars have no presence).
   if (request.time_limit_s() != 0.0) options.time_limit_s = request.time_limit_s();
   options.seed = request.seed();
+  out.improve_remembered = request.improve_remembered();
   if (request.min_free_fraction() != 0.0) options.min_free_fraction = request.min_free_fraction();
   out.regions = PolygonsFromProto(request.regions());
   out.no_go = PolygonsFromProto(request.no_go());

@@ -62,6 +62,25 @@ v1::TerminationLimit LimitToProto(TerminationLimit l) {
   return v1::TERMINATION_LIMIT_UNSPECIFIED;
 }
 
+v1::PlanSource PlanOriginToProto(PlanOrigin s) {
+  switch (s) {
+    case PlanOrigin::kCold: return v1::PLAN_SOURCE_COLD;
+    case PlanOrigin::kCacheHit: return v1::PLAN_SOURCE_CACHE_HIT;
+    case PlanOrigin::kImproved: return v1::PLAN_SOURCE_IMPROVED;
+    case PlanOrigin::kWarmStart: return v1::PLAN_SOURCE_WARM_START;
+  }
+  return v1::PLAN_SOURCE_UNSPECIFIED;
+}
+
+PlanOrigin PlanOriginFromProto(v1::PlanSource s) {
+  switch (s) {
+    case v1::PLAN_SOURCE_CACHE_HIT: return PlanOrigin::kCacheHit;
+    case v1::PLAN_SOURCE_IMPROVED: return PlanOrigin::kImproved;
+    case v1::PLAN_SOURCE_WARM_START: return PlanOrigin::kWarmStart;
+    default: return PlanOrigin::kCold;
+  }
+}
+
 }  // namespace
 
 void PolygonsToProto(const std::vector<PolygonInput>& polygons,
@@ -193,6 +212,7 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_map_free_area_m2(s.map_free_area_m2);
   o->set_tour_cut_short(s.tour_cut_short);
   o->set_decomposition_cached(s.decomposition_cached);
+  o->set_plan_source(PlanOriginToProto(s.plan_source));
   o->set_partition_solver(s.partition_solver);
   o->set_tour_solver(s.tour_solver);
   o->set_unreachable_free_cells(static_cast<int32_t>(s.unreachable_free_cells));
@@ -360,6 +380,7 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   o.map_free_area_m2 = s.map_free_area_m2();
   o.tour_cut_short = s.tour_cut_short();
   o.decomposition_cached = s.decomposition_cached();
+  o.plan_source = PlanOriginFromProto(s.plan_source());
   o.partition_solver = s.partition_solver();
   o.tour_solver = s.tour_solver();
   o.unreachable_free_cells = s.unreachable_free_cells();

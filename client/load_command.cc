@@ -17,6 +17,7 @@
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
 #include "api/convert.h"
+#include "planner/engine/engine.h"
 
 namespace covplan {
 namespace {
@@ -27,12 +28,48 @@ constexpr char kUsage[] =
     "                    [--concurrency N] [--duration S] [--requests N]\n"
     "                    [--deadline-ms D] [--resolution M] [--tool-width M]\n"
     "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n"
-    "                    [--zipf S] [--seed N] [--inline]\n"
+    "                    [--zipf S] [--seed N] [--inline] [--random-start]\n"
     "--maps: every *.yaml and *.geojson in DIR (sorted), or a comma list; each\n"
     "request picks one, map k (0-based, in that order) with weight 1/(k+1)^S\n"
     "(--zipf 0: uniform). --inline sends the map in every request instead of\n"
     "PutMap once and plan by id (any replica can then serve any map).\n"
-    "--requests N stops after N requests (or --duration, whichever is first).\n";
+    "--requests N stops after N requests (or --duration, whichever is first).\n"
+    "--random-start: each request starts at a free cell drawn uniformly (seeded by\n"
+    "--seed) from the cells the robot can reach, heading uniform in [0, 2 pi).\n";
+
+// The centres of the cells a robot of `tool` width can reach on `map`: the
+// engine's own drive grid, built locally.
+absl::StatusOr<std::vector<Point2>> ReachableCellCentres(const v1::Map& map, double tool) {
+  ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(map, InputLimits()));
+  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  LocalArtifactCache cache;
+  const PlanningEngine engine(&registry, &cache, EngineLimitsFor(InputLimits()));
+  MapSource source;
+  source.map_id = "load";
+  source.load = [&]() -> absl::StatusOr<SiteMap> { return site; };
+  PlanRequest request;
+  request.common.robot.tool_width_m = tool;
+  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area, engine.AreaFor(source, request));
+  std::vector<Point2> centres;
+  const Grid& drive = *area->drive;
+  for (int r = 0; r < drive.rows(); ++r) {
+    for (int c = 0; c < drive.cols(); ++c) {
+      if (drive.IsFree(r, c)) centres.push_back(drive.CellCenter(r, c));
+    }
+  }
+  if (centres.empty()) return absl::InvalidArgumentError("--random-start: the map has no reachable cell");
+  return centres;
+}
+
+std::string SourceName(v1::PlanSource s) {
+  switch (s) {
+    case v1::PLAN_SOURCE_COLD: return "cold";
+    case v1::PLAN_SOURCE_CACHE_HIT: return "cache_hit";
+    case v1::PLAN_SOURCE_IMPROVED: return "improved";
+    case v1::PLAN_SOURCE_WARM_START: return "warm_start";
+    default: return "unspecified";
+  }
+}
 
 // The files of --maps: a directory's *.yaml / *.geojson (sorted) or a list.
 absl::StatusOr<std::vector<std::string>> MapFiles(const std::string& spec) {
@@ -63,7 +100,7 @@ absl::Status Run(const std::vector<std::string>& args) {
                              WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
                                                   "deadline-ms", "resolution", "tool-width", "time-limit",
                                                   "tour", "backoff-ms", "zipf", "seed", "requests"}),
-                             {"inline"}));
+                             {"inline", "random-start"}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   if (!a.Get("map") == !a.Get("maps")) {
     return absl::InvalidArgumentError("exactly one of --map FILE or --maps DIR|LIST is required");
@@ -96,6 +133,8 @@ absl::Status Run(const std::vector<std::string>& args) {
     ASSIGN_OR_RETURN(files, MapFiles(*a.Get("maps")));
   }
   const bool send_inline = a.Has("inline");
+  const bool random_start = a.Has("random-start");
+  std::vector<std::vector<Point2>> start_cells;  // per map, with --random-start
   ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, server));
   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(connection);
   // One prepared request per map.
@@ -103,6 +142,10 @@ absl::Status Run(const std::vector<std::string>& args) {
   std::vector<std::string> acknowledged;
   for (const std::string& file : files) {
     ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, overrides, InputLimits()));
+    if (random_start) {
+      ASSIGN_OR_RETURN(std::vector<Point2> cells, ReachableCellCentres(map, tool.value_or(0.8)));
+      start_cells.push_back(std::move(cells));
+    }
     v1::PlanRequest request;
     if (send_inline) {
       *request.mutable_map() = std::move(map);
@@ -135,6 +178,7 @@ absl::Status Run(const std::vector<std::string>& args) {
   report.deadline_ms = deadline;
   report.maps = static_cast<int>(requests.size());
   report.map_ids = acknowledged;
+  report.random_start = random_start;
   absl::Mutex mu;
   int64_t issued = 0;  // guarded by mu
   const absl::Time start = absl::Now();
@@ -150,7 +194,16 @@ absl::Status Run(const std::vector<std::string>& args) {
           if (issued >= *max_requests) break;
           ++issued;
         }
-        const v1::PlanRequest& request = requests[pick(rng)];
+        const size_t k = pick(rng);
+        v1::PlanRequest request = requests[k];
+        if (random_start) {
+          const std::vector<Point2>& cells = start_cells[k];
+          const Point2 p = cells[std::uniform_int_distribution<size_t>(0, cells.size() - 1)(rng)];
+          v1::Pose* start = request.mutable_robot()->mutable_start();
+          start->set_x(p.x);
+          start->set_y(p.y);
+          start->set_theta(std::uniform_real_distribution<double>(0.0, 2 * M_PI)(rng));
+        }
         const absl::Time sent = absl::Now();
         absl::StatusOr<v1::PlanResponse> reply = remote->Plan(request, absl::Milliseconds(deadline));
         const double ms = absl::ToDoubleMilliseconds(absl::Now() - sent);
@@ -162,6 +215,8 @@ absl::Status Run(const std::vector<std::string>& args) {
           if (reply.ok()) {
             ++report.ok;
             report.cut_short += reply->stats().tour_cut_short();
+            ++report.plan_sources[SourceName(reply->stats().plan_source())];
+            report.estimated_duration_sum_s += reply->stats().estimated_duration_s();
           }
           if (ms > static_cast<double>(deadline)) ++report.late;
         }
@@ -188,17 +243,22 @@ std::string LoadReport::ToJson() const {
   for (const auto& [code, count] : codes) {
     absl::StrAppend(&codes_json, codes_json.empty() ? "" : ", ", "\"", code, "\": ", count);
   }
+  std::string sources_json;
+  for (const auto& [source, count] : plan_sources) {
+    absl::StrAppend(&sources_json, sources_json.empty() ? "" : ", ", "\"", source, "\": ", count);
+  }
   std::string ids_json;
   if (!map_ids.empty()) ids_json = absl::StrCat(", \"map_ids\": [\"", absl::StrJoin(map_ids, "\", \""), "\"]");
   return absl::StrFormat(
       "{\"requests\": %d, \"ok\": %d, \"codes\": {%s}, \"p50_ms\": %.2f, \"p95_ms\": %.2f, "
       "\"p99_ms\": %.2f, \"max_ms\": %.2f, \"late\": %d, \"cut_short\": %d, "
       "\"concurrency\": %d, \"maps\": %d, \"deadline_ms\": %d, \"duration_s\": %.2f, "
-      "\"throughput_rps\": %.2f%s}",
+      "\"throughput_rps\": %.2f, \"random_start\": %s, \"plan_sources\": {%s}, "
+      "\"mean_estimated_duration_s\": %.3f%s}",
       requests, ok, codes_json, Percentile(sorted, 0.50), Percentile(sorted, 0.95),
       Percentile(sorted, 0.99), sorted.empty() ? 0.0 : sorted.back(), late, cut_short,
       concurrency, maps, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0,
-      ids_json);
+      random_start ? "true" : "false", sources_json, ok > 0 ? estimated_duration_sum_s / ok : 0.0, ids_json);
 }
 
 int RunLoadCommand(const std::vector<std::string>& args) {

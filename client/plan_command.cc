@@ -28,6 +28,15 @@ namespace {
 // --local without --time-limit: the same tour budget as the server default.
 constexpr double kLocalDefaultBudgetS = 2.0;
 
+const char* PlanSourceText(v1::PlanSource s) {
+  switch (s) {
+    case v1::PLAN_SOURCE_CACHE_HIT: return "remembered plan";
+    case v1::PLAN_SOURCE_IMPROVED: return "remembered plan, searched further";
+    case v1::PLAN_SOURCE_WARM_START: return "warm-started from a remembered tour";
+    default: return "cold";
+  }
+}
+
 constexpr char kUsage[] =
     "usage: covplan plan --map FILE [--resolution M] [--tool-width M]\n"
     "                    [--local | --server HOST:PORT] [--out plan.json] [--svg plan.svg]\n"
@@ -35,7 +44,7 @@ constexpr char kUsage[] =
     "                    [--time-limit S] [--seed N] [--partition matching|mincut|lp] [--tour gtsp|greedy]\n"
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
-    "                    [--min-free-fraction F] [--deadline-ms D]\n"
+    "                    [--min-free-fraction F] [--deadline-ms D] [--improve-remembered]\n"
     "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|boustrophedon]\n"
     "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
     "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
@@ -48,6 +57,8 @@ constexpr char kUsage[] =
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
     "--resolution) or a .geojson polygon map (Polygon/MultiPolygon in metres; the free\n"
     "space). Without --local the server defaults to 127.0.0.1:50051.\n"
+    "The server remembers plans: an identical request gets the remembered plan at once;\n"
+    "--improve-remembered searches on from it within --time-limit instead.\n"
     "AREA is a GeoJSON file or a ring \"x,y x,y x,y ...\" in metres (closed for you):\n"
     "--region covers only the free cells mostly inside the regions (the rest of the\n"
     "map may still be driven through); --no-go is never entered. Both repeat.\n"
@@ -150,7 +161,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
                  "energy-per-second", "atomic-units", "sweep-axis",
                  "algorithm", "stc-tree", "sweep-direction", "stc-partial"}),
-                {"local", "negate", "interruptible"}, {"region", "no-go"}));
+                {"local", "negate", "interruptible", "improve-remembered"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   c.map_path = *a.Get("map");
@@ -184,6 +195,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   if (auto end = a.Get("end")) RETURN_IF_ERROR(ParsePose("end", *end, robot->mutable_end()));
   ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
   if (limit) r.set_time_limit_s(*limit);
+  r.set_improve_remembered(a.Has("improve-remembered"));
   ASSIGN_OR_RETURN(std::optional<double> fraction, a.GetDouble("min-free-fraction"));
   if (fraction) r.set_min_free_fraction(*fraction);
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
@@ -383,7 +395,10 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
       s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
       s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
       s.partition_ms(), s.transitions_ms(), s.tour_ms(),
-      s.decomposition_cached() ? " (decomposition cached)" : "") +
+      absl::StrCat(s.decomposition_cached() ? " (decomposition cached)" : "",
+                   s.plan_source() == v1::PLAN_SOURCE_COLD || s.plan_source() == v1::PLAN_SOURCE_UNSPECIFIED
+                       ? ""
+                       : absl::StrCat(" (", PlanSourceText(s.plan_source()), ")"))) +
          (r.cycles().empty()
               ? std::string()
               : absl::StrFormat("battery    %d charge cycles, energy %.1f (unconstrained %.1f, bound %.1f)\n",

@@ -122,6 +122,24 @@ class SharedLruCache {
     return absl::UnavailableError("artifact build kept being abandoned; retry");
   }
 
+  // The cached value of `key` (now most recently used), or null. Not counted
+  // as a hit or miss: those count builds avoided and done.
+  Value Find(const std::string& key) {
+    absl::MutexLock lock(&mu_);
+    auto it = entries_.find(key);
+    if (it == entries_.end()) return nullptr;
+    lru_.splice(lru_.begin(), lru_, it->second.position);
+    return it->second.value;
+  }
+
+  // Stores `value` under `key`, replacing an older value (its bytes are
+  // released first), and evicts from the LRU end to stay within the budget.
+  void Put(const std::string& key, Value value) {
+    if (value == nullptr) return;
+    absl::MutexLock lock(&mu_);
+    Insert(key, value);
+  }
+
   // Drops every entry whose key starts with `prefix` (e.g. a deleted map).
   void EraseWithPrefix(const std::string& prefix) {
     absl::MutexLock lock(&mu_);
@@ -176,7 +194,16 @@ class SharedLruCache {
 
   void Insert(const std::string& key, const Value& value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
     const size_t bytes = size_fn_(*value);
-    if (bytes > budget_bytes_) return;  // would evict everything and still not fit
+    if (auto old = entries_.find(key); old != entries_.end()) {  // a replacement (Put)
+      stats_.bytes -= old->second.bytes;
+      lru_.erase(old->second.position);
+      entries_.erase(old);
+    }
+    if (bytes > budget_bytes_) {  // would evict everything and still not fit
+      stats_.entries = entries_.size();
+      if (observer_ != nullptr) observer_->OnCacheSize(stats_.bytes, stats_.entries);
+      return;
+    }
     lru_.push_front(key);
     entries_[key] = Entry{value, bytes, lru_.begin()};
     stats_.bytes += bytes;
@@ -236,6 +263,8 @@ class ArtifactLru final : public ArtifactCache {
                                    const Builder& build, bool* hit) override {
     return lru_.GetOrBuild(key, stop, build, hit);
   }
+  Value Find(const std::string& key) override { return lru_.Find(key); }
+  void Put(const std::string& key, Value value) override { lru_.Put(key, std::move(value)); }
   void EraseWithPrefix(const std::string& prefix) { lru_.EraseWithPrefix(prefix); }
   SharedLruCache<Artifact>::Stats stats() const { return lru_.stats(); }
   size_t budget_bytes() const { return lru_.budget_bytes(); }

@@ -59,6 +59,12 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                   .Name("covplan_replans_total")
                   .Help("Replans answered, by the method that produced the plan")
                   .Register(r);
+  plan_sources_ = &prometheus::BuildCounter()
+                       .Name("covplan_plan_source_total")
+                       .Help("Plans answered, by source: cold search, remembered plan (cache_hit), "
+                             "search on from it (improved), search from a remembered tour (warm_start)")
+                       .Register(r);
+  for (const char* s : {"cold", "cache_hit", "improved", "warm_start"}) plan_sources_->Add({{"source", s}});
   replan_duration_ = &prometheus::BuildHistogram()
                           .Name("covplan_replan_duration_seconds")
                           .Help("Compute time of one replan")
@@ -97,6 +103,10 @@ void ServerMetrics::RecordRequest(const std::string& method, const std::string& 
 void ServerMetrics::RecordSolve(double seconds, bool cut_short) {
   solve_duration_->Observe(seconds);
   if (cut_short) cut_short_->Increment();
+}
+
+void ServerMetrics::RecordPlanSource(const std::string& source) {
+  plan_sources_->Add({{"source", source}}).Increment();
 }
 
 void ServerMetrics::OnCacheSize(size_t bytes, size_t entries) {

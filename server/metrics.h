@@ -41,6 +41,8 @@ class ServerMetrics : public CacheObserver {
   // `code` is the gRPC status code name, e.g. "OK", "INVALID_ARGUMENT".
   void RecordRequest(const std::string& method, const std::string& code, double seconds);
   void RecordSolve(double seconds, bool cut_short);
+  // `source` is PlanOriginName: "cold", "cache_hit", "improved", "warm_start".
+  void RecordPlanSource(const std::string& source);
   void RecordReplan(const std::string& method, double seconds, int greedy_detours);
   void SetReplanEstimator(double a, double b, double c, int64_t samples);
 
@@ -81,6 +83,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge* plans_retained_;
   prometheus::Gauge* store_writable_;
   prometheus::Family<prometheus::Counter>* replans_;
+  prometheus::Family<prometheus::Counter>* plan_sources_;
   prometheus::Histogram* replan_duration_;
   prometheus::Counter* greedy_detours_;
   prometheus::Family<prometheus::Gauge>* estimator_;

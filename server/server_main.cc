@@ -43,6 +43,10 @@ ABSL_FLAG(std::string, pg_conninfo, "",
           "With --map_store=postgres: libpq connection string, e.g. \"host=/run/pg dbname=covplan\"");
 ABSL_FLAG(int, threads, 2, "Worker threads for planning");
 ABSL_FLAG(int, max_queue, 16, "Requests that may wait for a worker; beyond: RESOURCE_EXHAUSTED");
+ABSL_FLAG(bool, plan_memory, true,
+          "Remember plans within the --cache_mb budget: an identical Plan request is answered at once, "
+          "one differing only in start/end pose or seed searches from the remembered tour; false: every "
+          "request searches from scratch");
 ABSL_FLAG(int64_t, cache_mb, 256, "Per-map artifact cache budget in MiB (grids, coverage areas, partitions, transitions)");
 ABSL_FLAG(double, default_budget_s, 2.0, "Tour search budget for calls without a deadline");
 ABSL_FLAG(int, deadline_margin_ms, 25, "Part of a call's deadline kept for sending the reply");
@@ -199,6 +203,7 @@ int main(int argc, char** argv) {
   service.worker_threads = absl::GetFlag(FLAGS_threads);
   service.max_queue = absl::GetFlag(FLAGS_max_queue);
   service.cache_budget_bytes = static_cast<size_t>(absl::GetFlag(FLAGS_cache_mb)) << 20;
+  service.plan_memory = absl::GetFlag(FLAGS_plan_memory);
   service.default_budget_s = absl::GetFlag(FLAGS_default_budget_s);
   service.deadline_margin = absl::Milliseconds(absl::GetFlag(FLAGS_deadline_margin_ms));
   service.plan_ttl = absl::Seconds(absl::GetFlag(FLAGS_plan_ttl_s));

@@ -20,6 +20,12 @@ namespace {
 
 constexpr char kEstimatorFile[] = "replan_estimator.txt";
 
+EngineLimits EngineLimitsWithMemory(const ServiceOptions& options) {
+  EngineLimits limits = EngineLimitsFor(options.limits);
+  limits.plan_memory = options.plan_memory;
+  return limits;
+}
+
 // The answers for an id that does not exist, also given for another
 // tenant's id, so a caller cannot tell the two apart.
 absl::Status MapNotFound(const std::string& map_id) {
@@ -138,7 +144,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       metrics_(metrics),
       cache_(options.cache_budget_bytes, metrics),
       registry_(PlannerRegistry::WithBuiltins()),
-      engine_(&registry_, &cache_, EngineLimitsFor(options.limits)),
+      engine_(&registry_, &cache_, EngineLimitsWithMemory(options)),
       plans_(options.plan_ttl, options.max_retained_plans),
       sessions_(options.max_sessions, options.session_idle),
       id_salt_(std::random_device{}()),
@@ -640,6 +646,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   if (request.map_ref_case() == v1::PlanRequest::kMapId) PersistPlan(request, *response);
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, retained->plan.stats.tour_cut_short);
+  metrics_->RecordPlanSource(PlanOriginName(retained->plan.stats.plan_source));
   const int64_t mean = mean_solve_us_.load();
   mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
   plans_.Put(std::move(retained));
@@ -704,12 +711,13 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     ReleaseSolve();
     std::string detail;
     if (status.ok()) {
-      detail = absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s cached=%d",
+      detail = absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s cached=%d source=%s",
                                response->plan_id(), response->planner(),
                                response->stats().num_ranks(),
                                v1::TerminationReason_Name(response->termination().reason()),
                                v1::TerminationLimit_Name(response->termination().limit()),
-                               response->stats().decomposition_cached());
+                               response->stats().decomposition_cached(),
+                               v1::PlanSource_Name(response->stats().plan_source()));
     }
     FinishCall(reactor, call, status, detail);
     MaybeTrimMemory(absl::Now() - call.start);

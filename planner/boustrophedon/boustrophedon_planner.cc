@@ -33,6 +33,11 @@ absl::Status BoustrophedonOptions::Validate() const {
   return absl::OkStatus();
 }
 
+std::string BoustrophedonOptions::CacheText() const {
+  return absl::StrFormat("boustrophedon:axis=%d;tour=%d;effort=%d", static_cast<int>(sweep_axis),
+                         static_cast<int>(tour_solver), static_cast<int>(tour_effort));
+}
+
 size_t BoustrophedonDetail::MemoryBytes() const {
   size_t bytes = sizeof(*this) + cell_order.capacity() * sizeof(int) + cell_reversed.capacity() / 8 +
                  cell_mirrored.capacity() / 8;

@@ -37,6 +37,7 @@ struct BoustrophedonOptions final : PlannerOptions {
   TourSolver tour_solver = TourSolver::kGtsp;
   GtspEffort tour_effort = GtspEffort::kDefault;
   absl::Status Validate() const override;
+  std::string CacheText() const override;
 };
 
 struct BoustrophedonCellInfo {

@@ -68,6 +68,14 @@ class ArtifactCache {
   // already there (or built by another caller). Failed builds are not kept.
   virtual absl::StatusOr<Value> GetOrBuild(const std::string& key, const StopToken& stop,
                                            const Builder& build, bool* hit) = 0;
+  // The value of `key` if present (marks it recently used), else null. For
+  // entries that are replaced rather than built once (remembered plans).
+  virtual Value Find(const std::string& key) = 0;
+  // Stores `value` under `key`, replacing what was there, within the budget.
+  // Unlike GetOrBuild there is no fence against a concurrent prefix erase:
+  // use it only for keys whose text identifies the content (map content id),
+  // so that a value put after an erase is still correct, merely cached.
+  virtual void Put(const std::string& key, Value value) = 0;
 };
 
 // Typed access: builds a T under an ArtifactKey<T>.
@@ -112,6 +120,16 @@ class LocalArtifactCache final : public ArtifactCache {
       values_.emplace(key, *built);
     }
     return built;
+  }
+  Value Find(const std::string& key) override {
+    absl::MutexLock lock(&mu_);
+    auto it = values_.find(key);
+    return it == values_.end() ? nullptr : it->second;
+  }
+  void Put(const std::string& key, Value value) override {
+    if (value == nullptr) return;
+    absl::MutexLock lock(&mu_);
+    values_[key] = std::move(value);
   }
   size_t size() const {
     absl::MutexLock lock(&mu_);

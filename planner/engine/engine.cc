@@ -9,7 +9,9 @@
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
 #include "planner/energy/charge_cycles.h"
+#include "planner/engine/plan_memory.h"
 #include "planner/tour/path_timing.h"
+#include "planner/tour/tour_model.h"
 
 namespace covplan {
 namespace {
@@ -31,6 +33,12 @@ absl::Status CheckInsideMap(const std::vector<PolygonInput>& polygons, const cha
   }
   return absl::OkStatus();
 }
+
+// Trials a new start pose's warm start spends (OrdererOptions::warm_trials):
+// none. The remembered cycle, cut at its best place for the new start and
+// locally optimised, is as good as a cold search on the shipped maps
+// (docs/benchmarks.md §12) at a small fraction of its time.
+constexpr int kWarmStartTrials = 0;
 
 }  // namespace
 
@@ -164,37 +172,16 @@ absl::StatusOr<std::shared_ptr<const CoverageArea>> PlanningEngine::AreaFor(
   return ctx.area;
 }
 
-absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
-                                                  const PlanRequest& original) const {
-  ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
-  PlanRequest request = original;
-  if (request.battery.has_value()) {
-    // A battery tour starts and ends at the station.
-    if (!request.common.robot.start) request.common.robot.start = request.battery->station;
-    if (!request.common.robot.end) request.common.robot.end = request.battery->station;
-  }
-  PlanContext ctx;
-  bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
-  if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
-  ASSIGN_OR_RETURN(CoveragePlan plan, resolved.planner->Plan(ctx));
-  const CoverageArea& area = *ctx.area;
-  plan.planner = std::string(resolved.planner->name());
-  if (request.battery.has_value()) {
-    const absl::Time t = absl::Now();
-    ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *area.drive, *request.battery, request.common.robot,
-                                                 request.common.stop));
-    plan.stats.tour_ms += absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
-  }
-
+absl::Status PlanningEngine::Finish(const PlanRequest& request, const Resolved& resolved,
+                                    const CoverageArea& area, bool all_cached, CoveragePlan* plan) const {
   // The engine's own check: no segment may enter a no-go zone's interior.
   if (resolved.zones.has_no_go()) {
-    for (size_t i = 1; i < plan.path.size(); ++i) {
-      const Waypoint& a = plan.path[i - 1];
-      const Waypoint& b = plan.path[i];
+    for (size_t i = 1; i < plan->path.size(); ++i) {
+      const Waypoint& a = plan->path[i - 1];
+      const Waypoint& b = plan->path[i];
       if (resolved.zones.no_go->SegmentLengthInInterior({a.x, a.y}, {b.x, b.y}) <= 1e-9) continue;
       const bool from_start = i <= 2 && request.common.robot.start.has_value();
-      const bool to_end = i + 2 >= plan.path.size() && request.common.robot.end.has_value();
+      const bool to_end = i + 2 >= plan->path.size() && request.common.robot.end.has_value();
       const bool station_leg = request.battery.has_value() &&
                                (b.kind == SegmentKind::kToStation || b.kind == SegmentKind::kFromStation);
       if (station_leg) {
@@ -214,8 +201,8 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
     }
   }
 
-  PlanStats& s = plan.stats;
-  const PlanStats path_stats = ComputePathStats(plan.path, request.common.robot);
+  PlanStats& s = plan->stats;
+  const PlanStats path_stats = ComputePathStats(plan->path, request.common.robot);
   s.num_turns = path_stats.num_turns;
   s.coverage_length_m = path_stats.coverage_length_m;
   s.transition_length_m = path_stats.transition_length_m;
@@ -226,7 +213,7 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   s.free_cells = area.cover_cells;
   std::vector<uint8_t> swept(static_cast<size_t>(area.drive->size()), 0);
   s.covered_cells = 0;
-  for (const CoverageSweep& sweep : plan.sweeps) {
+  for (const CoverageSweep& sweep : plan->sweeps) {
     for (const CellIndex& c : sweep.cells) {
       if (!area.drive->InBounds(c.row, c.col)) continue;
       uint8_t& bit = swept[area.drive->Index(c.row, c.col)];
@@ -241,8 +228,113 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   s.grid_ms = area.grid_ms;
   s.planning_ms = s.grid_ms + s.partition_ms + s.transitions_ms + s.tour_ms;
   s.decomposition_cached = all_cached;
-  const TerminationLimit limit = plan.termination.limit;
+  const TerminationLimit limit = plan->termination.limit;
   s.tour_cut_short = limit == TerminationLimit::kDeadline || limit == TerminationLimit::kCancelled;
+  return absl::OkStatus();
+}
+
+absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
+                                                  const PlanRequest& original) const {
+  const absl::Time t0 = absl::Now();
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
+  PlanRequest request = original;
+  if (request.battery.has_value()) {
+    // A battery tour starts and ends at the station.
+    if (!request.common.robot.start) request.common.robot.start = request.battery->station;
+    if (!request.common.robot.end) request.common.robot.end = request.battery->station;
+  }
+  PlanContext ctx;
+  bool all_cached = true;
+  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
+
+  // Remembered plans (plan_memory.h).
+  std::optional<PlanMemoryKeys> keys;
+  std::shared_ptr<const RememberedPlan> remembered;
+  std::shared_ptr<const RememberedTour> remembered_tour;
+  PlanOrigin plan_source = PlanOrigin::kCold;
+  if (limits_.plan_memory) {
+    keys = PlanMemoryKeysFor(ctx.area_key, resolved.planner->name(), *resolved.options, request.common,
+                             request.battery);
+    remembered = FindRemembered<RememberedPlan>(*cache_, keys->exact);
+    if (remembered != nullptr && !request.improve_remembered &&
+        remembered->Answers(request.common.time_limit_s)) {
+      // Copied outside the cache's lock; the entry itself stays shared.
+      EngineResult hit{remembered->plan, ctx.area};
+      hit.plan.grid = ctx.area->drive;
+      PlanStats& s = hit.plan.stats;
+      s.plan_source = PlanOrigin::kCacheHit;
+      s.tour_ms = 0.0;
+      s.decomposition_cached = all_cached;
+      s.planning_ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
+      return hit;
+    }
+    if (resolved.planner->SupportsWarmStart(*resolved.options)) {
+      if (remembered != nullptr && !remembered->plan.tour_vertices.empty()) {
+        ctx.warm_tour = &remembered->plan.tour_vertices;
+        ctx.warm_trials = OrdererOptions::kEffortTrials;  // all warm
+        // Each further improvement run searches with seeds of its own.
+        request.common.seed += 0x9E3779B97F4A7C15ull * static_cast<uint64_t>(remembered->generation + 1);
+        plan_source = PlanOrigin::kImproved;
+      } else if ((remembered_tour = FindRemembered<RememberedTour>(*cache_, keys->tour)) != nullptr) {
+        ctx.warm_tour = &remembered_tour->vertices;
+        ctx.warm_trials = kWarmStartTrials;
+        plan_source = PlanOrigin::kWarmStart;
+      }
+    }
+  }
+
+  ASSIGN_OR_RETURN(CoveragePlan plan, resolved.planner->Plan(ctx));
+  request.common.seed = original.common.seed;
+  const CoverageArea& area = *ctx.area;
+  plan.planner = std::string(resolved.planner->name());
+  if (request.battery.has_value()) {
+    const absl::Time t = absl::Now();
+    ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *area.drive, *request.battery, request.common.robot,
+                                                 request.common.stop));
+    plan.stats.tour_ms += absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
+  }
+  RETURN_IF_ERROR(Finish(request, resolved, area, all_cached, &plan));
+  plan.stats.plan_source = plan_source;
+
+  if (keys.has_value()) {
+    int generation = 0;
+    if (plan_source == PlanOrigin::kImproved) {
+      generation = remembered->generation + 1;
+      if (remembered->plan.stats.estimated_duration_s < plan.stats.estimated_duration_s) {
+        // The search found nothing better: answer (and keep) the remembered plan.
+        // Its statistics and termination still tell how this search went.
+        const PlanStats fresh = plan.stats;
+        const Termination termination = plan.termination;
+        plan = remembered->plan;
+        plan.grid = area.drive;
+        plan.termination = termination;
+        plan.stats.plan_source = PlanOrigin::kImproved;
+        plan.stats.tour_ms = fresh.tour_ms;
+        plan.stats.planning_ms = fresh.planning_ms;
+        plan.stats.decomposition_cached = fresh.decomposition_cached;
+        plan.stats.tour_cut_short = fresh.tour_cut_short;
+      }
+    }
+    // The tour to warm-start from comes from full searches only, so that
+    // warm starts (a local step for one start pose) cannot wear it down.
+    if (!plan.tour_vertices.empty() && plan_source != PlanOrigin::kWarmStart) {
+      auto tour = std::make_shared<RememberedTour>();
+      tour->vertices = plan.tour_vertices;
+      cache_->Put(keys->tour, std::move(tour));
+    }
+    // A plan the caller's deadline or cancellation cut short is not what
+    // this request would get with its time: only its tour is remembered.
+    if (!plan.stats.tour_cut_short) {
+      auto entry = std::make_shared<RememberedPlan>();
+      entry->plan = plan;
+      entry->plan.grid = nullptr;  // held by the coverage area
+      entry->generation = generation;
+      entry->time_limit_s = std::max(request.common.time_limit_s,
+                                     remembered != nullptr ? remembered->time_limit_s : 0.0);
+      cache_->Put(keys->exact, std::move(entry));
+    }
+  }
   return EngineResult{std::move(plan), ctx.area};
 }
 

@@ -4,7 +4,11 @@
 // zones against the map), builds or finds the per-map artifacts (grid,
 // coverage area; the planner adds its own), runs the selected planner and
 // fills the statistics that follow from the path. It also checks the
-// result: no path segment may enter a no-go zone.
+// result: no path segment may enter a no-go zone. With
+// EngineLimits::plan_memory it remembers each plan in the cache and answers
+// an identical request from it at once, or warm-starts a request that
+// differs only in start/end pose or seed (plan_memory.h; the outcome is
+// PlanStats::plan_source).
 //
 //   PlannerRegistry registry = PlannerRegistry::WithBuiltins();
 //   LocalArtifactCache cache;
@@ -65,6 +69,10 @@ struct PlanRequest {
   // cycles from and to the station. Unless given, robot.start and robot.end
   // default to the station.
   std::optional<BatteryOptions> battery;
+  // With a remembered plan of an identical request (plan_memory.h): search
+  // on from its tour within this request's budget and remember the better
+  // of the two ("improved"), instead of returning it at once ("cache_hit").
+  bool improve_remembered = false;
 };
 
 // A plan kept for GetPlan and later continuation: the plan, the request it
@@ -109,6 +117,9 @@ class PlanningEngine {
   absl::StatusOr<Resolved> Resolve(const PlanRequest& request) const;
   absl::Status Setup(const MapSource& source, const PlanRequest& request, const Resolved& resolved,
                      PlanContext* ctx, bool* all_cached) const;
+  // Path checks and path-derived statistics of a planner's result.
+  absl::Status Finish(const PlanRequest& request, const Resolved& resolved, const CoverageArea& area,
+                      bool all_cached, CoveragePlan* plan) const;
 
   const PlannerRegistry* registry_;
   ArtifactCache* cache_;

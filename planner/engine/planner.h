@@ -24,6 +24,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -56,6 +57,9 @@ class PlannerOptions {
   virtual ~PlannerOptions() = default;
   // InvalidArgument naming the field (e.g. "oarp.partition_solver").
   virtual absl::Status Validate() const = 0;
+  // Every field, as stable text for cache keys (remembered plans): two
+  // options with equal text must give equal plans.
+  virtual std::string CacheText() const = 0;
 };
 
 // Limits of the host (server flags) that planners must respect.
@@ -63,6 +67,9 @@ struct EngineLimits {
   int64_t max_grid_cells = 4'000'000;
   int64_t max_ranks = 1000;          // OARP: the transition table grows with ranks^2
   int64_t max_area_vertices = 100'000;  // per regions / no_go / polygon map
+  // Remember plans in the artifact cache (planner/engine/plan_memory.h);
+  // false: every request searches from scratch, as before issue 12.3.
+  bool plan_memory = true;
 };
 
 struct PlanContext {
@@ -74,6 +81,14 @@ struct PlanContext {
   EngineLimits limits;
   // Set to false by a planner when one of its artifacts had to be built.
   bool* all_cached = nullptr;
+  // A remembered tour to start the search from (TourModel vertices in
+  // visiting order, as CoveragePlan::tour_vertices; see plan_memory.h), or
+  // null. Only planners whose SupportsWarmStart() is true read it.
+  const std::vector<int>* warm_tour = nullptr;
+  // With warm_tour: search trials to spend on it (OrdererOptions::warm_trials:
+  // -1 = the effort's full count, to improve an identical request's plan;
+  // 0 = only the local step).
+  int warm_trials = 1;
 };
 
 class Planner {
@@ -87,6 +102,9 @@ class Planner {
   // may call it alone to warm the cache. Plan() calls it too.
   virtual absl::Status Prepare(const PlanContext& ctx) const = 0;
   virtual absl::StatusOr<CoveragePlan> Plan(const PlanContext& ctx) const = 0;
+  // True when Plan() with these options honours PlanContext::warm_tour and
+  // fills CoveragePlan::tour_vertices.
+  virtual bool SupportsWarmStart(const PlannerOptions&) const { return false; }
 };
 
 }  // namespace covplan

@@ -30,6 +30,15 @@ absl::Status OarpOptions::Validate() const {
   return absl::OkStatus();
 }
 
+std::string OarpOptions::CacheText() const {
+  return absl::StrFormat("oarp:partition=%d;tour=%d;effort=%d", static_cast<int>(partition_solver),
+                         static_cast<int>(tour_solver), static_cast<int>(tour_effort));
+}
+
+bool OarpPlanner::SupportsWarmStart(const PlannerOptions& options) const {
+  return static_cast<const OarpOptions&>(options).tour_solver == TourSolver::kGtsp;
+}
+
 std::shared_ptr<const PlannerOptions> OarpPlanner::DefaultOptions() const {
   return std::make_shared<const OarpOptions>();
 }
@@ -106,6 +115,10 @@ absl::StatusOr<CoveragePlan> OarpPlanner::Plan(const PlanContext& ctx) const {
   oo.seed = common.seed;
   oo.num_threads = common.num_threads;
   oo.effort = options.tour_effort;
+  if (ctx.warm_tour != nullptr && SupportsWarmStart(options)) {
+    oo.warm_order = *ctx.warm_tour;
+    oo.warm_trials = ctx.warm_trials;
+  }
   std::unique_ptr<TourOrderer> orderer;
   if (options.tour_solver == TourSolver::kGreedy) {
     orderer = std::make_unique<GreedyOrderer>();
@@ -138,6 +151,7 @@ absl::StatusOr<CoveragePlan> OarpPlanner::Plan(const PlanContext& ctx) const {
   }
   plan.termination = tour.termination;
   plan.detail = std::move(detail);
+  if (SupportsWarmStart(options)) plan.tour_vertices = std::move(tour.vertices);
   PlanStats& s = plan.stats;
   s.num_ranks = static_cast<int64_t>(ranks.size());
   s.partition_ms = a.partition->build_ms;

@@ -34,6 +34,7 @@ struct OarpOptions final : PlannerOptions {
   // within the budget); kThorough keeps improving until the budget is spent.
   GtspEffort tour_effort = GtspEffort::kDefault;
   absl::Status Validate() const override;
+  std::string CacheText() const override;
 };
 
 // OARP's detail beside the planner-neutral plan.
@@ -71,6 +72,8 @@ class OarpPlanner final : public Planner {
   absl::Status CheckOptions(const PlannerOptions& options) const override;
   absl::Status Prepare(const PlanContext& ctx) const override;
   absl::StatusOr<CoveragePlan> Plan(const PlanContext& ctx) const override;
+  // The GTSP orderer only (the greedy order has nothing to warm-start).
+  bool SupportsWarmStart(const PlannerOptions& options) const override;
 
  private:
   struct Artifacts {

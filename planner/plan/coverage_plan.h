@@ -71,6 +71,15 @@ struct Termination {
 const char* TerminationReasonName(TerminationReason r);
 const char* TerminationLimitName(TerminationLimit l);
 
+// Where a plan came from (planner/engine/plan_memory.h).
+enum class PlanOrigin : uint8_t {
+  kCold = 0,       // searched from scratch (no remembered tour)
+  kCacheHit = 1,   // the remembered plan of an identical request, no search
+  kImproved = 2,   // an identical request's remembered tour, searched further
+  kWarmStart = 3,  // searched from the remembered tour of a request that differed in start/end/seed
+};
+const char* PlanOriginName(PlanOrigin s);  // "cold", "cache_hit", "improved", "warm_start"
+
 // Statistics every planner fills (the engine computes the path-derived ones
 // from the waypoints, so they agree with the path by construction).
 struct PlanStats {
@@ -103,6 +112,7 @@ struct PlanStats {
   double tour_ms = 0.0;
   bool tour_cut_short = false;  // kept for old callers: termination.limit_reached()
   bool decomposition_cached = false;  // every per-map artifact came from the cache
+  PlanOrigin plan_source = PlanOrigin::kCold;  // set by the engine
   std::string partition_solver;
   std::string tour_solver;
   // Battery plans only (planner/energy): energy in the battery's units.
@@ -143,6 +153,10 @@ struct CoveragePlan {
   PlanStats stats;
   Termination termination;
   std::shared_ptr<const PlannerDetail> detail;
+  // The planner's TourModel vertices in visiting order (planners that
+  // SupportsWarmStart only; empty otherwise): what a later request with
+  // another start pose warm-starts from.
+  std::vector<int> tour_vertices;
 
   template <typename T>
   const T* detail_as() const {

@@ -10,6 +10,12 @@
 
 namespace covplan {
 
+std::string StcOptions::CacheText() const {
+  return absl::StrFormat("stc:tree=%d;sweep=%d;partial=%d;offset=%d", static_cast<int>(tree),
+                         static_cast<int>(sweep_direction), static_cast<int>(partial_cells),
+                         search_offset ? 1 : 0);
+}
+
 absl::Status StcOptions::Validate() const {
   if (tree != StcTreeMethod::kDfs && tree != StcTreeMethod::kPrim) {
     return absl::InvalidArgumentError("stc.tree: unknown tree method (DFS or PRIM)");

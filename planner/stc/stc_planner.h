@@ -42,6 +42,7 @@ struct StcOptions final : PlannerOptions {
   // false: coarse cells start at row 0, column 0.
   bool search_offset = true;
   absl::Status Validate() const override;
+  std::string CacheText() const override;
 };
 
 class StcDetail final : public PlannerDetail {

@@ -110,10 +110,59 @@ bool BuildGtspInstance(const TourModel& model, const StopToken& stop, GtspInstan
   return true;
 }
 
+std::vector<int> BestRotation(const TourModel& model, const std::vector<int>& order) {
+  const int m = model.num_elements();
+  if (static_cast<int>(order.size()) != m || m == 0) return {};
+  std::vector<char> seen(m, 0);
+  for (int v : order) {
+    if (v < 0 || v >= model.num_vertices() || seen[model.element_of(v)]) return {};
+    seen[model.element_of(v)] = 1;
+  }
+  std::vector<int> reversed(order.rbegin(), order.rend());
+  for (int& v : reversed) {
+    const int e = model.element_of(v);
+    if (model.num_variants(e) == 2) v = model.first_vertex(e) + 1 - (v - model.first_vertex(e));
+  }
+  // A rotation's cost is the cycle's inner arcs minus the one it cuts, plus
+  // the start and end arcs at the cut: O(m) for all m rotations.
+  std::vector<int> best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const std::vector<int>* seq : {&order, static_cast<const std::vector<int>*>(&reversed)}) {
+    const std::vector<int>& s = *seq;
+    double ring = 0.0;
+    for (int i = 0; i < m; ++i) ring += model.Between(s[i], s[(i + 1) % m]);
+    for (int k = 0; k < m; ++k) {
+      // Tour s[k], s[k+1], ..., s[k-1]: drops the arc s[k-1] -> s[k].
+      const int first = s[k], last = s[(k + m - 1) % m];
+      const double cut = m == 1 ? 0.0 : model.Between(last, first);
+      const double cost = model.FromStart(first) + (ring - cut) + model.ToEnd(last);
+      if (std::isfinite(cost) && cost < best_cost) {
+        best_cost = cost;
+        best.assign(s.begin() + k, s.end());
+        best.insert(best.end(), s.begin(), s.begin() + k);
+      }
+    }
+  }
+  return best;
+}
+
 absl::StatusOr<TourOrder> GtspOrderer::Order(const TourModel& model, const StopToken& stop) const {
-  // Warm start and fallback: the greedy tour.
+  // Warm start and fallback: the greedy tour, or the remembered order's best
+  // rotation when it is cheaper.
   absl::StatusOr<TourOrder> greedy = GreedyOrderer().Order(model, stop);
   if (!greedy.ok()) return greedy.status();
+  bool warm = false;
+  if (!options_.warm_order.empty()) {
+    std::vector<int> rotated = BestRotation(model, options_.warm_order);
+    if (!rotated.empty()) {
+      warm = true;
+      const double cost = model.TourCost(rotated);
+      if (cost <= greedy->cost) {
+        greedy->vertices = std::move(rotated);
+        greedy->cost = cost;
+      }
+    }
+  }
   greedy->termination = Termination::Converged("single element: nothing to search");
   const int n = model.num_vertices();
   if (model.num_elements() <= 1) return greedy;
@@ -131,6 +180,11 @@ absl::StatusOr<TourOrder> GtspOrderer::Order(const TourModel& model, const StopT
   opt.num_threads = options_.num_threads;
   opt.effort = options_.effort;
   opt.stop = budget;
+  if (warm) {  // all trials warm: SolveGtsp skips cold trials when given an initial tour
+    opt.max_trials = options_.warm_trials == OrdererOptions::kEffortTrials ? 0
+                     : options_.warm_trials == 0                         ? GtspOptions::kLocalStepOnly
+                                                                         : options_.warm_trials;
+  }
   opt.initial_tour.push_back(start);
   for (int v : greedy->vertices) opt.initial_tour.push_back(v);
   if (end >= 0) opt.initial_tour.push_back(end);

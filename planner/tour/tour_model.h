@@ -100,6 +100,15 @@ struct OrdererOptions {
   uint64_t seed = 1;
   int num_threads = 1;
   GtspEffort effort = GtspEffort::kDefault;
+  // A remembered order of this model's elements (one vertex per element,
+  // e.g. the tour of the same map from another start pose). GtspOrderer then
+  // starts from its best rotation (or its reversal's: the start/end arcs
+  // moved, the cycle between them did not) instead of the greedy tour, and
+  // runs `warm_trials` warm trials (kEffortTrials: the effort's count; 0:
+  // only the local step). Ignored when it does not fit the model.
+  std::vector<int> warm_order = {};
+  int warm_trials = 1;
+  static constexpr int kEffortTrials = -1;
 };
 
 class TourOrderer {
@@ -127,6 +136,11 @@ class GtspOrderer final : public TourOrderer {
  private:
   OrdererOptions options_;
 };
+
+// The cheapest of the rotations of `order` and of its reversal (each
+// element driven in its other variant, when it has exactly two), or empty
+// when `order` is not one vertex per element of `model`.
+std::vector<int> BestRotation(const TourModel& model, const std::vector<int>& order);
 
 // The GTSP instance of a model: vertices 0..n-1 are the model's, n is the
 // start and n + 1 the end (when the model has one). False when `stop` fired.

@@ -193,7 +193,7 @@ TEST(GtspValidateTest, RejectsBadOptions) {
   options.num_threads = 0;
   EXPECT_EQ(SolveGtsp(Tiny(), options).status().code(), absl::StatusCode::kInvalidArgument);
   options = GtspOptions();
-  options.max_trials = -1;
+  options.max_trials = -2;  // -1 is kLocalStepOnly
   EXPECT_EQ(SolveGtsp(Tiny(), options).status().code(), absl::StatusCode::kInvalidArgument);
   options = GtspOptions();
   options.initial_tour = {1, 2};  // both from set 1

@@ -3,6 +3,7 @@
 // map is built once, so the cache sees exactly one miss set per map.
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -36,9 +37,13 @@ class LoadCommandTest : public ::testing::Test {
   }
 
   std::string Run(std::vector<std::string> extra, int* exit_code) {
-    std::vector<std::string> args = {"--server", absl::StrCat("127.0.0.1:", server_->port()),
-                                     "--concurrency", "2", "--duration", "60", "--requests",
-                                     "8", "--deadline-ms", "20000", "--tour", "greedy"};
+    std::vector<std::string> args = {"--server", absl::StrCat("127.0.0.1:", server_->port())};
+    // Defaults, unless `extra` gives the flag.
+    for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{
+             {"--concurrency", "2"}, {"--duration", "60"}, {"--requests", "8"},
+             {"--deadline-ms", "20000"}, {"--tour", "greedy"}}) {
+      if (std::find(extra.begin(), extra.end(), flag) == extra.end()) args.insert(args.end(), {flag, value});
+    }
     args.insert(args.end(), extra.begin(), extra.end());
     ::testing::internal::CaptureStdout();
     *exit_code = RunLoadCommand(args);
@@ -79,6 +84,23 @@ TEST_F(LoadCommandTest, InlineMapsNeedNoPutMap) {
   EXPECT_THAT(json, HasSubstr("\"maps\": 2,"));
   EXPECT_EQ(StoredMaps(), 0);
   EXPECT_THAT(json, ::testing::Not(HasSubstr("map_ids")));
+}
+
+// --random-start: every request starts elsewhere, so after the first cold
+// search each reply is a warm start (or, for a start drawn twice, a cache
+// hit); each reply's plan starts at its drawn pose, which the report's mean
+// duration reflects.
+TEST_F(LoadCommandTest, RandomStartsWarmStartFromTheRememberedTour) {
+  int code = -1;
+  const std::string json =
+      Run({"--map", absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml"), "--random-start",
+           "--concurrency", "1", "--tour", "gtsp", "--seed", "9"}, &code);
+  EXPECT_EQ(code, 0);
+  EXPECT_THAT(json, HasSubstr("\"requests\": 8, \"ok\": 8,"));
+  EXPECT_THAT(json, HasSubstr("\"random_start\": true"));
+  EXPECT_THAT(json, HasSubstr("\"cold\": 1"));
+  EXPECT_THAT(json, ::testing::MatchesRegex(".*\"plan_sources\": \\{(\"cache_hit\": [0-9], )?\"cold\": 1, \"warm_start\": [1-7]\\}.*"));
+  EXPECT_THAT(json, ::testing::ContainsRegex("\"mean_estimated_duration_s\": [1-9][0-9]*\\.[0-9]+"));
 }
 
 TEST_F(LoadCommandTest, MapAndMapsAreExclusive) {

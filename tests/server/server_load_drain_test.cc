@@ -149,7 +149,8 @@ TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNo
 // the grace; the process still exits within the grace plus a small bound,
 // and the plan is answered with its best tour, marked cut short by the drain.
 TEST_F(ServerHardeningTest, DrainKeepsItsGraceAndAnswersWithTheBestPlan) {
-  StartServer({"--drain_grace_s=1", "--threads=1"});
+  // Without remembered plans: the seed-2 request must search, not warm-start.
+  StartServer({"--drain_grace_s=1", "--threads=1", "--plan_memory=false"});
   const std::string map_id = PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
   v1::PlanResponse warm;
   ASSERT_TRUE(Plan(map_id, 0.3, &warm).ok());  // artifacts cached: the next search has a plan at once

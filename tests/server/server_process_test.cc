@@ -263,7 +263,8 @@ TEST_F(ServerProcessTest, CorruptedMapFileIsReportedNotServed) {
 }
 
 TEST_F(ServerProcessTest, ShortDeadlineGetsAValidPlanInTime) {
-  StartServer();
+  // The repeated request must search under its deadline, not be remembered.
+  StartServer({"--plan_memory=false"});
   const std::string map_id = PutMap(OfficeMap());
   // Warm the decomposition cache; the full search gets a generous budget.
   v1::PlanResponse full;
@@ -281,6 +282,7 @@ TEST_F(ServerProcessTest, ShortDeadlineGetsAValidPlanInTime) {
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_LT(took, absl::Milliseconds(150));
     EXPECT_TRUE(plan.stats().decomposition_cached());
+    EXPECT_EQ(plan.stats().plan_source(), v1::PLAN_SOURCE_COLD);  // --plan_memory=false
     // A valid plan: every rank visited once.
     EXPECT_EQ(plan.rank_order_size(), plan.ranks_size());
     std::vector<int> order(plan.rank_order().begin(), plan.rank_order().end());
@@ -377,7 +379,8 @@ TEST_F(ServerProcessTest, OverloadIsRefusedQuicklyAndRecovers) {
 }
 
 TEST_F(ServerProcessTest, QueueWaitBeyondTheDeadlineIsRefusedAtOnce) {
-  StartServer({"--threads=1", "--max_queue=4"});
+  // Identical requests must each search for ~1 s, not be answered from memory.
+  StartServer({"--threads=1", "--max_queue=4", "--plan_memory=false"});
   const std::string map_id = PutMap(OfficeMap());
   // Warm the cache and teach the server that a solve takes ~1 s.
   v1::PlanResponse warm;

@@ -425,6 +425,55 @@ TEST_F(ServiceTest, HealthIsServingAndReflectionListsTheService) {
   EXPECT_THAT(*services, Contains("grpc.health.v1.Health"));
 }
 
+// Remembered plans follow map content: the id is the content's, DeleteMap
+// forgets the plans with the artifacts, and other content is another id.
+TEST_F(ServiceTest, RememberedPlansAreNeverAnsweredForOtherMapContent) {
+  const std::string map_id = PutTwoRooms();
+  v1::PlanResponse cold, hit;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &cold).ok());
+  EXPECT_EQ(cold.stats().plan_source(), v1::PLAN_SOURCE_COLD);
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &hit).ok());
+  EXPECT_EQ(hit.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  ASSERT_EQ(hit.path_size(), cold.path_size());
+  for (int i = 0; i < cold.path_size(); ++i) {
+    EXPECT_EQ(hit.path(i).x(), cold.path(i).x());
+    EXPECT_EQ(hit.path(i).y(), cold.path(i).y());
+  }
+  EXPECT_NE(hit.plan_id(), cold.plan_id());
+
+  // Deleted, then stored again under the same (content) id: planned afresh.
+  {
+    grpc::ClientContext context;
+    v1::DeleteMapRequest del;
+    del.set_map_id(map_id);
+    v1::DeleteMapResponse deleted;
+    ASSERT_TRUE(stub_->DeleteMap(&context, del, &deleted).ok());
+  }
+  v1::PlanResponse gone;
+  EXPECT_EQ(Plan(PlanRequestFor(map_id, 0.4), &gone).error_code(), grpc::StatusCode::NOT_FOUND);
+  ASSERT_EQ(PutTwoRooms(), map_id);
+  v1::PlanResponse fresh;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &fresh).ok());
+  EXPECT_EQ(fresh.stats().plan_source(), v1::PLAN_SOURCE_COLD);
+
+  // Other content (a wall opened): another id, never the old plan.
+  std::vector<std::string> rows = testing::TwoRooms();
+  rows[2][5] = '.';
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(RasterMap(AsciiToPgm(rows, 4), 0.1), &put).ok());
+  ASSERT_NE(put.map_id(), map_id);
+  v1::PlanResponse other;
+  ASSERT_TRUE(Plan(PlanRequestFor(put.map_id(), 0.4), &other).ok());
+  EXPECT_EQ(other.stats().plan_source(), v1::PLAN_SOURCE_COLD);
+  EXPECT_EQ(other.stats().free_cells(), cold.stats().free_cells() + 1);
+
+  // Bad input is still refused, remembered plan or not.
+  v1::PlanRequest bad = PlanRequestFor(map_id, 0.4);
+  bad.set_time_limit_s(-1);
+  v1::PlanResponse refused;
+  EXPECT_EQ(Plan(bad, &refused).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
 class MetricsServiceTest : public ServiceTest {
  protected:
   MetricsServiceTest() { with_metrics_ = true; }
@@ -443,6 +492,7 @@ TEST_F(MetricsServiceTest, MetricsEndpointExposesTheFamilies) {
         "covplan_plan_solve_duration_seconds_count 1", "covplan_plans_cut_short_total",
         "covplan_worker_queue_depth", "covplan_solves_in_flight",
         "covplan_artifact_cache_misses_total 4", // grid, area, partition, transitions
+        "covplan_plan_source_total{source=\"cold\"} 1", "covplan_plan_source_total{source=\"cache_hit\"} 0",
         "covplan_artifact_cache_hits_total",
         "covplan_artifact_cache_evictions_total", "covplan_artifact_cache_bytes",
         "covplan_maps_stored 1"}) {

@@ -104,8 +104,8 @@ absl::Status GtspOptions::Validate() const {
   if (num_threads < 1 || num_threads > 256) {
     return absl::InvalidArgumentError(absl::StrCat("num_threads must be in [1, 256], got ", num_threads));
   }
-  if (max_trials < 0) {
-    return absl::InvalidArgumentError(absl::StrCat("max_trials must be >= 0, got ", max_trials));
+  if (max_trials < GtspOptions::kLocalStepOnly) {
+    return absl::InvalidArgumentError(absl::StrCat("max_trials must be >= -1, got ", max_trials));
   }
   return absl::OkStatus();
 }
@@ -192,7 +192,9 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
   // restarts if time remains.
   const bool until_deadline =
       options.max_trials == 0 && stop.has_deadline() && options.effort == GtspEffort::kThorough;
-  if (options.max_trials > 0) {
+  if (options.max_trials == GtspOptions::kLocalStepOnly) {
+    total_trials = 0;
+  } else if (options.max_trials > 0) {
     total_trials = options.max_trials;
   } else if (until_deadline) {
     total_trials = kUnlimitedTrials;

@@ -49,7 +49,8 @@ struct GtspOptions {
   uint64_t seed = 1;
   int num_threads = 1;            // trials run in parallel on this many threads
   GtspEffort effort = GtspEffort::kDefault;
-  int max_trials = 0;             // 0 = chosen by effort
+  int max_trials = 0;             // 0 = chosen by effort; kLocalStepOnly: no LNS trial
+  static constexpr int kLocalStepOnly = -1;  // the initial (or greedy) tour, locally optimised
   StopToken stop;                 // deadline / cancellation
   // Optional starting tour (one vertex per set, in visiting order) to improve.
   std::vector<int> initial_tour;

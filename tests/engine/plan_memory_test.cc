@@ -1,0 +1,226 @@
+// Remembered plans (planner/engine/plan_memory.h): an identical request is
+// answered from memory with the same path; any change to the map, zones,
+// robot, options or seed is not; a new start pose warm-starts and still
+// covers every cell from that pose; without memory (or with a fresh cache)
+// the same seed gives the same plan.
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gtest/gtest.h"
+#include "planner/engine/engine.h"
+#include "planner/oarp/oarp_planner.h"
+#include "tests/testing/plan_conformance.h"
+#include "tests/testing/shipped_maps.h"
+
+namespace covplan {
+namespace {
+
+class PlanMemoryTest : public ::testing::Test {
+ protected:
+  PlanMemoryTest() : map_(testing::LoadShippedMap("sample_office.yaml")) {}
+
+  MapSource Source(const std::string& id = "office") const {
+    MapSource s;
+    s.map_id = id;
+    s.load = [this]() -> absl::StatusOr<SiteMap> {
+      SiteMap site;
+      site.raster = std::make_shared<const OccupancyMap>(map_);
+      return site;
+    };
+    return s;
+  }
+  static PlanRequest Request() {
+    PlanRequest r;
+    r.common.robot.tool_width_m = 0.8;
+    r.common.time_limit_s = 60;  // the default effort converges long before: deterministic
+    r.common.seed = 3;
+    return r;
+  }
+  EngineResult MustPlan(const PlanningEngine& engine, const PlanRequest& r, const std::string& id = "office") {
+    absl::StatusOr<EngineResult> result = engine.Plan(Source(id), r);
+    EXPECT_TRUE(result.ok()) << result.status();
+    return result.ok() ? *std::move(result) : EngineResult{};
+  }
+  static void ExpectSamePath(const CoveragePlan& a, const CoveragePlan& b) {
+    ASSERT_EQ(a.path.size(), b.path.size());
+    for (size_t i = 0; i < a.path.size(); ++i) {
+      EXPECT_EQ(a.path[i].x, b.path[i].x) << i;
+      EXPECT_EQ(a.path[i].y, b.path[i].y) << i;
+      EXPECT_EQ(a.path[i].theta, b.path[i].theta) << i;
+      EXPECT_EQ(a.path[i].kind, b.path[i].kind) << i;
+    }
+  }
+
+  const PlannerRegistry registry_ = PlannerRegistry::WithBuiltins();
+  OccupancyMap map_;
+};
+
+TEST_F(PlanMemoryTest, IdenticalRequestIsACacheHitWithTheSamePath) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  const EngineResult first = MustPlan(engine, Request());
+  EXPECT_EQ(first.plan.stats.plan_source, PlanOrigin::kCold);
+  PlanRequest again = Request();
+  again.common.time_limit_s = 5;  // the time budget is not part of the key
+  const EngineResult hit = MustPlan(engine, again);
+  EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
+  EXPECT_EQ(hit.plan.stats.tour_ms, 0.0);
+  EXPECT_EQ(hit.plan.grid.get(), hit.area->drive.get());
+  ExpectSamePath(first.plan, hit.plan);
+  EXPECT_EQ(hit.plan.stats.estimated_duration_s, first.plan.stats.estimated_duration_s);
+  EXPECT_EQ(testing::CheckPlanConformance(hit.plan, *hit.area, again.common.robot), "");
+}
+
+TEST_F(PlanMemoryTest, AnyOtherInputIsNotAHit) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  MustPlan(engine, Request());
+
+  PlanRequest seed = Request();
+  seed.common.seed = 4;  // a cold search would search another way: warm start, not a hit
+  EXPECT_EQ(MustPlan(engine, seed).plan.stats.plan_source, PlanOrigin::kWarmStart);
+
+  PlanRequest zones = Request();
+  zones.no_go = {{{{2.1, 1.3}, {3.7, 1.6}, {3.2, 3.1}, {2.1, 1.3}}, {}}};
+  EXPECT_EQ(MustPlan(engine, zones).plan.stats.plan_source, PlanOrigin::kCold);
+
+  PlanRequest tool = Request();
+  tool.common.robot.tool_width_m = 0.7;
+  EXPECT_EQ(MustPlan(engine, tool).plan.stats.plan_source, PlanOrigin::kCold);
+
+  PlanRequest robot = Request();
+  robot.common.robot.turn_rate_deg_s = 45;
+  EXPECT_EQ(MustPlan(engine, robot).plan.stats.plan_source, PlanOrigin::kCold);
+
+  PlanRequest options = Request();
+  auto thorough = std::make_shared<OarpOptions>();
+  thorough->tour_effort = GtspEffort::kFast;
+  options.options = thorough;
+  EXPECT_EQ(MustPlan(engine, options).plan.stats.plan_source, PlanOrigin::kCold);
+
+  PlanRequest threads = Request();
+  threads.common.num_threads = 2;
+  EXPECT_EQ(MustPlan(engine, threads).plan.stats.plan_source, PlanOrigin::kWarmStart);
+
+  // Another map content id.
+  EXPECT_EQ(MustPlan(engine, Request(), "office-v2").plan.stats.plan_source, PlanOrigin::kCold);
+  // And the original is still remembered.
+  EXPECT_EQ(MustPlan(engine, Request()).plan.stats.plan_source, PlanOrigin::kCacheHit);
+}
+
+TEST_F(PlanMemoryTest, NewStartPoseWarmStartsFromThereAndCoversEveryCell) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  const EngineResult cold = MustPlan(engine, Request());
+  // Start poses on the path of the first plan (free, reachable cells).
+  for (size_t k : {cold.plan.path.size() / 3, 2 * cold.plan.path.size() / 3}) {
+    PlanRequest r = Request();
+    const Waypoint& at = cold.plan.path[k];
+    r.common.robot.start = Pose2{at.x, at.y, 1.0};
+    const EngineResult warm = MustPlan(engine, r);
+    SCOPED_TRACE(k);
+    EXPECT_EQ(warm.plan.stats.plan_source, PlanOrigin::kWarmStart);
+    ASSERT_FALSE(warm.plan.path.empty());
+    EXPECT_DOUBLE_EQ(warm.plan.path.front().x, at.x);
+    EXPECT_DOUBLE_EQ(warm.plan.path.front().y, at.y);
+    // Back to the start (no end pose given).
+    EXPECT_NEAR(warm.plan.path.back().x, at.x, 1e-9);
+    EXPECT_NEAR(warm.plan.path.back().y, at.y, 1e-9);
+    EXPECT_EQ(warm.plan.stats.covered_cells, warm.plan.stats.free_cells);
+    EXPECT_EQ(testing::CheckPlanConformance(warm.plan, *warm.area, r.common.robot), "");
+    // The same start pose again: now remembered.
+    const EngineResult hit = MustPlan(engine, r);
+    EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
+    ExpectSamePath(warm.plan, hit.plan);
+  }
+  // An end pose as well.
+  PlanRequest r = Request();
+  const Waypoint& end = cold.plan.path[cold.plan.path.size() / 2];
+  r.common.robot.end = Pose2{end.x, end.y, 0.0};
+  const EngineResult to_end = MustPlan(engine, r);
+  EXPECT_EQ(to_end.plan.stats.plan_source, PlanOrigin::kWarmStart);
+  EXPECT_NEAR(to_end.plan.path.back().x, end.x, 1e-9);
+  EXPECT_NEAR(to_end.plan.path.back().y, end.y, 1e-9);
+  EXPECT_EQ(testing::CheckPlanConformance(to_end.plan, *to_end.area, r.common.robot), "");
+}
+
+TEST_F(PlanMemoryTest, ColdPlansStayDeterministicForASeed) {
+  LocalArtifactCache cache_a, cache_b, cache_off;
+  PlanningEngine a(&registry_, &cache_a, EngineLimits{});
+  PlanningEngine b(&registry_, &cache_b, EngineLimits{});
+  EngineLimits off;
+  off.plan_memory = false;
+  PlanningEngine without(&registry_, &cache_off, off);
+  const EngineResult ra = MustPlan(a, Request());
+  const EngineResult rb = MustPlan(b, Request());
+  const EngineResult r1 = MustPlan(without, Request());
+  const EngineResult r2 = MustPlan(without, Request());
+  for (const EngineResult* r : {&ra, &rb, &r1, &r2}) EXPECT_EQ(r->plan.stats.plan_source, PlanOrigin::kCold);
+  ExpectSamePath(ra.plan, rb.plan);
+  ExpectSamePath(ra.plan, r1.plan);
+  ExpectSamePath(ra.plan, r2.plan);
+  EXPECT_EQ(cache_off.size(), 4u);  // artifacts only, nothing remembered
+}
+
+TEST_F(PlanMemoryTest, ImproveRememberedSearchesOnAndKeepsTheBetterPlan) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  PlanRequest quick = Request();
+  auto fast = std::make_shared<OarpOptions>();
+  fast->tour_effort = GtspEffort::kFast;
+  quick.options = fast;
+  const EngineResult first = MustPlan(engine, quick);
+  PlanRequest more = quick;
+  more.improve_remembered = true;
+  const EngineResult improved = MustPlan(engine, more);
+  EXPECT_EQ(improved.plan.stats.plan_source, PlanOrigin::kImproved);
+  EXPECT_LE(improved.plan.stats.estimated_duration_s, first.plan.stats.estimated_duration_s);
+  EXPECT_EQ(testing::CheckPlanConformance(improved.plan, *improved.area, more.common.robot), "");
+  const EngineResult hit = MustPlan(engine, quick);
+  EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
+  ExpectSamePath(improved.plan, hit.plan);
+}
+
+// A search its own time limit stopped answers requests with no more time;
+// one with more searches on from it.
+TEST_F(PlanMemoryTest, TimeLimitedPlanAnswersNoLongerBudgetAndImprovesWithMore) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  PlanRequest r = Request();
+  auto thorough = std::make_shared<OarpOptions>();
+  thorough->tour_effort = GtspEffort::kThorough;  // searches until the time limit
+  r.options = thorough;
+  r.common.time_limit_s = 0.2;
+  const EngineResult timed = MustPlan(engine, r);
+  ASSERT_EQ(timed.plan.termination.limit, TerminationLimit::kTime);
+  r.common.time_limit_s = 0.1;
+  EXPECT_EQ(MustPlan(engine, r).plan.stats.plan_source, PlanOrigin::kCacheHit);
+  r.common.time_limit_s = 0.4;
+  const EngineResult more = MustPlan(engine, r);
+  EXPECT_EQ(more.plan.stats.plan_source, PlanOrigin::kImproved);
+  EXPECT_LE(more.plan.stats.estimated_duration_s, timed.plan.stats.estimated_duration_s);
+  // Now remembered for 0.4 s.
+  const EngineResult hit = MustPlan(engine, r);
+  EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
+  ExpectSamePath(more.plan, hit.plan);
+}
+
+TEST_F(PlanMemoryTest, BadInputIsStillInvalidArgumentWhenAPlanIsRemembered) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  MustPlan(engine, Request());
+  PlanRequest bad = Request();
+  bad.common.time_limit_s = -1;
+  EXPECT_EQ(engine.Plan(Source(), bad).status().code(), absl::StatusCode::kInvalidArgument);
+  bad = Request();
+  bad.common.robot.start = Pose2{-50, -50, 0};  // off the map
+  EXPECT_EQ(engine.Plan(Source(), bad).status().code(), absl::StatusCode::kInvalidArgument);
+  bad = Request();
+  bad.regions = {{{{100, 100}, {101, 100}, {101, 101}, {100, 100}}, {}}};  // outside the map
+  EXPECT_EQ(engine.Plan(Source(), bad).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace covplan
