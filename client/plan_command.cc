@@ -1,5 +1,6 @@
 #include "client/plan_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -35,7 +36,7 @@ constexpr char kUsage[] =
     "                    [--time-limit S] [--seed N] [--partition matching|mincut|lp] [--tour gtsp|greedy]\n"
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
-    "                    [--min-free-fraction F] [--deadline-ms D]\n"
+    "                    [--min-free-fraction F] [--deadline-ms D] [--threads N]   (--local)\n"
     "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|boustrophedon]\n"
     "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
     "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
@@ -138,6 +139,7 @@ struct PlanCommand {
   std::optional<std::string> out;
   std::optional<std::string> svg;
   std::optional<int64_t> deadline_ms;
+  int threads = 1;  // --local only
 };
 
 absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
@@ -149,7 +151,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
                  "energy-per-second", "atomic-units", "sweep-axis",
-                 "algorithm", "stc-tree", "sweep-direction", "stc-partial"}),
+                 "algorithm", "stc-tree", "sweep-direction", "stc-partial", "threads"}),
                 {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -168,6 +170,12 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   ASSIGN_OR_RETURN(c.deadline_ms, a.GetInt("deadline-ms"));
   if (c.deadline_ms && *c.deadline_ms <= 0) {
     return absl::InvalidArgumentError("--deadline-ms must be positive");
+  }
+  ASSIGN_OR_RETURN(std::optional<int64_t> threads, a.GetInt("threads"));
+  if (threads) {
+    if (!c.local) return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
+    if (*threads < 1 || *threads > 256) return absl::InvalidArgumentError("--threads must be in [1, 256]");
+    c.threads = static_cast<int>(*threads);
   }
 
   v1::PlanRequest& r = c.request;
@@ -283,7 +291,7 @@ absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& ma
   if (c.local) {
     v1::PlanRequest request = c.request;
     *request.mutable_map() = map;
-    return PlanLocally(request, limits);
+    return PlanLocally(request, limits, c.threads);
   }
   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(c.server);
   v1::PutMapRequest put;
@@ -334,9 +342,10 @@ absl::Status Run(const std::vector<std::string>& args) {
 }  // namespace
 
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits) {
+                                             const InputLimits& limits, int num_threads) {
   if (!request.has_map()) return absl::InvalidArgumentError("local planning needs an inline map");
   ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
+  plan_request.common.num_threads = std::max(1, num_threads);
   if (request.time_limit_s() <= 0) plan_request.common.time_limit_s = kLocalDefaultBudgetS;
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
   LocalArtifactCache cache;

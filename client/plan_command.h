@@ -23,8 +23,9 @@ int RunPlanCommand(const std::vector<std::string>& args);
 
 // Plans in-process through the same convert code the server uses, so --local
 // and server mode produce the same JSON (up to plan_id and timings).
+// `num_threads`: worker threads of the planning core (server: 1 per call).
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits);
+                                             const InputLimits& limits, int num_threads = 1);
 
 // The human summary printed to stdout.
 std::string FormatPlanSummary(const v1::PlanResponse& response);
