@@ -19,7 +19,7 @@ const OarpOptions& Options(const PlanContext& ctx) {
   return *static_cast<const OarpOptions*>(ctx.options);
 }
 
-constexpr int kCandidateNeighbours = 12;
+constexpr int kCandidateNeighbours = 20;
 constexpr int64_t kCachedPairs = 4'000'000;
 constexpr int64_t kBytesPerCachedPair = 40;  // unordered_map node + bucket
 

@@ -157,7 +157,8 @@ void AnyAngleSearch::Reset() {
   touched_.clear();
 }
 
-bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& stop) {
+bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& stop, int64_t max_expansions,
+                           float* bound) {
   Reset();
   if (!grid_.IsFree(source) || !grid_.IsFree(target)) return true;
   source_ = grid_.Index(source.row, source.col);
@@ -175,7 +176,11 @@ bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& 
     const auto [f, s] = open.top();
     open.pop();
     if (closed_[s] || f > dist_[s] + h(s) + 1e-4f) continue;
-    if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
+    if (++expansions > max_expansions) {
+      if (bound != nullptr) *bound = f;
+      return false;
+    }
+    if ((expansions & 1023) == 0 && stop.ShouldStop()) return false;
     const CellIndex cs = grid_.FromIndex(s);
     const int32_t p = parent_[s];
     if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {

@@ -75,8 +75,11 @@ class AnyAngleSearch {
   // Goal-directed (A*, Euclidean heuristic) search that stops once `target`
   // is settled; afterwards PathTo(target) and DistanceCells(target) hold.
   // Costs only the cells it touches (no whole-grid reset), so many short
-  // searches on a large grid stay cheap. False if stopped early.
-  bool RunTo(CellIndex source, CellIndex target, const StopToken& stop);
+  // searches on a large grid stay cheap. False if stopped early, or after
+  // `max_expansions` expansions: then `*bound` (if given) is a lower bound
+  // of the distance (the smallest g + h still open).
+  bool RunTo(CellIndex source, CellIndex target, const StopToken& stop,
+             int64_t max_expansions = INT64_MAX, float* bound = nullptr);
   // Run() cut short: the same search (same order, same distances) that
   // calls settle(cell index, distance) for each cell it closes and stops when
   // settle returns false or `max_settled` cells are closed. Costs only the

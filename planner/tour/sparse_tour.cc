@@ -138,7 +138,8 @@ class Problem {
   }
 
   // Exact drive time x -> y: candidate lists, the cache, then a search.
-  double ExactCost(int x, int y, AnyAngleSearch* search) {
+  // Infinity (not cached) if `stop` fires during the search.
+  double ExactCost(int x, int y, AnyAngleSearch* search, const StopToken& stop) {
     const absl::Span<const EndpointCandidate> cx = candidates(x);
     for (size_t i = 0; i < cx.size(); ++i) {
       if (cx[i].endpoint == y) return CandidateCost(x, i);
@@ -160,19 +161,47 @@ class Problem {
     {
       std::lock_guard<std::mutex> lock(shard.mu);
       auto it = shard.map.find(key);
-      if (it != shard.map.end()) return it->second;
+      if (it != shard.map.end() && it->second.exact) return it->second.cost;
     }
-    // Never cut short: a partial search would cache a wrong cost.
-    search->RunTo(a, b, never_);
+    if (!search->RunTo(a, b, stop)) return std::numeric_limits<double>::infinity();
     const std::vector<CellIndex> cells = search->PathTo(b);
     const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
     searches_.fetch_add(1, std::memory_order_relaxed);
-    if (cached_.load(std::memory_order_relaxed) < max_cached_) {
-      std::lock_guard<std::mutex> lock(shard.mu);
-      if (shard.map.emplace(key, c).second) cached_.fetch_add(1, std::memory_order_relaxed);
-    }
+    Store(shard, key, {c, true});
     return c;
   }
+
+  // A cheap, tighter lower bound of ExactCost(x, y) (or the exact cost): a
+  // search capped at kProbeExpansions, whose open frontier bounds the
+  // distance when it does not reach y. Pairs across walls, whose Euclidean
+  // bound is loose, are mostly rejected here without a full search.
+  double ProbeCost(int x, int y, AnyAngleSearch* search) {
+    if (Known(x, y)) return ExactCost(x, y, search, never_);
+    const CellIndex a = cells_[x], b = cells_[y];
+    if (graph_.component(a) != graph_.component(b) || graph_.component(a) < 0) {
+      return std::numeric_limits<double>::infinity();
+    }
+    const uint64_t key = static_cast<uint64_t>(std::min(x, y)) * (2 * n_ + 2) + std::max(x, y);
+    Shard& shard = shards_[(key * 0x9E3779B97F4A7C15ULL) >> 58];
+    {
+      std::lock_guard<std::mutex> lock(shard.mu);
+      auto it = shard.map.find(key);
+      if (it != shard.map.end()) return it->second.cost;
+    }
+    float bound = 0.0f;
+    probes_.fetch_add(1, std::memory_order_relaxed);
+    if (!search->RunTo(a, b, never_, kProbeExpansions, &bound)) {
+      const double c = BoundCost(x, y, bound);
+      Store(shard, key, {c, false});
+      return c;
+    }
+    const std::vector<CellIndex> cells = search->PathTo(b);
+    const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
+    searches_.fetch_add(1, std::memory_order_relaxed);
+    Store(shard, key, {c, true});
+    return c;
+  }
+  int64_t probes() const { return probes_.load(); }
   int64_t searches() const { return searches_.load(); }
   const Grid& grid() const { return grid_; }
   // True when ExactCost(x, y) needs no search (a candidate pair).
@@ -185,10 +214,25 @@ class Problem {
   }
 
  private:
+  static constexpr int64_t kProbeExpansions = 1500;
+  struct Cached {
+    double cost;
+    bool exact;  // else a lower bound from a capped search
+  };
   struct Shard {
     std::mutex mu;
-    std::unordered_map<uint64_t, double> map;
+    std::unordered_map<uint64_t, Cached> map;
   };
+  void Store(Shard& shard, uint64_t key, Cached value) {
+    std::lock_guard<std::mutex> lock(shard.mu);
+    auto it = shard.map.find(key);
+    if (it != shard.map.end()) {
+      it->second = value;
+    } else if (cached_.load(std::memory_order_relaxed) < max_cached_) {
+      shard.map.emplace(key, value);
+      cached_.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
   size_t candidate_base(int e) const {
     return static_cast<size_t>(graph_.candidates(e).data() - graph_.candidates(0).data());
   }
@@ -206,7 +250,7 @@ class Problem {
   std::vector<double> pose_costs_[2];
   std::vector<double> cand_costs_;  // parallel to the graph's candidates
   Shard shards_[64];
-  std::atomic<int64_t> cached_{0}, searches_{0};
+  std::atomic<int64_t> cached_{0}, searches_{0}, probes_{0};
   StopToken never_;
 };
 
@@ -270,7 +314,8 @@ class Run {
   void Push(int node) {
     if (!queued_[node]) queued_[node] = 1, queue_.push_back(node);
   }
-  double C(int x, int y) { return p_.ExactCost(x, y, &search_); }
+  double C(int x, int y) { return p_.ExactCost(x, y, &search_, *stop_); }
+  double B(int x, int y) { return p_.ProbeCost(x, y, &search_); }
   double L(int x, int y) const { return p_.LowerCost(x, y); }
 
   bool Improve(int x);
@@ -281,6 +326,8 @@ class Run {
   void DoubleBridge(int i, int j, int k);
 
   Problem& p_;
+  const StopToken* stop_ = &never_;  // bounds exact searches of the current phase
+  StopToken never_;
   AnyAngleSearch search_;
   gtsp_internal::Rng rng_;
   std::vector<int> t_, pos_, mate_;
@@ -408,9 +455,12 @@ bool Run::TryTwoOpt(int i, int j) {
   // The pair known without a search first, so the bound can spare the other.
   if (p_.Known(b, d) && !p_.Known(a, c)) {
     c2 = C(b, d);
-    if (lac + c2 >= removed - kEps) return false;
+    if (B(a, c) + c2 >= removed - kEps) return false;
     c1 = C(a, c);
   } else {
+    c1 = B(a, c);
+    if (c1 + lbd >= removed - kEps) return false;
+    if (B(b, d) + c1 >= removed - kEps) return false;
     c1 = C(a, c);
     if (c1 + lbd >= removed - kEps) return false;
     c2 = C(b, d);
@@ -459,6 +509,10 @@ bool Run::TryOrOpt(int a, int b, int k, bool reversed) {
   const int xs[3] = {before, left, last}, ys[3] = {after, first, right};
   int order[3] = {0, 1, 2};
   std::stable_sort(order, order + 3, [&](int u, int v) { return p_.Known(xs[u], ys[u]) > p_.Known(xs[v], ys[v]); });
+  for (int o : order) {
+    cost[o] = B(xs[o], ys[o]);
+    if (cost[0] + cost[1] + cost[2] >= removed - kEps) return false;
+  }
   for (int o : order) {
     cost[o] = C(xs[o], ys[o]);
     if (cost[0] + cost[1] + cost[2] >= removed - kEps) return false;
@@ -519,9 +573,10 @@ bool Run::Improve(int x) {
 }
 
 void Run::LocalSearch(const StopToken& stop) {
+  stop_ = &stop;
   int64_t pops = 0;
   while (!queue_.empty()) {
-    if ((++pops & 255) == 0 && stop.ShouldStop()) break;
+    if ((++pops & 15) == 0 && stop.ShouldStop()) break;
     const int x = queue_.front();
     queue_.pop_front();
     queued_[x] = 0;
@@ -529,6 +584,7 @@ void Run::LocalSearch(const StopToken& stop) {
   }
   for (int v : queue_) queued_[v] = 0;
   queue_.clear();
+  stop_ = &never_;
 }
 
 void Run::DoubleBridge(int i, int j, int k) {
@@ -585,10 +641,11 @@ bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limi
     const double saved = cost_;
     ++kicks_;
     logging_ = true;
+    stop_ = &stop;
     DoubleBridge(i, j, k);
     LocalSearch(stop);
     logging_ = false;
-    if (cost_ < saved - kEps) {
+    if (cost_ < saved - kEps && std::isfinite(cost_)) {
       log_.clear();
       no_improve = 0;
     } else {
@@ -674,10 +731,10 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     if (std::getenv("COVPLAN_SPARSE_DEBUG") != nullptr) {
       std::fprintf(stderr,
                    "sparse run %d: nn %.1f (%.0f ms, %lld searches), local search %.1f, final %.1f, %lld kicks, "
-                   "%.0f ms, %lld searches\n",
+                   "%.0f ms, %lld searches, %lld probes\n",
                    index, built, absl::ToDoubleMilliseconds(t0 - began), static_cast<long long>(construct_searches),
                    local, r.cost(), static_cast<long long>(r.kicks()), absl::ToDoubleMilliseconds(absl::Now() - t0),
-                   static_cast<long long>(problem.searches()));
+                   static_cast<long long>(problem.searches()), static_cast<long long>(problem.probes()));
     }
     out.tour = r.tour();
     out.cost = r.cost();

@@ -47,8 +47,8 @@ struct SparseTourOptions {
   bool until_limit = false;     // true: keep kicking until the budget is spent
   // Kicks without improvement after which a run counts as converged:
   // max(min_kicks, kicks_per_rank * ranks).
-  int64_t min_kicks = 1000;
-  double kicks_per_rank = 2.0;
+  int64_t min_kicks = 500;
+  double kicks_per_rank = 1.0;
   int64_t max_cached_pairs = 4'000'000;  // on-demand exact lengths kept
 };
 
