@@ -19,6 +19,7 @@
 #include "client/remote.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/engine/engine.h"
+#include "planner/oarp/oarp_planner.h"
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "planner/plan/svg.h"
@@ -36,7 +37,8 @@ constexpr char kUsage[] =
     "                    [--time-limit S] [--seed N] [--partition matching|mincut|lp] [--tour gtsp|greedy]\n"
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
-    "                    [--min-free-fraction F] [--deadline-ms D] [--threads N]   (--local)\n"
+    "                    [--min-free-fraction F] [--deadline-ms D]\n"
+    "                    [--threads N] [--tour-effort fast|default|thorough]   (--local)\n"
     "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|boustrophedon]\n"
     "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
     "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
@@ -140,6 +142,7 @@ struct PlanCommand {
   std::optional<std::string> svg;
   std::optional<int64_t> deadline_ms;
   int threads = 1;  // --local only
+  std::optional<GtspEffort> tour_effort;  // --local only
 };
 
 absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
@@ -151,7 +154,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
                  "energy-per-second", "atomic-units", "sweep-axis",
-                 "algorithm", "stc-tree", "sweep-direction", "stc-partial", "threads"}),
+                 "algorithm", "stc-tree", "sweep-direction", "stc-partial", "threads", "tour-effort"}),
                 {"local", "negate", "interruptible"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -176,6 +179,13 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     if (!c.local) return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
     if (*threads < 1 || *threads > 256) return absl::InvalidArgumentError("--threads must be in [1, 256]");
     c.threads = static_cast<int>(*threads);
+  }
+  if (auto effort = a.Get("tour-effort")) {
+    if (!c.local) return absl::InvalidArgumentError("--tour-effort needs --local");
+    if (*effort == "fast") c.tour_effort = GtspEffort::kFast;
+    else if (*effort == "default") c.tour_effort = GtspEffort::kDefault;
+    else if (*effort == "thorough") c.tour_effort = GtspEffort::kThorough;
+    else return absl::InvalidArgumentError(absl::StrCat("--tour-effort must be fast, default or thorough, got '", *effort, "'"));
   }
 
   v1::PlanRequest& r = c.request;
@@ -291,7 +301,7 @@ absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& ma
   if (c.local) {
     v1::PlanRequest request = c.request;
     *request.mutable_map() = map;
-    return PlanLocally(request, limits, c.threads);
+    return PlanLocally(request, limits, c.threads, c.tour_effort);
   }
   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(c.server);
   v1::PutMapRequest put;
@@ -342,10 +352,18 @@ absl::Status Run(const std::vector<std::string>& args) {
 }  // namespace
 
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits, int num_threads) {
+                                             const InputLimits& limits, int num_threads,
+                                             std::optional<GtspEffort> tour_effort) {
   if (!request.has_map()) return absl::InvalidArgumentError("local planning needs an inline map");
   ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
   plan_request.common.num_threads = std::max(1, num_threads);
+  if (tour_effort) {
+    const auto* oarp = dynamic_cast<const OarpOptions*>(plan_request.options.get());
+    if (plan_request.planner != "oarp") return absl::InvalidArgumentError("--tour-effort needs --planner oarp");
+    auto options = std::make_shared<OarpOptions>(oarp != nullptr ? *oarp : OarpOptions());
+    options->tour_effort = *tour_effort;
+    plan_request.options = std::move(options);
+  }
   if (request.time_limit_s() <= 0) plan_request.common.time_limit_s = kLocalDefaultBudgetS;
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
   LocalArtifactCache cache;
