@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -657,7 +655,7 @@ bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limi
   return false;
 }
 
-// Points from `pose` then the centres of `cells`.
+// Appends the centres of `cells`.
 void AppendCentres(const Grid& grid, const std::vector<CellIndex>& cells, std::vector<Point2>* pts) {
   for (const CellIndex& c : cells) pts->push_back(grid.CellCenter(c));
 }
@@ -718,23 +716,10 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     Outcome& out = outcomes[index];
     out.status = r.Construct(stop);
     if (!out.status.ok()) return;
-    const double built = r.cost();
-    const absl::Time t0 = absl::Now();
-    const int64_t construct_searches = problem.searches();
-    double local = built;
     if (options.local_search) {
       r.PushAll();
       r.LocalSearch(budget);
-      local = r.cost();
       out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit);
-    }
-    if (std::getenv("COVPLAN_SPARSE_DEBUG") != nullptr) {
-      std::fprintf(stderr,
-                   "sparse run %d: nn %.1f (%.0f ms, %lld searches), local search %.1f, final %.1f, %lld kicks, "
-                   "%.0f ms, %lld searches, %lld probes\n",
-                   index, built, absl::ToDoubleMilliseconds(t0 - began), static_cast<long long>(construct_searches),
-                   local, r.cost(), static_cast<long long>(r.kicks()), absl::ToDoubleMilliseconds(absl::Now() - t0),
-                   static_cast<long long>(problem.searches()), static_cast<long long>(problem.probes()));
     }
     out.tour = r.tour();
     out.cost = r.cost();

@@ -2,14 +2,16 @@
 // of RankTourCost + GtspOrderer + BuildPath.
 //
 // The tour is a sequence of rank endpoints: start, (entry, exit) of each
-// rank, end. A transition x -> y is priced by a surrogate of the robot's
-// time model: the straight-segment time of the exact 8-connected path
-// length (EndpointGraph candidates or an on-demand OctileSearch, cached)
-// plus the in-place turns from x's exit heading onto the straight line
-// x -> y and from it onto y's rank heading. The same formula with the
-// octile lower bound prices moves first, so exact searches run only for
-// moves that could improve. It is symmetric, so reversing a run of ranks
-// (all directions flipped) keeps its inner cost.
+// rank, end. A transition x -> y costs what RankTourCost charges: the robot's
+// time (path_timing.h) along the any-angle path, with the turn from x's rank
+// heading and onto y's. Paths of candidate pairs come from the
+// EndpointGraph; others are searched on demand (AnyAngleSearch::RunTo) and
+// their costs cached for the request. Moves are priced first with a lower
+// bound (straight-line time of the Euclidean distance plus the turns onto
+// and off the straight line), then with a capped probe search, and only then
+// exactly, so full searches run only for moves that could still improve.
+// Endpoint-to-endpoint costs are symmetric, so reversing a run of ranks (all
+// directions flipped) keeps its inner cost.
 //
 // Search: nearest neighbour over the candidate lists (with a bucket-grid
 // fallback to the nearest unvisited endpoints when all candidates are
@@ -17,8 +19,7 @@
 // to candidate lists, driven by a work queue, then iterated local search
 // with local double-bridge kicks and undo; one independent run per thread
 // (different seeds), the best kept. Only the final tour's transitions become
-// any-angle paths (AnyAngleSearch::RunTo, in parallel), and plan durations
-// come from those real paths.
+// paths (in parallel); plan durations come from those paths.
 //
 //   ASSIGN_OR_RETURN(SparseTour tour, PlanSparseRankTour(drive, ranks, *graph, robot, opts, stop));
 //
