@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
+#include "planner/common/status_macros.h"
 #include "planner/tour/grid_paths.h"
 #include "planner/tour/gtsp/rng.h"
 #include "planner/tour/path_timing.h"
@@ -272,6 +273,10 @@ class Run {
   double cost() const { return cost_; }
   int64_t kicks() const { return kicks_; }
   const std::vector<int>& tour() const { return t_; }
+  // Starts from `other`'s tour (same problem).
+  void CopyTour(const Run& other) {
+    t_ = other.t_, pos_ = other.pos_, mate_ = other.mate_, lc_ = other.lc_, cost_ = other.cost_;
+  }
   void PushAll() {
     for (int v : t_) Push(v);
   }
@@ -702,23 +707,32 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   const absl::Time began = absl::Now();
   const StopToken budget = stop.WithEarlierDeadline(began + absl::Seconds(options.time_limit_s));
   const int threads = options.local_search ? std::max(1, options.num_threads) : 1;
+
   const int64_t converge_after =
-      std::max<int64_t>(options.min_kicks, static_cast<int64_t>(options.kicks_per_rank * n));
+      std::max<int64_t>(options.min_kicks, static_cast<int64_t>(options.kicks_per_rank * n)) / threads;
   struct Outcome {
-    absl::Status status;
     std::vector<int> tour;
     double cost = std::numeric_limits<double>::infinity();
     bool converged = true;
   };
   std::vector<Outcome> outcomes(threads);
+  // One construction and first descent (deterministic: repeating them per
+  // thread would only duplicate work), then one kick run per thread from
+  // that tour with its own seed.
+  std::vector<std::unique_ptr<Run>> runs;
+  for (int t = 0; t < threads; ++t) {
+    runs.push_back(std::make_unique<Run>(&problem, gtsp_internal::SeedFor(options.seed, t)));
+  }
+  RETURN_IF_ERROR(runs[0]->Construct(stop));
+  if (options.local_search) {
+    runs[0]->PushAll();
+    runs[0]->LocalSearch(budget);
+  }
+  for (int t = 1; t < threads; ++t) runs[t]->CopyTour(*runs[0]);
   auto run = [&](int index) {
-    Run r(&problem, gtsp_internal::SeedFor(options.seed, index));
+    Run& r = *runs[index];
     Outcome& out = outcomes[index];
-    out.status = r.Construct(stop);
-    if (!out.status.ok()) return;
     if (options.local_search) {
-      r.PushAll();
-      r.LocalSearch(budget);
       out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit);
     }
     out.tour = r.tour();
@@ -732,7 +746,6 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   }
   int best = -1;
   for (int t = 0; t < threads; ++t) {
-    if (!outcomes[t].status.ok()) return outcomes[t].status;
     if (best < 0 || outcomes[t].cost < outcomes[best].cost - kEps) best = t;
   }
   const std::vector<int>& t = outcomes[best].tour;
