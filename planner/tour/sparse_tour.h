@@ -17,9 +17,10 @@
 // fallback to the nearest unvisited endpoints when all candidates are
 // visited), then 2-opt and Or-opt (1-3 ranks, either direction) restricted
 // to candidate lists, driven by a work queue, then iterated local search
-// with local double-bridge kicks and undo; one independent run per thread
-// (different seeds), the best kept. Only the final tour's transitions become
-// paths (in parallel); plan durations come from those paths.
+// with local double-bridge kicks and undo: one construction and descent,
+// then one kick run per thread from it (different seeds), the best kept.
+// Only the final tour's transitions become paths (in parallel); plan
+// durations come from those paths.
 //
 //   ASSIGN_OR_RETURN(SparseTour tour, PlanSparseRankTour(drive, ranks, *graph, robot, opts, stop));
 //
