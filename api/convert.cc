@@ -109,7 +109,8 @@ absl::StatusOr<std::string> ReadFile(const std::string& path, int64_t max_bytes)
 }  // namespace
 
 absl::Status InputLimits::Validate() const {
-  if (max_image_bytes <= 0 || max_map_pixels <= 0 || max_grid_cells <= 0 || max_ranks <= 0) {
+  if (max_image_bytes <= 0 || max_map_pixels <= 0 || max_grid_cells <= 0 || max_ranks <= 0 ||
+      max_transition_bytes <= 0 || dense_transition_bytes < 0) {
     return absl::InvalidArgumentError("input limits must be positive");
   }
   return absl::OkStatus();
@@ -351,6 +352,8 @@ EngineLimits EngineLimitsFor(const InputLimits& limits) {
   EngineLimits e;
   e.max_grid_cells = limits.max_grid_cells;
   e.max_ranks = limits.max_ranks;
+  e.max_transition_bytes = limits.max_transition_bytes;
+  e.dense_transition_bytes = limits.dense_transition_bytes;
   e.max_area_vertices = limits.max_area_vertices;
   return e;
 }

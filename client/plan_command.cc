@@ -1,5 +1,6 @@
 #include "client/plan_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +19,7 @@
 #include "client/remote.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/engine/engine.h"
+#include "planner/oarp/oarp_planner.h"
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
 #include "planner/plan/svg.h"
@@ -45,6 +47,7 @@ constexpr char kUsage[] =
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D] [--improve-remembered]\n"
+    "                    [--threads N] [--tour-effort fast|default|thorough]   (--local)\n"
     "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|boustrophedon]\n"
     "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
     "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
@@ -149,6 +152,8 @@ struct PlanCommand {
   std::optional<std::string> out;
   std::optional<std::string> svg;
   std::optional<int64_t> deadline_ms;
+  int threads = 1;  // --local only
+  std::optional<GtspEffort> tour_effort;  // --local only
 };
 
 absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
@@ -160,7 +165,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
                  "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
                  "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
                  "energy-per-second", "atomic-units", "sweep-axis",
-                 "algorithm", "stc-tree", "sweep-direction", "stc-partial"}),
+                 "algorithm", "stc-tree", "sweep-direction", "stc-partial", "threads", "tour-effort"}),
                 {"local", "negate", "interruptible", "improve-remembered"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -179,6 +184,19 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   ASSIGN_OR_RETURN(c.deadline_ms, a.GetInt("deadline-ms"));
   if (c.deadline_ms && *c.deadline_ms <= 0) {
     return absl::InvalidArgumentError("--deadline-ms must be positive");
+  }
+  ASSIGN_OR_RETURN(std::optional<int64_t> threads, a.GetInt("threads"));
+  if (threads) {
+    if (!c.local) return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
+    if (*threads < 1 || *threads > 256) return absl::InvalidArgumentError("--threads must be in [1, 256]");
+    c.threads = static_cast<int>(*threads);
+  }
+  if (auto effort = a.Get("tour-effort")) {
+    if (!c.local) return absl::InvalidArgumentError("--tour-effort needs --local");
+    if (*effort == "fast") c.tour_effort = GtspEffort::kFast;
+    else if (*effort == "default") c.tour_effort = GtspEffort::kDefault;
+    else if (*effort == "thorough") c.tour_effort = GtspEffort::kThorough;
+    else return absl::InvalidArgumentError(absl::StrCat("--tour-effort must be fast, default or thorough, got '", *effort, "'"));
   }
 
   v1::PlanRequest& r = c.request;
@@ -295,7 +313,7 @@ absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& ma
   if (c.local) {
     v1::PlanRequest request = c.request;
     *request.mutable_map() = map;
-    return PlanLocally(request, limits);
+    return PlanLocally(request, limits, c.threads, c.tour_effort);
   }
   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(c.server);
   v1::PutMapRequest put;
@@ -346,9 +364,18 @@ absl::Status Run(const std::vector<std::string>& args) {
 }  // namespace
 
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits) {
+                                             const InputLimits& limits, int num_threads,
+                                             std::optional<GtspEffort> tour_effort) {
   if (!request.has_map()) return absl::InvalidArgumentError("local planning needs an inline map");
   ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
+  plan_request.common.num_threads = std::max(1, num_threads);
+  if (tour_effort) {
+    const auto* oarp = dynamic_cast<const OarpOptions*>(plan_request.options.get());
+    if (plan_request.planner != "oarp") return absl::InvalidArgumentError("--tour-effort needs --planner oarp");
+    auto options = std::make_shared<OarpOptions>(oarp != nullptr ? *oarp : OarpOptions());
+    options->tour_effort = *tour_effort;
+    plan_request.options = std::move(options);
+  }
   if (request.time_limit_s() <= 0) plan_request.common.time_limit_s = kLocalDefaultBudgetS;
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
   LocalArtifactCache cache;

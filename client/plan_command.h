@@ -9,12 +9,14 @@
 #ifndef COVPLAN_CLIENT_PLAN_COMMAND_H_
 #define COVPLAN_CLIENT_PLAN_COMMAND_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "covplan/v1/covplan.pb.h"
 #include "api/convert.h"
+#include "planner/tour/gtsp/gtsp.h"
 
 namespace covplan {
 
@@ -23,8 +25,11 @@ int RunPlanCommand(const std::vector<std::string>& args);
 
 // Plans in-process through the same convert code the server uses, so --local
 // and server mode produce the same JSON (up to plan_id and timings).
+// `num_threads`: worker threads of the planning core (server: 1 per call);
+// `tour_effort` (OARP only, not in the API): the tour search's effort.
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits);
+                                             const InputLimits& limits, int num_threads = 1,
+                                             std::optional<GtspEffort> tour_effort = std::nullopt);
 
 // The human summary printed to stdout.
 std::string FormatPlanSummary(const v1::PlanResponse& response);

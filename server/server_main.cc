@@ -55,8 +55,14 @@ ABSL_FLAG(int, max_retained_plans, 256, "Most plans kept for GetPlan");
 ABSL_FLAG(int64_t, max_image_mb, 64, "Largest accepted map image, MiB");
 ABSL_FLAG(int64_t, max_map_pixels, 64'000'000, "Largest accepted map, pixels");
 ABSL_FLAG(int64_t, max_grid_cells, 4'000'000, "Largest accepted tool-width grid, cells");
-ABSL_FLAG(int64_t, max_ranks, 1000,
-          "Most coverage ranks per plan (the transition table grows with ranks^2)");
+ABSL_FLAG(int64_t, max_ranks, 100000,
+          "Hard cap on coverage ranks per plan (memory is bounded by --max_transition_mb)");
+ABSL_FLAG(int64_t, max_transition_mb, 1024,
+          "Memory budget of one plan's transitions, MiB (OARP all-pairs table or sparse candidate "
+          "graph; boustrophedon table); above it: RESOURCE_EXHAUSTED");
+ABSL_FLAG(int64_t, dense_transition_mb, 16,
+          "OARP uses the exact all-pairs transition table and dense GTSP while they fit in this many "
+          "MiB, the sparse candidate graph above");
 ABSL_FLAG(double, max_request_s, 120.0,
           "Calls without a deadline stop after this long with DEADLINE_EXCEEDED");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");
@@ -107,6 +113,8 @@ std::vector<std::string> ValidateFlags() {
   CheckRange<int64_t>("max_map_pixels", absl::GetFlag(FLAGS_max_map_pixels), 1, int64_t{1} << 36, &errors);
   CheckRange<int64_t>("max_grid_cells", absl::GetFlag(FLAGS_max_grid_cells), 1, int64_t{1} << 32, &errors);
   CheckRange<int64_t>("max_ranks", absl::GetFlag(FLAGS_max_ranks), 1, 100000, &errors);
+  CheckRange<int64_t>("max_transition_mb", absl::GetFlag(FLAGS_max_transition_mb), 1, 1 << 20, &errors);
+  CheckRange<int64_t>("dense_transition_mb", absl::GetFlag(FLAGS_dense_transition_mb), 0, 1 << 20, &errors);
   CheckRange("max_request_s", absl::GetFlag(FLAGS_max_request_s), 1e-3, 24 * 3600.0, &errors);
   CheckRange("drain_grace_s", absl::GetFlag(FLAGS_drain_grace_s), 0.0, 3600.0, &errors);
   CheckRange("drain_notice_s", absl::GetFlag(FLAGS_drain_notice_s), 0.0, 3600.0, &errors);
@@ -212,6 +220,8 @@ int main(int argc, char** argv) {
   service.limits.max_map_pixels = absl::GetFlag(FLAGS_max_map_pixels);
   service.limits.max_grid_cells = absl::GetFlag(FLAGS_max_grid_cells);
   service.limits.max_ranks = absl::GetFlag(FLAGS_max_ranks);
+  service.limits.max_transition_bytes = absl::GetFlag(FLAGS_max_transition_mb) << 20;
+  service.limits.dense_transition_bytes = absl::GetFlag(FLAGS_dense_transition_mb) << 20;
   service.max_request_time = absl::Seconds(absl::GetFlag(FLAGS_max_request_s));
   // Room for the image plus YAML and the rest of the request.
   config.max_message_bytes =

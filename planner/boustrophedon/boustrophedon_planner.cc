@@ -75,15 +75,15 @@ absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> BoustrophedonPlanne
   if (!hit && ctx.all_cached != nullptr) *ctx.all_cached = false;
   const int64_t n = static_cast<int64_t>(d->decomposition->cells.size());
   if (n == 0) return absl::InvalidArgumentError("no cells to cover: the coverage area is empty");
-  // Four entry corners per cell: the transition table has 4n endpoints, as
-  // many as OARP's 2 * max_ranks at n = max_ranks / 2.
-  if (2 * n > ctx.limits.max_ranks) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "the map decomposes into %d boustrophedon cells at tool width %g m, above the limit of %d "
-        "cells (the transition table over their corners would take about %d MiB); use a wider tool "
-        "or split the map",
-        n, ctx.area->cover->cell_size(), ctx.limits.max_ranks / 2,
-        TransitionTable::EstimateBytes(static_cast<int>(4 * n)) >> 20));
+  // Four entry corners per cell: the all-pairs transition table has 4n
+  // endpoints and must fit the transition memory budget.
+  const int64_t table_bytes = TransitionTable::EstimateBytes(static_cast<int>(std::min<int64_t>(4 * n, 1 << 30)));
+  if (table_bytes > ctx.limits.max_transition_bytes) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "the map decomposes into %d boustrophedon cells at tool width %g m: the transition table over "
+        "their corners would take about %d MiB, above the transition memory budget of %d MiB "
+        "(--max_transition_mb); use a wider tool or split the map",
+        n, ctx.area->cover->cell_size(), table_bytes >> 20, ctx.limits.max_transition_bytes >> 20));
   }
   return d;
 }

@@ -269,18 +269,21 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
       s.planning_ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
       return hit;
     }
-    if (resolved.planner->SupportsWarmStart(*resolved.options)) {
-      if (remembered != nullptr && !remembered->plan.tour_vertices.empty()) {
+    const bool warm = resolved.planner->SupportsWarmStart(*resolved.options);
+    if (remembered != nullptr) {
+      // Search on: from the remembered tour where the planner can start from
+      // one (the dense GTSP), else a fresh search; the better plan is kept.
+      if (warm && !remembered->plan.tour_vertices.empty()) {
         ctx.warm_tour = &remembered->plan.tour_vertices;
         ctx.warm_trials = OrdererOptions::kEffortTrials;  // all warm
-        // Each further improvement run searches with seeds of its own.
-        request.common.seed += 0x9E3779B97F4A7C15ull * static_cast<uint64_t>(remembered->generation + 1);
-        plan_source = PlanOrigin::kImproved;
-      } else if ((remembered_tour = FindRemembered<RememberedTour>(*cache_, keys->tour)) != nullptr) {
-        ctx.warm_tour = &remembered_tour->vertices;
-        ctx.warm_trials = kWarmStartTrials;
-        plan_source = PlanOrigin::kWarmStart;
       }
+      // Each further improvement run searches with seeds of its own.
+      request.common.seed += 0x9E3779B97F4A7C15ull * static_cast<uint64_t>(remembered->generation + 1);
+      plan_source = PlanOrigin::kImproved;
+    } else if (warm && (remembered_tour = FindRemembered<RememberedTour>(*cache_, keys->tour)) != nullptr) {
+      ctx.warm_tour = &remembered_tour->vertices;
+      ctx.warm_trials = kWarmStartTrials;
+      plan_source = PlanOrigin::kWarmStart;
     }
   }
 

@@ -65,7 +65,17 @@ class PlannerOptions {
 // Limits of the host (server flags) that planners must respect.
 struct EngineLimits {
   int64_t max_grid_cells = 4'000'000;
-  int64_t max_ranks = 1000;          // OARP: the transition table grows with ranks^2
+  // OARP: hard cap on coverage ranks. The transitions are bounded by memory
+  // (below), not by this count.
+  int64_t max_ranks = 100'000;
+  // Memory budget of the transitions of one plan (OARP: the exact all-pairs
+  // table and dense GTSP, or the sparse candidate graph with its search
+  // scratch; boustrophedon: its all-pairs table). Above it: RESOURCE_EXHAUSTED.
+  int64_t max_transition_bytes = int64_t{1} << 30;
+  // OARP uses the exact all-pairs table and the dense GTSP while they fit in
+  // this many bytes (about 200 ranks at the default), the sparse candidate
+  // graph and tour search above (planner/tour/sparse_tour.h).
+  int64_t dense_transition_bytes = int64_t{16} << 20;
   int64_t max_area_vertices = 100'000;  // per regions / no_go / polygon map
   // Remember plans in the artifact cache (planner/engine/plan_memory.h);
   // false: every request searches from scratch, as before issue 12.3.

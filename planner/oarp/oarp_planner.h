@@ -5,6 +5,7 @@
 // Per-map artifacts, derived from the request's CoverageArea key:
 //   ...|partition(<solver>)      the minimum rank partition of the cover grid
 //   ...|partition(...)|transitions   any-angle paths between rank endpoints
+//   ...|partition(...)|candidates    sparse nearest-endpoint graph (large maps)
 //
 //   OarpOptions opts; opts.tour_solver = TourSolver::kGreedy;
 //   request.planner = "oarp"; request.options = std::make_shared<OarpOptions>(opts);
@@ -20,6 +21,7 @@
 #include "planner/engine/planner.h"
 #include "planner/partition/partitioner.h"
 #include "planner/partition/rank.h"
+#include "planner/tour/endpoint_graph.h"
 #include "planner/tour/gtsp/gtsp.h"
 #include "planner/tour/transitions.h"
 
@@ -57,12 +59,24 @@ class PartitionArtifact final : public Artifact {
   size_t MemoryBytes() const override { return sizeof(*this) + partition->MemoryBytes(); }
 };
 
+// Exactly one of `table` (all-pairs, small maps) and `graph` (sparse
+// candidates, above EngineLimits::dense_transition_bytes) is set.
 class TransitionArtifact final : public Artifact {
  public:
   std::shared_ptr<const TransitionTable> table;
+  std::shared_ptr<const EndpointGraph> graph;
   double build_ms = 0.0;
-  size_t MemoryBytes() const override { return sizeof(*this) + table->MemoryBytes(); }
+  size_t MemoryBytes() const override {
+    return sizeof(*this) + (table ? table->MemoryBytes() : 0) + (graph ? graph->MemoryBytes() : 0);
+  }
 };
+
+// Bytes of OARP's dense path at `num_ranks`: the all-pairs table plus the
+// GTSP instance and its search form (three V x V double matrices).
+int64_t DenseTransitionBytes(int64_t num_ranks);
+// Peak bytes of the sparse path: candidate graph, per-thread search scratch
+// (octile and any-angle), tour state and the capped exact-length cache.
+int64_t SparseTransitionBytes(int64_t grid_cells, int64_t num_ranks, int num_threads);
 
 class OarpPlanner final : public Planner {
  public:

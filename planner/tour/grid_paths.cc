@@ -90,26 +90,9 @@ float Euclid(const Grid& g, int64_t a, int64_t b) {
   return std::sqrt(dr * dr + dc * dc);
 }
 
-// Calls f(neighbour index) for every allowed move from c: 4-neighbours, and
-// diagonals whose two orthogonal cells are free (no corner cutting) and whose
-// segment touches no non-free map pixel.
 template <typename F>
 void ForEachMove(const Grid& g, CellIndex c, F&& f) {
-  constexpr int kDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-  constexpr int kDc[8] = {0, 0, 1, -1, 1, -1, 1, -1};
-  for (int k = 0; k < 8; ++k) {
-    const int dr = kDr[k], dc = kDc[k];
-    if (k < 4) {
-      if (g.Passable(c.row, c.col, dr, dc)) f(g.Index(c.row + dr, c.col + dc));
-      continue;
-    }
-    // Diagonal: both L-shaped routes around the corner must be open.
-    if (g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
-        g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc) &&
-        (g.obstacle_pixels() == nullptr || !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc))) {
-      f(g.Index(c.row + dr, c.col + dc));
-    }
-  }
+  ForEachDriveMove(g, c, [&](int64_t n, bool) { f(n); });
 }
 
 }  // namespace
@@ -118,6 +101,8 @@ bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
   std::fill(dist_.begin(), dist_.end(), kUnreached);
   std::fill(parent_.begin(), parent_.end(), -1);
   std::fill(closed_.begin(), closed_.end(), 0);
+  touched_.clear();
+  all_dirty_ = true;
   if (!grid_.IsFree(source)) return true;
   source_ = grid_.Index(source.row, source.col);
   using Entry = std::pair<float, int32_t>;
@@ -151,6 +136,117 @@ bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
       if (closed_[n]) return;
       const float cand = dist_[ps] + Euclid(grid_, ps, n);
       if (cand < dist_[n]) {
+        dist_[n] = cand;
+        parent_[n] = ps;
+        open.push({cand, static_cast<int32_t>(n)});
+      }
+    });
+  }
+  return true;
+}
+
+void AnyAngleSearch::Reset() {
+  if (all_dirty_) {
+    std::fill(dist_.begin(), dist_.end(), kUnreached);
+    std::fill(parent_.begin(), parent_.end(), -1);
+    std::fill(closed_.begin(), closed_.end(), 0);
+    all_dirty_ = false;
+  } else {
+    for (int32_t i : touched_) dist_[i] = kUnreached, parent_[i] = -1, closed_[i] = 0;
+  }
+  touched_.clear();
+}
+
+bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& stop, int64_t max_expansions,
+                           float* bound) {
+  Reset();
+  if (!grid_.IsFree(source) || !grid_.IsFree(target)) return true;
+  source_ = grid_.Index(source.row, source.col);
+  const int64_t goal = grid_.Index(target.row, target.col);
+  // Ties (frequent in open areas) go to the cell nearer the goal.
+  auto h = [&](int64_t i) { return Euclid(grid_, i, goal) * (1.0f + 1e-5f); };
+  using Entry = std::pair<float, int32_t>;  // (g + h, cell)
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  dist_[source_] = 0.0f;
+  parent_[source_] = static_cast<int32_t>(source_);
+  touched_.push_back(static_cast<int32_t>(source_));
+  open.push({h(source_), static_cast<int32_t>(source_)});
+  int64_t expansions = 0;
+  while (!open.empty()) {
+    const auto [f, s] = open.top();
+    open.pop();
+    if (closed_[s] || f > dist_[s] + h(s) + 1e-4f) continue;
+    if (++expansions > max_expansions) {
+      if (bound != nullptr) *bound = f;
+      return false;
+    }
+    if ((expansions & 1023) == 0 && stop.ShouldStop()) return false;
+    const CellIndex cs = grid_.FromIndex(s);
+    const int32_t p = parent_[s];
+    if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {
+      float best = kUnreached;
+      int32_t best_parent = -1;
+      ForEachMove(grid_, cs, [&](int64_t n) {
+        if (!closed_[n]) return;
+        const float cand = dist_[n] + Euclid(grid_, n, s);
+        if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
+      });
+      if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
+    }
+    closed_[s] = 1;
+    if (s == goal) return true;
+    const int32_t ps = parent_[s];
+    ForEachMove(grid_, cs, [&](int64_t n) {
+      if (closed_[n]) return;
+      const float cand = dist_[ps] + Euclid(grid_, ps, n);
+      if (cand < dist_[n]) {
+        if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
+        dist_[n] = cand;
+        parent_[n] = ps;
+        open.push({cand + h(n), static_cast<int32_t>(n)});
+      }
+    });
+  }
+  return true;
+}
+
+bool AnyAngleSearch::Explore(CellIndex source, int64_t max_settled, const StopToken& stop,
+                             const std::function<bool(int64_t, float)>& settle) {
+  Reset();
+  if (!grid_.IsFree(source)) return true;
+  source_ = grid_.Index(source.row, source.col);
+  using Entry = std::pair<float, int32_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  dist_[source_] = 0.0f;
+  parent_[source_] = static_cast<int32_t>(source_);
+  touched_.push_back(static_cast<int32_t>(source_));
+  open.push({0.0f, static_cast<int32_t>(source_)});
+  int64_t expansions = 0, settled = 0;
+  while (!open.empty()) {
+    const auto [d, s] = open.top();
+    open.pop();
+    if (closed_[s] || d > dist_[s]) continue;
+    if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
+    const CellIndex cs = grid_.FromIndex(s);
+    const int32_t p = parent_[s];
+    if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {
+      float best = kUnreached;
+      int32_t best_parent = -1;
+      ForEachMove(grid_, cs, [&](int64_t n) {
+        if (!closed_[n]) return;
+        const float cand = dist_[n] + Euclid(grid_, n, s);
+        if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
+      });
+      if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
+    }
+    closed_[s] = 1;
+    if (!settle(s, dist_[s]) || ++settled >= max_settled) return true;
+    const int32_t ps = parent_[s];
+    ForEachMove(grid_, cs, [&](int64_t n) {
+      if (closed_[n]) return;
+      const float cand = dist_[ps] + Euclid(grid_, ps, n);
+      if (cand < dist_[n]) {
+        if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
         dist_[n] = cand;
         parent_[n] = ps;
         open.push({cand, static_cast<int32_t>(n)});

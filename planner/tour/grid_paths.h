@@ -52,17 +52,55 @@ bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<b
 // names the pose in the InvalidArgument error ("start", "end").
 absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& pose, const char* what);
 
+// Calls f(neighbour index, diagonal?) for every move the drive searches allow
+// from c: 4-neighbours through passable boundaries, and diagonals whose two
+// L-shaped routes are open (no corner cutting) and whose segment touches no
+// non-free map pixel.
+template <typename F>
+void ForEachDriveMove(const Grid& g, CellIndex c, F&& f) {
+  constexpr int kDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  constexpr int kDc[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  for (int k = 0; k < 8; ++k) {
+    const int dr = kDr[k], dc = kDc[k];
+    if (k < 4) {
+      if (g.Passable(c.row, c.col, dr, dc)) f(g.Index(c.row + dr, c.col + dc), false);
+      continue;
+    }
+    if (g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
+        g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc) &&
+        (g.obstacle_pixels() == nullptr || !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc))) {
+      f(g.Index(c.row + dr, c.col + dc), true);
+    }
+  }
+}
+
 class AnyAngleSearch {
  public:
   explicit AnyAngleSearch(const Grid& grid);
 
   // Returns false if stopped early (results then incomplete).
   bool Run(CellIndex source, const StopToken& stop);
+  // Goal-directed (A*, Euclidean heuristic) search that stops once `target`
+  // is settled; afterwards PathTo(target) and DistanceCells(target) hold.
+  // Costs only the cells it touches (no whole-grid reset), so many short
+  // searches on a large grid stay cheap. False if stopped early, or after
+  // `max_expansions` expansions: then `*bound` (if given) is a lower bound
+  // of the distance (the smallest g + h still open).
+  bool RunTo(CellIndex source, CellIndex target, const StopToken& stop,
+             int64_t max_expansions = INT64_MAX, float* bound = nullptr);
+  // Run() cut short: the same search (same order, same distances) that
+  // calls settle(cell index, distance) for each cell it closes and stops when
+  // settle returns false or `max_settled` cells are closed. Costs only the
+  // cells it touches. False if stopped early.
+  bool Explore(CellIndex source, int64_t max_settled, const StopToken& stop,
+               const std::function<bool(int64_t, float)>& settle);
   bool Reached(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)] < kUnreached; }
   // Path length in cell units (multiply by cell size for metres).
   double DistanceCells(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)]; }
   // Corner cells from the source to `target`, both included; empty if unreached.
   std::vector<CellIndex> PathTo(CellIndex target) const;
+  // Scratch bytes per grid cell (distance, parent, closed flag, touched list).
+  static constexpr int64_t kBytesPerCell = 13;
 
  private:
   static constexpr float kUnreached = 1e30f;
@@ -70,7 +108,10 @@ class AnyAngleSearch {
   std::vector<float> dist_;
   std::vector<int32_t> parent_;
   std::vector<uint8_t> closed_;
+  std::vector<int32_t> touched_;  // cells written by the last RunTo
+  bool all_dirty_ = false;        // Run wrote the whole grid
   int64_t source_ = -1;
+  void Reset();
 };
 
 }  // namespace covplan

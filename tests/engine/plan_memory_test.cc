@@ -183,6 +183,37 @@ TEST_F(PlanMemoryTest, ImproveRememberedSearchesOnAndKeepsTheBetterPlan) {
   ExpectSamePath(improved.plan, hit.plan);
 }
 
+// The sparse tour search (large maps) cannot start from a remembered tour:
+// its plans are remembered whole, a new start pose searches cold, and
+// improve_remembered runs a fresh search with a new seed and keeps the better.
+TEST_F(PlanMemoryTest, SparsePlansAreRememberedWholeAndNeverClaimAWarmStart) {
+  LocalArtifactCache cache;
+  EngineLimits limits;
+  limits.dense_transition_bytes = 0;  // every map takes the sparse path
+  PlanningEngine engine(&registry_, &cache, limits);
+  const PlanRequest r = Request();
+  const EngineResult first = MustPlan(engine, r);
+  ASSERT_EQ(first.plan.stats.tour_solver, "sparse");
+  EXPECT_EQ(first.plan.stats.plan_source, PlanOrigin::kCold);
+  EXPECT_TRUE(first.plan.tour_vertices.empty());
+  const EngineResult hit = MustPlan(engine, r);
+  EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
+  ExpectSamePath(first.plan, hit.plan);
+
+  PlanRequest moved = r;
+  moved.common.robot.start = Pose2{first.plan.path.back().x, first.plan.path.back().y, 0.0};
+  const EngineResult other = MustPlan(engine, moved);
+  EXPECT_EQ(other.plan.stats.plan_source, PlanOrigin::kCold);
+  EXPECT_EQ(testing::CheckPlanConformance(other.plan, *other.area, moved.common.robot), "");
+
+  PlanRequest more = r;
+  more.improve_remembered = true;
+  const EngineResult improved = MustPlan(engine, more);
+  EXPECT_EQ(improved.plan.stats.plan_source, PlanOrigin::kImproved);
+  EXPECT_LE(improved.plan.stats.estimated_duration_s, first.plan.stats.estimated_duration_s);
+  EXPECT_EQ(testing::CheckPlanConformance(improved.plan, *improved.area, more.common.robot), "");
+}
+
 // A search its own time limit stopped answers requests with no more time;
 // one with more searches on from it.
 TEST_F(PlanMemoryTest, TimeLimitedPlanAnswersNoLongerBudgetAndImprovesWithMore) {

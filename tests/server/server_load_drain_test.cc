@@ -70,7 +70,9 @@ TEST_F(ServerHardeningTest, MalformedRequestsAreInvalidArgumentLoggedAndCounted)
 // Defect 9: a call admitted behind a long solve that starts with too little
 // of its deadline left is refused as overload, not DEADLINE_EXCEEDED.
 TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExceeded) {
-  StartServer({"--threads=1"});
+  // The all-pairs transitions and the dense GTSP (not the much faster sparse
+  // path) keep the busy solve long enough.
+  StartServer({"--threads=1", "--dense_transition_mb=1024"});
   const std::string busy_map = PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
   const std::string fresh_map = PutMapOk(RasterMap(AsciiToPgm(PillarField(240, 180, 600, 5), 4), 0.025));
   v1::PlanResponse warm;
@@ -150,7 +152,9 @@ TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNo
 // and the plan is answered with its best tour, marked cut short by the drain.
 TEST_F(ServerHardeningTest, DrainKeepsItsGraceAndAnswersWithTheBestPlan) {
   // Without remembered plans: the seed-2 request must search, not warm-start.
-  StartServer({"--drain_grace_s=1", "--threads=1", "--plan_memory=false"});
+  // The dense GTSP keeps searching for its whole budget (the sparse path
+  // converges before the drain).
+  StartServer({"--drain_grace_s=1", "--threads=1", "--plan_memory=false", "--dense_transition_mb=1024"});
   const std::string map_id = PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
   v1::PlanResponse warm;
   ASSERT_TRUE(Plan(map_id, 0.3, &warm).ok());  // artifacts cached: the next search has a plan at once

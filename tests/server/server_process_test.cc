@@ -308,9 +308,10 @@ TEST_F(ServerProcessTest, DeadlineTooShortForAFirstPlanIsDeadlineExceeded) {
 }
 
 TEST_F(ServerProcessTest, CancelledCallFreesItsWorker) {
-  StartServer({"--threads=1", "--max_queue=0"});
-  // 120 x 100 cells of 0.5 m with 300 pillars: seconds of transition paths
-  // and tour search.
+  // 120 x 100 cells of 0.5 m with 300 pillars: seconds of all-pairs
+  // transition paths and dense tour search (the sparse path would finish
+  // before the cancel).
+  StartServer({"--threads=1", "--max_queue=0", "--dense_transition_mb=1024"});
   const std::string big = PutMap(RasterMap(AsciiToPgm(PillarField(120, 100, 300, 5), 5), 0.1));
   const std::string small = PutMap(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1));
 

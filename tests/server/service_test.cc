@@ -50,6 +50,7 @@ class ServiceTest : public ::testing::Test {
     config.service.limits.max_image_bytes = 1 << 20;
     config.service.limits.max_map_pixels = 1'000'000;
     config.service.limits.max_ranks = max_ranks_;
+    config.service.limits.dense_transition_bytes = dense_transition_bytes_;
     config.service.max_request_time = max_request_time_;
     absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
     ASSERT_TRUE(server.ok()) << server.status();
@@ -86,6 +87,7 @@ class ServiceTest : public ::testing::Test {
 
   bool with_metrics_ = false;
   int64_t max_ranks_ = 1000;
+  int64_t dense_transition_bytes_ = InputLimits().dense_transition_bytes;
   absl::Duration max_request_time_ = absl::Seconds(120);
   std::string dir_;
   std::unique_ptr<CovplanServer> server_;
@@ -557,7 +559,12 @@ TEST_F(RankLimitServiceTest, TooManyRanksIsInvalidArgumentBeforeTheTransitionTab
 
 class RequestTimeLimitServiceTest : public ServiceTest {
  protected:
-  RequestTimeLimitServiceTest() { max_request_time_ = absl::Milliseconds(150); }
+  // The all-pairs transition table: far longer than 150 ms on PillarMap
+  // (the sparse path would plan it within the limit).
+  RequestTimeLimitServiceTest() {
+    max_request_time_ = absl::Milliseconds(150);
+    dense_transition_bytes_ = int64_t{1} << 30;
+  }
 };
 
 TEST_F(RequestTimeLimitServiceTest, CallWithoutDeadlineStopsAtTheServerLimit) {

@@ -1,0 +1,254 @@
+// The sparse transitions of large maps: candidate lengths are the exact
+// any-angle distances, sparse tours are valid plans close to the dense
+// solver's, plans above the old 1000-rank limit are not refused, and an
+// exceeded transition memory budget is a clear RESOURCE_EXHAUSTED.
+#include "planner/tour/sparse_tour.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "planner/engine/plan_coverage.h"
+#include "planner/oarp/oarp_planner.h"
+#include "planner/partition/mincut_partitioner.h"
+#include "planner/tour/endpoint_graph.h"
+#include "planner/tour/grid_paths.h"
+#include "planner/tour/path_timing.h"
+#include "planner/tour/rank_tour.h"
+#include "tests/testing/grid_fixtures.h"
+#include "tests/testing/plan_conformance.h"
+#include "tests/testing/shipped_maps.h"
+
+namespace covplan {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::vector<std::string> kRooms = {
+    "....................",
+    "....................",
+    "...##.......###.....",
+    "...##.......###.....",
+    "........#...........",
+    "#######.#.##########",
+    "........#...........",
+    "...#................",
+    "...#......##........",
+    "..........##........",
+};
+
+std::vector<CellIndex> Endpoints(const std::vector<Rank>& ranks) {
+  std::vector<CellIndex> e;
+  for (const Rank& r : ranks) {
+    e.push_back(r.first);
+    e.push_back(r.last);
+  }
+  return e;
+}
+
+bool Connected(const Grid& grid) {
+  int32_t comps = 0;
+  FreeComponents(grid, &comps);
+  return comps == 1;
+}
+
+std::vector<Grid> SmallGrids() {
+  std::vector<Grid> grids;
+  grids.push_back(Grid::FromAscii(kRooms, 0.8));
+  for (uint32_t seed = 0; seed < 8; ++seed) {
+    Grid g = testing::RandomGrid(14, 18, 0.85, seed);
+    if (Connected(g)) grids.push_back(std::move(g));
+  }
+  return grids;
+}
+
+TEST(EndpointGraph, CandidatesAreTheNearestEndpointsAtExactAnyAngleDistances) {
+  for (const Grid& grid : SmallGrids()) {
+    const RankPartition partition = *MinCutPartitioner().Partition(grid, StopToken());
+    const std::vector<CellIndex> endpoints = Endpoints(partition.ranks);
+    EndpointGraph::Options options;
+    options.neighbours = 4;
+    auto graph = EndpointGraph::Build(grid, endpoints, options, StopToken(), 2);
+    ASSERT_TRUE(graph.ok()) << graph.status();
+    const int count = static_cast<int>(endpoints.size());
+    // Full (unbounded) searches from every endpoint: dist[a][b].
+    std::vector<std::vector<float>> dist(count, std::vector<float>(count));
+    AnyAngleSearch full(grid);
+    for (int a = 0; a < count; ++a) {
+      ASSERT_TRUE(full.Run(endpoints[a], StopToken()));
+      for (int b = 0; b < count; ++b) dist[a][b] = static_cast<float>(full.DistanceCells(endpoints[b]));
+    }
+    for (int e = 0; e < count; ++e) {
+      ASSERT_TRUE(full.Run(endpoints[e], StopToken()));
+      const auto cands = (*graph)->candidates(e);
+      // Every candidate's length is a full search's distance (from e, or
+      // from the candidate for entries added by symmetrising: Lazy Theta* is
+      // not exactly symmetric), and its path runs from e to the candidate
+      // through free cells.
+      for (const EndpointCandidate& c : cands) {
+        ASSERT_NE(c.endpoint, e);
+        ASSERT_NE(c.endpoint, e ^ 1);
+        const float forward = dist[e][c.endpoint], backward = dist[c.endpoint][e];
+        EXPECT_TRUE(std::abs(c.length_cells - forward) <= 1e-4 || std::abs(c.length_cells - backward) <= 1e-4)
+            << e << "->" << c.endpoint << ": " << c.length_cells << " vs " << forward << " / " << backward;
+        std::vector<CellIndex> cells;
+        (*graph)->AppendPath(e, c, &cells);
+        ASSERT_EQ(cells.front(), endpoints[e]);
+        ASSERT_EQ(cells.back(), endpoints[c.endpoint]);
+        std::vector<Waypoint> wps;
+        for (const CellIndex& cell : cells) {
+          wps.push_back({grid.CellCenter(cell).x, grid.CellCenter(cell).y, 0, SegmentKind::kTransition, -1});
+        }
+        EXPECT_EQ(testing::CheckPathStaysFree(grid, wps), "") << e << "->" << c.endpoint;
+      }
+      // The `neighbours` nearest other endpoints are all in the list: any
+      // endpoint nearer than the 4th nearest by more than a cell is a
+      // candidate (Lazy Theta* settles cells in tentative-distance order, so
+      // near-ties may come in either order).
+      std::vector<float> others;
+      for (int f = 0; f < count; ++f) {
+        if (f != e && f != (e ^ 1)) others.push_back(full.DistanceCells(endpoints[f]));
+      }
+      std::sort(others.begin(), others.end());
+      if (others.size() < 4) continue;
+      const float kth = others[3];
+      for (int f = 0; f < count; ++f) {
+        if (f == e || f == (e ^ 1) || full.DistanceCells(endpoints[f]) >= kth - 1.0f) continue;
+        EXPECT_TRUE(std::any_of(cands.begin(), cands.end(), [&](const EndpointCandidate& c) { return c.endpoint == f; }))
+            << "endpoint " << f << " is nearer to " << e << " than the 4th nearest but no candidate";
+      }
+      // Lower bounds never exceed the exact distance.
+      for (int f = 0; f < count; ++f) {
+        EXPECT_LE((*graph)->LowerBoundCells(endpoints[e], endpoints[f]), full.DistanceCells(endpoints[f]) + 1e-4);
+      }
+    }
+  }
+}
+
+CoveragePlan SparsePlan(const Grid& grid, const RankPartition& partition, const SparseTour& tour,
+                        const RobotModel& robot) {
+  CoveragePlan plan;
+  plan.grid = std::make_shared<const Grid>(grid);
+  auto detail = std::make_shared<OarpDetail>();
+  detail->ranks = partition.ranks;
+  for (int v : tour.vertices) {
+    detail->rank_order.push_back(v / 2);
+    detail->rank_reversed.push_back(v % 2 == 1);
+  }
+  plan.detail = detail;
+  plan.path = tour.path;
+  plan.stats = ComputePathStats(plan.path, robot);
+  plan.stats.num_ranks = static_cast<int64_t>(partition.ranks.size());
+  return plan;
+}
+
+// Sparse tours drive every rank once, stay in free cells across no barrier,
+// honour the poses, and cost at most 10 % more than the dense GTSP's tour on
+// the same small grids (the estimated duration of the real paths).
+TEST(SparseTour, ValidPlansWithinTenPercentOfTheDenseSolver) {
+  constexpr double kFactor = 1.10;
+  double sparse_total = 0.0, dense_total = 0.0;
+  for (const Grid& grid : SmallGrids()) {
+    const RankPartition partition = *MinCutPartitioner().Partition(grid, StopToken());
+    auto graph = EndpointGraph::Build(grid, Endpoints(partition.ranks), {}, StopToken(), 2);
+    ASSERT_TRUE(graph.ok()) << graph.status();
+    for (bool with_end : {false, true}) {
+      RobotModel robot;
+      const CellIndex s = partition.ranks.back().first;
+      robot.start = Pose2{grid.CellCenter(s).x, grid.CellCenter(s).y, 0.3};
+      if (with_end) {
+        const CellIndex e = partition.ranks.front().last;
+        robot.end = Pose2{grid.CellCenter(e).x, grid.CellCenter(e).y, 0.0};
+      }
+      SparseTourOptions options;
+      options.time_limit_s = 5.0;  // converges long before
+      options.num_threads = 2;
+      auto tour = PlanSparseRankTour(grid, partition.ranks, **graph, robot, options, StopToken());
+      ASSERT_TRUE(tour.ok()) << tour.status();
+      ASSERT_EQ(tour->vertices.size(), partition.ranks.size());
+      const CoveragePlan plan = SparsePlan(grid, partition, *tour, robot);
+      EXPECT_EQ(testing::CheckOarpDetail(plan, grid), "");
+      EXPECT_EQ(testing::CheckPathStaysFree(grid, plan.path), "");
+      const Pose2 end = robot.end.value_or(*robot.start);
+      EXPECT_NEAR(plan.path.back().x, end.x, 1e-9);
+      EXPECT_NEAR(plan.path.back().y, end.y, 1e-9);
+      EXPECT_FALSE(tour->stopped_early);
+
+      auto table = TransitionTable::Build(grid, partition.ranks, StopToken(), 2);
+      ASSERT_TRUE(table.ok());
+      auto cost = RankTourCost::Create(grid, partition.ranks, **table, robot, StopToken());
+      ASSERT_TRUE(cost.ok()) << cost.status();
+      auto dense = GtspOrderer({0.5, 1, 1}).Order(*cost, StopToken());
+      ASSERT_TRUE(dense.ok());
+      EXPECT_LE(plan.stats.estimated_duration_s, kFactor * dense->cost)
+          << "sparse " << plan.stats.estimated_duration_s << " s vs dense " << dense->cost << " s";
+      sparse_total += plan.stats.estimated_duration_s;
+      dense_total += dense->cost;
+    }
+  }
+  RecordProperty("sparse_over_dense", std::to_string(sparse_total / dense_total));
+}
+
+// A comb of thin walls: `teeth` one-cell gaps below a two-row corridor, one
+// rank per gap plus the corridor's (1 px = one 0.1 m cell).
+OccupancyMap Comb(int teeth) {
+  const int width = 2 * teeth + 1, height = 12;
+  OccupancyMap map(width, height, 0.1, {0.0, 0.0});
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const bool wall = (c % 2 == 1) && r < height - 2;
+      map.set(r, c, wall ? CellState::kOccupied : CellState::kFree);
+    }
+  }
+  return map;
+}
+
+PlanOptions CombOptions() {
+  PlanOptions o;
+  o.robot.tool_width_m = 0.1;
+  o.time_limit_s = 1.0;
+  o.num_threads = 2;
+  return o;
+}
+
+TEST(SparseTour, PlanAboveTheOldThousandRankLimitIsNotRefused) {
+  const OccupancyMap map = Comb(1250);
+  const PlanOptions o = CombOptions();
+  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(map, o);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_GT(r->plan.stats.num_ranks, 1200);
+  EXPECT_EQ(r->plan.stats.tour_solver, "sparse");
+  EXPECT_EQ(testing::CheckOarpConformance(*r, o.robot), "");
+}
+
+TEST(SparseTour, ExceededTransitionBudgetIsResourceExhaustedNamingTheBudget) {
+  const OccupancyMap map = Comb(1250);
+  EngineLimits limits;
+  limits.max_transition_bytes = int64_t{1} << 20;
+  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(map, CombOptions(), nullptr, "local", limits);
+  ASSERT_EQ(r.status().code(), absl::StatusCode::kResourceExhausted) << r.status();
+  EXPECT_THAT(std::string(r.status().message()), HasSubstr("transition memory budget of 1 MiB"));
+  EXPECT_THAT(std::string(r.status().message()), HasSubstr("--max_transition_mb"));
+  EXPECT_THAT(std::string(r.status().message()), HasSubstr("coverage ranks"));
+}
+
+TEST(SparseTour, DenseBelowTheDenseBudgetSparseAbove) {
+  const OccupancyMap map = testing::LoadShippedMap("small_rooms.yaml");
+  PlanOptions o;
+  o.robot.tool_width_m = 0.5;
+  o.time_limit_s = 0.3;
+  absl::StatusOr<EngineResult> dense = PlanCoverageWithArea(map, o);
+  ASSERT_TRUE(dense.ok()) << dense.status();
+  EXPECT_EQ(dense->plan.stats.tour_solver, "gtsp");
+  EngineLimits limits;
+  limits.dense_transition_bytes = 0;
+  absl::StatusOr<EngineResult> sparse = PlanCoverageWithArea(map, o, nullptr, "local", limits);
+  ASSERT_TRUE(sparse.ok()) << sparse.status();
+  EXPECT_EQ(sparse->plan.stats.tour_solver, "sparse");
+  EXPECT_EQ(testing::CheckOarpConformance(*sparse, o.robot), "");
+  EXPECT_EQ(sparse->plan.stats.num_ranks, dense->plan.stats.num_ranks);
+}
+
+}  // namespace
+}  // namespace covplan
