@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# Held-out-sized buildings (docs/benchmarks.md section 14, issue 12): the
+# whole `covplan plan --local` process on every plain IPA building and the
+# shipped maps at tool 0.8 m with 2 threads, median wall of RUNS runs, and
+# the estimated duration against a REF_S s `--tour-effort thorough` search
+# of the same binary. With BEFORE set, the same run measures an older
+# binary too (its --threads flag is used only if it has one).
+#   AFTER=build/bin/covplan BEFORE=/tmp/old/covplan scripts/bench_buildings.sh
+# Environment: AFTER (build/bin/covplan), BEFORE (unset), RUNS (3), REF_S
+# (30; 0 skips the reference), IPA_DIR, MAPS (all), OUT (raw JSON lines;
+# default a temp file). Prints a markdown table. The IPA maps are read in
+# place, never copied.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+AFTER=${AFTER:-build/bin/covplan}
+BEFORE=${BEFORE:-}
+RUNS=${RUNS:-3}
+REF_S=${REF_S:-30}
+IPA=${IPA_DIR:-../shared/data/maps/ipa}
+OUT=${OUT:-$(mktemp -t bench_buildings.XXXXXX.jsonl)}
+[ -x "$AFTER" ] || { echo "bench_buildings: $AFTER not built" >&2; exit 2; }
+maps=()
+if [ -n "${MAPS:-}" ]; then
+  read -r -a maps <<< "$MAPS"
+else
+  if [ -d "$IPA" ]; then
+    for f in "$IPA"/*.png; do case "$f" in *_furnitures.png) ;; *) maps+=("$f") ;; esac; done
+  else
+    echo "bench_buildings: $IPA not found; shipped maps only" >&2
+  fi
+  maps+=(maps/sample_office.yaml maps/small_rooms.yaml maps/sample_yard.geojson)
+fi
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
+echo "raw results: $OUT" >&2
+: > "$OUT"
+/usr/bin/python3 - "$OUT" "$AFTER" "$BEFORE" "$RUNS" "$REF_S" "${maps[@]}" <<'EOF'
+import json, os, statistics, subprocess, sys, tempfile, time
+out, after, before, runs, ref_s = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), float(sys.argv[5])
+maps = sys.argv[6:]
+tmp = tempfile.mkdtemp()
+
+def has_threads(binary):
+    h = subprocess.run([binary, "plan", "--help"], capture_output=True, text=True)
+    return "--threads" in (h.stdout + h.stderr)
+
+def plan(binary, m, extra):
+    args = [binary, "plan", "--local", "--map", m, "--tool-width", "0.8", "--out", os.path.join(tmp, "p.json")]
+    if m.endswith(".png"):
+        args += ["--resolution", "0.05", "--free-thresh", "0.021"]
+    t = time.perf_counter()
+    p = subprocess.run(args + extra, capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    if p.returncode != 0:
+        return {"wall_s": wall, "error": (p.stderr or p.stdout).strip()[:300]}
+    s = json.load(open(os.path.join(tmp, "p.json")))["stats"]
+    return {"wall_s": wall, "ranks": s["num_ranks"], "duration_s": s["estimated_duration_s"],
+            "tour_solver": s["tour_solver"], "transitions_ms": s["transitions_ms"], "tour_ms": s["tour_ms"]}
+
+bins = [("after", after)] + ([("before", before)] if before else [])
+rows = []
+with open(out, "w") as f:
+    for m in maps:
+        name = os.path.basename(m).split(".")[0]
+        row = {"map": name}
+        for label, b in bins:
+            thr = ["--threads", "2"] if has_threads(b) else []
+            rs = [plan(b, m, thr) for _ in range(runs)]
+            for r in rs:
+                f.write(json.dumps({"map": name, "bin": label, **r}) + "\n")
+            ok = [r for r in rs if "error" not in r]
+            if not ok:
+                row[label] = {"error": rs[0]["error"]}
+                continue
+            row[label] = {"wall": statistics.median(r["wall_s"] for r in ok), "ranks": ok[0]["ranks"],
+                          "dur": statistics.median(r["duration_s"] for r in ok), "solver": ok[0]["tour_solver"]}
+            if ref_s > 0 and label == "after":
+                ref = plan(b, m, thr + ["--time-limit", str(ref_s), "--tour-effort", "thorough"])
+                f.write(json.dumps({"map": name, "bin": label + "-ref", **ref}) + "\n")
+                row["ref"] = ref.get("duration_s")
+        rows.append(row)
+        f.flush()
+        print(f"  {name}: {row}", file=sys.stderr)
+
+hdr = "| map | ranks | tour | wall (median of %d) | est. duration | gap to %g s search |" % (runs, ref_s)
+sep = "|---|---:|---|---:|---:|---:|"
+if before:
+    hdr += " before: wall | before: est. duration |"
+    sep += "---:|---:|"
+print(hdr); print(sep)
+walls, gaps = [], []
+for r in rows:
+    a = r.get("after", {})
+    if "error" in a:
+        line = f"| {r['map']} | – | – | error: {a['error']} | | |"
+    else:
+        gap = 100.0 * (a["dur"] - r["ref"]) / r["ref"] if r.get("ref") else None
+        walls.append(a["wall"]); gaps.append(gap)
+        line = (f"| {r['map']} | {a['ranks']} | {a['solver']} | {a['wall']:.2f} s | {a['dur']:.1f} s | "
+                + (f"{gap:+.2f} %" if gap is not None else "–") + " |")
+    if before:
+        b = r.get("before", {})
+        line += (f" error: {b['error'][:80]} | |" if "error" in b else f" {b['wall']:.2f} s | {b['dur']:.1f} s |")
+    print(line)
+if walls:
+    g = [x for x in gaps if x is not None]
+    print(f"\nafter: max wall {max(walls):.2f} s, {sum(w <= 1.0 for w in walls)}/{len(walls)} maps <= 1 s"
+          + (f"; gap mean {statistics.mean(g):+.2f} %, max {max(g):+.2f} %" if g else ""))
+EOF
