@@ -1,21 +1,27 @@
 #!/usr/bin/env bash
-# Held-out-sized buildings (docs/benchmarks.md section 14, issue 12): the
-# whole `covplan plan --local` process on every plain IPA building and the
-# shipped maps at tool 0.8 m with 2 threads, median wall of RUNS runs, and
+# Held-out-sized buildings and small tools (docs/benchmarks.md section 14,
+# issue 12): the whole `covplan plan --local` process on every plain IPA
+# building and the shipped maps at tool TOOL (0.8 m) with 2 threads, median
+# wall of RUNS runs, and
 # the estimated duration against a REF_S s `--tour-effort thorough` search
 # of the same binary. With BEFORE set, the same run measures an older
 # binary too (its --threads flag is used only if it has one).
 #   AFTER=build/bin/covplan BEFORE=/tmp/old/covplan scripts/bench_buildings.sh
-# Environment: AFTER (build/bin/covplan), BEFORE (unset), RUNS (3), REF_S
-# (30; 0 skips the reference), IPA_DIR, MAPS (all), OUT (raw JSON lines;
-# default a temp file). Prints a markdown table. The IPA maps are read in
-# place, never copied.
+#   TOOL=0.1 REF_S=60 RUNS=1 MAPS=../shared/data/maps/ipa/lab_f_scan.png scripts/bench_buildings.sh
+# Environment: AFTER (build/bin/covplan), BEFORE (unset), RUNS (3),
+# BEFORE_RUNS (RUNS; runs of the before binary), REF_S
+# (30; 0 skips the reference), TOOL (0.8), IPA_DIR, MAPS (all), OUT (raw JSON
+# lines; default a temp file). Prints a markdown table with the median wall
+# time and the largest peak RSS of each binary's runs. The IPA maps are read
+# in place, never copied.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 AFTER=${AFTER:-build/bin/covplan}
 BEFORE=${BEFORE:-}
 RUNS=${RUNS:-3}
+BEFORE_RUNS=${BEFORE_RUNS:-$RUNS}
 REF_S=${REF_S:-30}
+TOOL=${TOOL:-0.8}
 IPA=${IPA_DIR:-../shared/data/maps/ipa}
 OUT=${OUT:-$(mktemp -t bench_buildings.XXXXXX.jsonl)}
 [ -x "$AFTER" ] || { echo "bench_buildings: $AFTER not built" >&2; exit 2; }
@@ -33,10 +39,11 @@ fi
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
 echo "raw results: $OUT" >&2
 : > "$OUT"
-/usr/bin/python3 - "$OUT" "$AFTER" "$BEFORE" "$RUNS" "$REF_S" "${maps[@]}" <<'EOF'
+/usr/bin/python3 - "$OUT" "$AFTER" "$BEFORE" "$RUNS" "$REF_S" "$TOOL" "$BEFORE_RUNS" "${maps[@]}" <<'EOF'
 import json, os, statistics, subprocess, sys, tempfile, time
 out, after, before, runs, ref_s = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), float(sys.argv[5])
-maps = sys.argv[6:]
+tool, before_runs = sys.argv[6], int(sys.argv[7])
+maps = sys.argv[8:]
 tmp = tempfile.mkdtemp()
 
 def has_threads(binary):
@@ -44,16 +51,20 @@ def has_threads(binary):
     return "--threads" in (h.stdout + h.stderr)
 
 def plan(binary, m, extra):
-    args = [binary, "plan", "--local", "--map", m, "--tool-width", "0.8", "--out", os.path.join(tmp, "p.json")]
+    args = [binary, "plan", "--local", "--map", m, "--tool-width", tool, "--out", os.path.join(tmp, "p.json")]
     if m.endswith(".png"):
         args += ["--resolution", "0.05", "--free-thresh", "0.021"]
+    log = open(os.path.join(tmp, "log"), "w+")
     t = time.perf_counter()
-    p = subprocess.run(args + extra, capture_output=True, text=True)
+    p = subprocess.Popen(args + extra, stdout=log, stderr=subprocess.STDOUT)
+    _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t
-    if p.returncode != 0:
-        return {"wall_s": wall, "error": (p.stderr or p.stdout).strip()[:300]}
+    rss_mib = usage.ru_maxrss / 1024.0  # KiB on Linux
+    if os.waitstatus_to_exitcode(status) != 0:
+        log.seek(0)
+        return {"wall_s": wall, "rss_mib": rss_mib, "error": log.read().strip()[:300]}
     s = json.load(open(os.path.join(tmp, "p.json")))["stats"]
-    return {"wall_s": wall, "ranks": s["num_ranks"], "duration_s": s["estimated_duration_s"],
+    return {"wall_s": wall, "rss_mib": rss_mib, "ranks": s["num_ranks"], "duration_s": s["estimated_duration_s"],
             "tour_solver": s["tour_solver"], "transitions_ms": s["transitions_ms"], "tour_ms": s["tour_ms"]}
 
 bins = [("after", after)] + ([("before", before)] if before else [])
@@ -64,7 +75,7 @@ with open(out, "w") as f:
         row = {"map": name}
         for label, b in bins:
             thr = ["--threads", "2"] if has_threads(b) else []
-            rs = [plan(b, m, thr) for _ in range(runs)]
+            rs = [plan(b, m, thr) for _ in range(runs if label == "after" else before_runs)]
             for r in rs:
                 f.write(json.dumps({"map": name, "bin": label, **r}) + "\n")
             ok = [r for r in rs if "error" not in r]
@@ -72,6 +83,7 @@ with open(out, "w") as f:
                 row[label] = {"error": rs[0]["error"]}
                 continue
             row[label] = {"wall": statistics.median(r["wall_s"] for r in ok), "ranks": ok[0]["ranks"],
+                          "rss": max(r["rss_mib"] for r in ok),
                           "dur": statistics.median(r["duration_s"] for r in ok), "solver": ok[0]["tour_solver"]}
             if ref_s > 0 and label == "after":
                 ref = plan(b, m, thr + ["--time-limit", str(ref_s), "--tour-effort", "thorough"])
@@ -81,28 +93,28 @@ with open(out, "w") as f:
         f.flush()
         print(f"  {name}: {row}", file=sys.stderr)
 
-hdr = "| map | ranks | tour | wall (median of %d) | est. duration | gap to %g s search |" % (runs, ref_s)
-sep = "|---|---:|---|---:|---:|---:|"
+hdr = "| map | ranks | tour | wall (median of %d) | peak RSS | est. duration | gap to %g s search |" % (runs, ref_s)
+sep = "|---|---:|---|---:|---:|---:|---:|"
 if before:
-    hdr += " before: wall | before: est. duration |"
-    sep += "---:|---:|"
+    hdr += " before: wall | before: peak RSS | before: est. duration |"
+    sep += "---:|---:|---:|"
 print(hdr); print(sep)
 walls, gaps = [], []
 for r in rows:
     a = r.get("after", {})
     if "error" in a:
-        line = f"| {r['map']} | – | – | error: {a['error']} | | |"
+        line = f"| {r['map']} | – | – | error: {a['error']} | | | |"
     else:
         gap = 100.0 * (a["dur"] - r["ref"]) / r["ref"] if r.get("ref") else None
         walls.append(a["wall"]); gaps.append(gap)
-        line = (f"| {r['map']} | {a['ranks']} | {a['solver']} | {a['wall']:.2f} s | {a['dur']:.1f} s | "
+        line = (f"| {r['map']} | {a['ranks']} | {a['solver']} | {a['wall']:.2f} s | {a['rss']:.0f} MiB | {a['dur']:.1f} s | "
                 + (f"{gap:+.2f} %" if gap is not None else "–") + " |")
     if before:
         b = r.get("before", {})
-        line += (f" error: {b['error'][:80]} | |" if "error" in b else f" {b['wall']:.2f} s | {b['dur']:.1f} s |")
+        line += (f" error: {b['error'][:80]} | | |" if "error" in b else f" {b['wall']:.2f} s | {b['rss']:.0f} MiB | {b['dur']:.1f} s |")
     print(line)
 if walls:
     g = [x for x in gaps if x is not None]
-    print(f"\nafter: max wall {max(walls):.2f} s, {sum(w <= 1.0 for w in walls)}/{len(walls)} maps <= 1 s"
+    print(f"\nafter: max wall {max(walls):.2f} s, {sum(w <= 1.0 for w in walls)}/{len(walls)} maps <= 1 s at tool {tool} m"
           + (f"; gap mean {statistics.mean(g):+.2f} %, max {max(g):+.2f} %" if g else ""))
 EOF
