@@ -428,6 +428,10 @@ absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path,
     ASSIGN_OR_RETURN(*raster->mutable_image(), ReadFile(image.string(), limits.max_image_bytes));
     raster->set_yaml(std::move(yaml));
   } else {
+    if (!overrides.resolution) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(path, " is a bare image: --resolution M (metres per pixel) is required"));
+    }
     ASSIGN_OR_RETURN(*raster->mutable_image(), ReadFile(path, limits.max_image_bytes));
   }
   if (overrides.resolution) raster->set_resolution(*overrides.resolution);

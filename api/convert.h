@@ -108,7 +108,7 @@ v1::MapInfo MapInfoFor(const SiteMap& site, const std::string& map_id);
 // Builds a Map proto from a file on disk: a map_server YAML (the image it
 // names is read relative to the YAML), a bare .pgm / .png, or a .geojson /
 // .json polygon map (metres in a local frame). Unset overrides leave the
-// YAML's values; a bare image needs `resolution`.
+// YAML's values; a bare image without `resolution` is InvalidArgument.
 struct MapFileOverrides {
   std::optional<double> resolution;
   std::optional<bool> negate;

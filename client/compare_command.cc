@@ -53,10 +53,6 @@ absl::Status Run(const std::vector<std::string>& args) {
   if (a.Has("negate")) overrides.negate = true;
   InputLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(map_path, overrides, limits));
-  if (map.has_raster() && map.raster().yaml().empty() && !map.raster().has_resolution()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(map_path, " is a bare image: --resolution M (metres per pixel) is required"));
-  }
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
   std::vector<std::string> planners = registry.Names();
   if (auto list = a.Get("algorithms")) {

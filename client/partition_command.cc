@@ -71,10 +71,6 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
   if (a.Has("negate")) overrides.negate = true;
   InputLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(map_path, overrides, limits));
-  if (map.has_raster() && map.raster().yaml().empty() && !map.raster().has_resolution()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(map_path, " is a bare image: --resolution M (metres per pixel) is required"));
-  }
   PlanRequest request;
   ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
   request.common.robot.tool_width_m = tool.value_or(0.8);

@@ -339,10 +339,6 @@ absl::Status Run(const std::vector<std::string>& args) {
   const PlanCommand& c = *parsed;
   InputLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(c.map_path, c.overrides, limits));
-  if (map.has_raster() && map.raster().yaml().empty() && !map.raster().has_resolution()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(c.map_path, " is a bare image: --resolution M (metres per pixel) is required"));
-  }
   ASSIGN_OR_RETURN(v1::PlanResponse response, Execute(c, map, limits));
   std::fputs(FormatPlanSummary(response).c_str(), stdout);
   if (c.out) {

@@ -95,6 +95,40 @@ void ForEachMove(const Grid& g, CellIndex c, F&& f) {
   ForEachDriveMove(g, c, [&](int64_t n, bool) { f(n); });
 }
 
+// Lazy Theta*: the parent of the cell s being settled was assumed visible
+// when s was queued; if it is not, s takes its best closed neighbour.
+void RepairParent(const Grid& g, int32_t s, CellIndex cs, float unreached, std::vector<float>& dist,
+                  std::vector<int32_t>& parent, const std::vector<uint8_t>& closed) {
+  const int32_t p = parent[s];
+  if (p == s || LineOfSight(g, g.FromIndex(p), cs)) return;
+  float best = unreached;
+  int32_t best_parent = -1;
+  ForEachMove(g, cs, [&](int64_t n) {
+    if (!closed[n]) return;
+    const float cand = dist[n] + Euclid(g, n, s);
+    if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
+  });
+  if (best_parent >= 0) dist[s] = best, parent[s] = best_parent;
+}
+
+// The any-angle step out of the settled cell s: each open move n is reached
+// straight from s's parent. improved(n, cost) runs before n's entries are
+// overwritten (it queues n, and may note that n was unreached).
+template <typename F>
+void RelaxThroughParent(const Grid& g, int32_t s, CellIndex cs, std::vector<float>& dist,
+                        std::vector<int32_t>& parent, const std::vector<uint8_t>& closed, F&& improved) {
+  const int32_t ps = parent[s];
+  ForEachMove(g, cs, [&](int64_t n) {
+    if (closed[n]) return;
+    const float cand = dist[ps] + Euclid(g, ps, n);
+    if (cand < dist[n]) {
+      improved(n, cand);
+      dist[n] = cand;
+      parent[n] = ps;
+    }
+  });
+}
+
 }  // namespace
 
 bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
@@ -117,30 +151,10 @@ bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
     if (closed_[s] || d > dist_[s]) continue;
     if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
     const CellIndex cs = grid_.FromIndex(s);
-    // Lazy Theta*: the parent was assumed visible; verify now, else take the
-    // best closed neighbour.
-    const int32_t p = parent_[s];
-    if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {
-      float best = kUnreached;
-      int32_t best_parent = -1;
-      ForEachMove(grid_, cs, [&](int64_t n) {
-        if (!closed_[n]) return;
-        const float cand = dist_[n] + Euclid(grid_, n, s);
-        if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
-      });
-      if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
-    }
+    RepairParent(grid_, s, cs, kUnreached, dist_, parent_, closed_);
     closed_[s] = 1;
-    const int32_t ps = parent_[s];
-    ForEachMove(grid_, cs, [&](int64_t n) {
-      if (closed_[n]) return;
-      const float cand = dist_[ps] + Euclid(grid_, ps, n);
-      if (cand < dist_[n]) {
-        dist_[n] = cand;
-        parent_[n] = ps;
-        open.push({cand, static_cast<int32_t>(n)});
-      }
-    });
+    RelaxThroughParent(grid_, s, cs, dist_, parent_, closed_,
+                       [&](int64_t n, float cand) { open.push({cand, static_cast<int32_t>(n)}); });
   }
   return true;
 }
@@ -182,29 +196,12 @@ bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& 
     }
     if ((expansions & 1023) == 0 && stop.ShouldStop()) return false;
     const CellIndex cs = grid_.FromIndex(s);
-    const int32_t p = parent_[s];
-    if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {
-      float best = kUnreached;
-      int32_t best_parent = -1;
-      ForEachMove(grid_, cs, [&](int64_t n) {
-        if (!closed_[n]) return;
-        const float cand = dist_[n] + Euclid(grid_, n, s);
-        if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
-      });
-      if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
-    }
+    RepairParent(grid_, s, cs, kUnreached, dist_, parent_, closed_);
     closed_[s] = 1;
     if (s == goal) return true;
-    const int32_t ps = parent_[s];
-    ForEachMove(grid_, cs, [&](int64_t n) {
-      if (closed_[n]) return;
-      const float cand = dist_[ps] + Euclid(grid_, ps, n);
-      if (cand < dist_[n]) {
-        if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
-        dist_[n] = cand;
-        parent_[n] = ps;
-        open.push({cand + h(n), static_cast<int32_t>(n)});
-      }
+    RelaxThroughParent(grid_, s, cs, dist_, parent_, closed_, [&](int64_t n, float cand) {
+      if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
+      open.push({cand + h(n), static_cast<int32_t>(n)});
     });
   }
   return true;
@@ -228,29 +225,12 @@ bool AnyAngleSearch::Explore(CellIndex source, int64_t max_settled, const StopTo
     if (closed_[s] || d > dist_[s]) continue;
     if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
     const CellIndex cs = grid_.FromIndex(s);
-    const int32_t p = parent_[s];
-    if (p != s && !LineOfSight(grid_, grid_.FromIndex(p), cs)) {
-      float best = kUnreached;
-      int32_t best_parent = -1;
-      ForEachMove(grid_, cs, [&](int64_t n) {
-        if (!closed_[n]) return;
-        const float cand = dist_[n] + Euclid(grid_, n, s);
-        if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
-      });
-      if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
-    }
+    RepairParent(grid_, s, cs, kUnreached, dist_, parent_, closed_);
     closed_[s] = 1;
     if (!settle(s, dist_[s]) || ++settled >= max_settled) return true;
-    const int32_t ps = parent_[s];
-    ForEachMove(grid_, cs, [&](int64_t n) {
-      if (closed_[n]) return;
-      const float cand = dist_[ps] + Euclid(grid_, ps, n);
-      if (cand < dist_[n]) {
-        if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
-        dist_[n] = cand;
-        parent_[n] = ps;
-        open.push({cand, static_cast<int32_t>(n)});
-      }
+    RelaxThroughParent(grid_, s, cs, dist_, parent_, closed_, [&](int64_t n, float cand) {
+      if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
+      open.push({cand, static_cast<int32_t>(n)});
     });
   }
   return true;

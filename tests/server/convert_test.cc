@@ -2,9 +2,14 @@
 // validation, plan round trips and the JSON shape of plan.json.
 #include "api/convert.h"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 
+#include "absl/strings/str_cat.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "planner/engine/artifact_cache.h"
@@ -103,6 +108,24 @@ TEST(MapFromProtoTest, RejectsBadMapsWithUsefulMessages) {
   v1::Map thresholds = RasterMap(pgm, 0.1);
   thresholds.mutable_raster()->set_free_thresh(0.9);
   EXPECT_THAT(MapFromProto(thresholds, limits), StatusIs(kInvalid, "free_thresh"));
+}
+
+// Every CLI command reads map files through MapProtoFromFile: a bare image
+// without --resolution is refused there, before anything is sent or planned.
+TEST(MapProtoFromFileTest, ABareImageNeedsAResolution) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_bare_", getpid(), ".pgm")).string();
+  std::ofstream(path, std::ios::binary) << AsciiToPgm(TwoRooms(), 4);
+  absl::StatusOr<v1::Map> bare = MapProtoFromFile(path, MapFileOverrides(), InputLimits());
+  EXPECT_THAT(bare, StatusIs(absl::StatusCode::kInvalidArgument, "is a bare image: --resolution M (metres per pixel) is required"));
+  EXPECT_THAT(bare.status().message(), HasSubstr(path));
+  MapFileOverrides with;
+  with.resolution = 0.1;
+  absl::StatusOr<v1::Map> ok = MapProtoFromFile(path, with, InputLimits());
+  ASSERT_TRUE(ok.ok()) << ok.status();
+  EXPECT_EQ(ok->raster().resolution(), 0.1);
+  EXPECT_TRUE(MapFromProto(*ok, InputLimits()).ok());
+  std::filesystem::remove(path);
 }
 
 TEST(MapFromProtoTest, EnforcesSizeLimits) {
