@@ -14,6 +14,7 @@
 #include "absl/time/clock.h"
 #include "api/convert.h"
 #include "client/args.h"
+#include "client/map_flags.h"
 #include "planner/common/status_macros.h"
 
 namespace covplan {
@@ -46,11 +47,7 @@ absl::Status Run(const std::vector<std::string>& args) {
                              {"markdown", "no-header", "negate"}));
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   const std::string map_path = *a.Get("map");
-  MapFileOverrides overrides;
-  ASSIGN_OR_RETURN(overrides.resolution, a.GetDouble("resolution"));
-  ASSIGN_OR_RETURN(overrides.free_thresh, a.GetDouble("free-thresh"));
-  ASSIGN_OR_RETURN(overrides.occupied_thresh, a.GetDouble("occupied-thresh"));
-  if (a.Has("negate")) overrides.negate = true;
+  ASSIGN_OR_RETURN(const MapFileOverrides overrides, MapFileOverridesFromFlags(a));
   InputLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(map_path, overrides, limits));
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();

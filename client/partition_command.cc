@@ -12,6 +12,7 @@
 #include "absl/time/clock.h"
 #include "api/convert.h"
 #include "client/args.h"
+#include "client/map_flags.h"
 #include "planner/common/status_macros.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/engine/engine.h"
@@ -64,11 +65,7 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
   if (repeat && (*repeat < 1 || *repeat > 1000)) {
     return absl::InvalidArgumentError(absl::StrFormat("--repeat must be in [1, 1000], got %d", *repeat));
   }
-  MapFileOverrides overrides;
-  ASSIGN_OR_RETURN(overrides.resolution, a.GetDouble("resolution"));
-  ASSIGN_OR_RETURN(overrides.free_thresh, a.GetDouble("free-thresh"));
-  ASSIGN_OR_RETURN(overrides.occupied_thresh, a.GetDouble("occupied-thresh"));
-  if (a.Has("negate")) overrides.negate = true;
+  ASSIGN_OR_RETURN(const MapFileOverrides overrides, MapFileOverridesFromFlags(a));
   InputLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(map_path, overrides, limits));
   PlanRequest request;

@@ -15,6 +15,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/str_format.h"
 #include "client/args.h"
+#include "client/map_flags.h"
 #include "api/geojson.h"
 #include "client/remote.h"
 #include "planner/engine/artifact_cache.h"
@@ -177,10 +178,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   ASSIGN_OR_RETURN(c.server, ConnectionFromArgs(a, a.Get("server").value_or(kDefaultServer)));
   c.out = a.Get("out");
   c.svg = a.Get("svg");
-  ASSIGN_OR_RETURN(c.overrides.resolution, a.GetDouble("resolution"));
-  ASSIGN_OR_RETURN(c.overrides.free_thresh, a.GetDouble("free-thresh"));
-  ASSIGN_OR_RETURN(c.overrides.occupied_thresh, a.GetDouble("occupied-thresh"));
-  if (a.Has("negate")) c.overrides.negate = true;
+  ASSIGN_OR_RETURN(c.overrides, MapFileOverridesFromFlags(a));
   ASSIGN_OR_RETURN(c.deadline_ms, a.GetInt("deadline-ms"));
   if (c.deadline_ms && *c.deadline_ms <= 0) {
     return absl::InvalidArgumentError("--deadline-ms must be positive");

@@ -11,6 +11,21 @@
 
 namespace covplan::testing {
 
+// Two rows of rooms joined by doorways, with pillars: 20 x 10 cells for
+// Grid::FromAscii ('.' free, '#' blocked).
+inline const std::vector<std::string> kRooms = {
+    "....................",
+    "....................",
+    "...##.......###.....",
+    "...##.......###.....",
+    "........#...........",
+    "#######.#.##########",
+    "........#...........",
+    "...#................",
+    "...#......##........",
+    "..........##........",
+};
+
 // A random grid with `free_prob` free cells plus a few rectangular holes.
 inline Grid RandomGrid(int rows, int cols, double free_prob, uint32_t seed) {
   std::mt19937 rng(seed);

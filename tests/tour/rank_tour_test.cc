@@ -46,18 +46,7 @@ std::string CheckRankPlan(const CoveragePlan& plan) {
   return testing::CheckPathStaysFree(*plan.grid, plan.path);
 }
 
-const std::vector<std::string> kRooms = {
-    "....................",
-    "....................",
-    "...##.......###.....",
-    "...##.......###.....",
-    "........#...........",
-    "#######.#.##########",
-    "........#...........",
-    "...#................",
-    "...#......##........",
-    "..........##........",
-};
+using testing::kRooms;
 
 TEST(TransitionTable, PathsConnectEndpointsAndStayFree) {
   Fixture f = Make(Grid::FromAscii(kRooms));

@@ -25,18 +25,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-const std::vector<std::string> kRooms = {
-    "....................",
-    "....................",
-    "...##.......###.....",
-    "...##.......###.....",
-    "........#...........",
-    "#######.#.##########",
-    "........#...........",
-    "...#................",
-    "...#......##........",
-    "..........##........",
-};
+using testing::kRooms;
 
 std::vector<CellIndex> Endpoints(const std::vector<Rank>& ranks) {
   std::vector<CellIndex> e;
