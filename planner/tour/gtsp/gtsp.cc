@@ -185,7 +185,11 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
     on_best(best);
   }
 
-  int total_trials = ConfigFor(options.effort).trials;
+  // The effort's trials, in whole rounds of `num_threads` parallel trials: a
+  // last round with fewer trials than threads would cost a full trial of
+  // wall time with cores idle, so it is dropped (at least one round runs).
+  const int threads = options.num_threads;
+  int total_trials = std::max(1, cfg.trials / threads) * threads;
   // kThorough with a deadline (and no trial limit) uses all the time given:
   // a few long annealing runs paced by the clock instead of iteration counts
   // (longer anneals beat many short ones on large instances), then more warm
@@ -203,7 +207,6 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
   if (problem.m <= 1) total_trials = 0;  // the greedy step is exact for one set
 
   GtspResult result;
-  const int threads = options.num_threads;
   int started = 0;
   while (started < total_trials && !stop.ShouldStop()) {
     const int round = std::min(threads, total_trials - started);
