@@ -630,6 +630,19 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
                ? StoppedStatus(result.status(), cancel, call, start, options_.max_request_time)
                : result.status();
   }
+  if (result->answered_by != nullptr) {
+    if (std::shared_ptr<const v1::PlanResponse> reply = ServedHitReply(call.tenant_tag, *result)) {
+      *response = *reply;
+      response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
+      response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
+      const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
+      metrics_->RecordSolve(solve_us * 1e-6, result->plan.stats.tour_cut_short);
+      metrics_->RecordPlanSource(PlanOriginName(result->plan.stats.plan_source));
+      const int64_t mean = mean_solve_us_.load();
+      mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+      return absl::OkStatus();
+    }
+  }
   auto retained = std::make_shared<RetainedPlan>();
   retained->plan_id = NewPlanId(call.tenant_tag);
   retained->map_id = map_id;
@@ -651,7 +664,56 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
   plans_.Put(std::move(retained));
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
+  // Only plans the store keeps too: a repeated hit is neither retained nor
+  // persisted again, so its id must stay resolvable (inline maps are not).
+  if (result->answered_by != nullptr && request.map_ref_case() == v1::PlanRequest::kMapId) {
+    RememberServedHit(call.tenant_tag, *result, *response);
+  }
   return absl::OkStatus();
+}
+
+std::shared_ptr<const v1::PlanResponse> CoveragePlannerService::ServedHitReply(const std::string& tenant_tag,
+                                                                              const EngineResult& hit) {
+  std::string plan_id;
+  std::shared_ptr<const v1::PlanResponse> reply;
+  {
+    absl::MutexLock lock(&served_mu_);
+    auto it = served_.find(ServedHitKey(tenant_tag, hit.answered_by.get()));
+    if (it == served_.end() || it->second.entry.lock() != hit.answered_by) return nullptr;
+    plan_id = it->second.plan_id;
+    reply = it->second.reply;
+  }
+  // Expired from the retained plans (GetPlan would not find it): a new id.
+  if (plans_.Get(plan_id) == nullptr) return nullptr;
+  return reply;
+}
+
+void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, const EngineResult& hit,
+                                               const v1::PlanResponse& reply) {
+  ServedHit served;
+  served.entry = hit.answered_by;
+  served.plan_id = reply.plan_id();
+  served.bytes = reply.ByteSizeLong();
+  if (served.bytes > kMaxServedHitBytes / 4) return;  // huge plans: converted per call
+  served.reply = std::make_shared<const v1::PlanResponse>(reply);
+  const ServedHitKey key(tenant_tag, hit.answered_by.get());
+  absl::MutexLock lock(&served_mu_);
+  auto [it, inserted] = served_.try_emplace(key);
+  if (!inserted) {
+    served_bytes_ -= it->second.bytes;
+  } else {
+    served_order_.push_back(key);
+  }
+  served_bytes_ += served.bytes;
+  it->second = std::move(served);
+  // Oldest first, also dropping order entries whose key was replaced in place.
+  while ((served_.size() > kMaxServedHits || served_bytes_ > kMaxServedHitBytes) && !served_order_.empty()) {
+    auto old = served_.find(served_order_.front());
+    served_order_.pop_front();
+    if (old == served_.end()) continue;
+    served_bytes_ -= old->second.bytes;
+    served_.erase(old);
+  }
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerContext* context,

@@ -159,6 +159,13 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                        const StopToken& cancel, v1::PlanResponse* response);
   void UpdateQueueGauges();
+  // Repeated cache hits (issue 12): the reply already sent for `hit`'s
+  // remembered entry to this tenant, if that plan is still retained; else
+  // null. RememberServedHit records a reply for the next ones.
+  std::shared_ptr<const v1::PlanResponse> ServedHitReply(const std::string& tenant_tag,
+                                                         const EngineResult& hit);
+  void RememberServedHit(const std::string& tenant_tag, const EngineResult& hit,
+                         const v1::PlanResponse& reply);
   // The Replan work proper (runs on a worker).
   absl::Status RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
                          const StopToken& cancel, v1::ReplanResponse* response);
@@ -263,6 +270,25 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   absl::Mutex origins_mu_;
   std::deque<std::pair<std::string, std::shared_ptr<const v1::PlanRequest>>> origins_
       ABSL_GUARDED_BY(origins_mu_);
+  // Identical requests answered from memory get the first hit's plan: its
+  // plan id (plan ids name immutable plans) and its reply, so a repeated hit
+  // is one proto copy instead of a conversion, a new retained plan (which
+  // would push other clients' plans out of `plans_`) and a disk write.
+  // Keyed by tenant and remembered entry; the weak pointer tells a live
+  // entry from a new one at a reused address. Bounded by count and bytes.
+  struct ServedHit {
+    std::weak_ptr<const RememberedPlan> entry;
+    std::string plan_id;
+    std::shared_ptr<const v1::PlanResponse> reply;
+    size_t bytes = 0;
+  };
+  using ServedHitKey = std::pair<std::string, const RememberedPlan*>;
+  static constexpr size_t kMaxServedHits = 64;
+  static constexpr size_t kMaxServedHitBytes = size_t{16} << 20;
+  absl::Mutex served_mu_;
+  std::map<ServedHitKey, ServedHit> served_ ABSL_GUARDED_BY(served_mu_);
+  std::deque<ServedHitKey> served_order_ ABSL_GUARDED_BY(served_mu_);  // oldest first
+  size_t served_bytes_ ABSL_GUARDED_BY(served_mu_) = 0;
   // Exponentially weighted mean wall time of a solve (microseconds), for the
   // deadline-aware admission: a call whose expected queue wait would leave no
   // time to plan before its deadline is refused at once.

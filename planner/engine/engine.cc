@@ -260,7 +260,7 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
     if (remembered != nullptr && !request.improve_remembered &&
         remembered->Answers(request.common.time_limit_s)) {
       // Copied outside the cache's lock; the entry itself stays shared.
-      EngineResult hit{remembered->plan, ctx.area};
+      EngineResult hit{remembered->plan, ctx.area, remembered};
       hit.plan.grid = ctx.area->drive;
       PlanStats& s = hit.plan.stats;
       s.plan_source = PlanOrigin::kCacheHit;

@@ -87,9 +87,15 @@ struct RetainedPlan {
   size_t MemoryBytes() const { return sizeof(*this) + plan.MemoryBytes(); }
 };
 
+class RememberedPlan;  // plan_memory.h
+
 struct EngineResult {
   CoveragePlan plan;
   std::shared_ptr<const CoverageArea> area;
+  // A cache hit (plan.stats.plan_source kCacheHit): the remembered entry
+  // that answered. Entries are immutable, so the same entry is the same
+  // answer; a server uses it to serve repeated hits with one reply.
+  std::shared_ptr<const RememberedPlan> answered_by;
 };
 
 class PlanningEngine {

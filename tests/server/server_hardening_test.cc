@@ -204,9 +204,11 @@ TEST_F(ServerHardeningTest, PlanIdsAreRandom128BitValues) {
   const std::string map_id = PutMapOk(Variant(0));
   const std::regex format("p-[0-9a-f]{32}");
   std::vector<std::string> ids;
+  // Three different requests (an identical one would get the remembered
+  // plan, under its id).
   for (int i = 0; i < 3; ++i) {
     v1::PlanResponse plan;
-    ASSERT_TRUE(Plan(map_id, 0.4, &plan).ok());
+    ASSERT_TRUE(Plan(map_id, 0.4 + 0.1 * i, &plan).ok());
     EXPECT_TRUE(std::regex_match(plan.plan_id(), format)) << plan.plan_id();
     ids.push_back(plan.plan_id());
   }

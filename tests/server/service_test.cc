@@ -427,6 +427,42 @@ TEST_F(ServiceTest, HealthIsServingAndReflectionListsTheService) {
   EXPECT_THAT(*services, Contains("grpc.health.v1.Health"));
 }
 
+// Identical requests answered from memory are one plan: every hit after the
+// first gets the first hit's plan id and reply (with this call's timings),
+// and that id stays resolvable by GetPlan. A request that differs (here the
+// seed) is another plan with another id.
+TEST_F(ServiceTest, RepeatedHitsAreOnePlanUnderOneId) {
+  const std::string map_id = PutTwoRooms();
+  v1::PlanResponse cold, first;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &cold).ok());
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &first).ok());
+  ASSERT_EQ(first.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  for (int i = 0; i < 4; ++i) {
+    v1::PlanResponse hit;
+    ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &hit).ok());
+    EXPECT_EQ(hit.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+    EXPECT_EQ(hit.plan_id(), first.plan_id());
+    EXPECT_TRUE(hit.stats().decomposition_cached());
+    // The same plan: everything but this call's planning time.
+    hit.mutable_stats()->set_planning_ms(first.stats().planning_ms());
+    EXPECT_EQ(hit.SerializeAsString(), first.SerializeAsString());
+  }
+  grpc::ClientContext context;
+  v1::GetPlanRequest get;
+  get.set_plan_id(first.plan_id());
+  v1::PlanResponse retained;
+  ASSERT_TRUE(stub_->GetPlan(&context, get, &retained).ok());
+  EXPECT_EQ(retained.plan_id(), first.plan_id());
+  EXPECT_EQ(retained.path_size(), first.path_size());
+
+  v1::PlanRequest other_seed = PlanRequestFor(map_id, 0.4);
+  other_seed.set_seed(other_seed.seed() + 1);
+  v1::PlanResponse other;
+  ASSERT_TRUE(Plan(other_seed, &other).ok());
+  EXPECT_NE(other.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  EXPECT_NE(other.plan_id(), first.plan_id());
+}
+
 // Remembered plans follow map content: the id is the content's, DeleteMap
 // forgets the plans with the artifacts, and other content is another id.
 TEST_F(ServiceTest, RememberedPlansAreNeverAnsweredForOtherMapContent) {
