@@ -177,12 +177,17 @@ absl::StatusOr<CoveragePlan> OarpPlanner::Plan(const PlanContext& ctx) const {
     so.until_limit = options.tour_effort == GtspEffort::kThorough;
     if (options.tour_effort == GtspEffort::kFast) so.kicks_per_rank = 1.0, so.min_kicks = 500;
     so.max_cached_pairs = kCachedPairs;
+    if (ctx.warm_tour != nullptr && SupportsWarmStart(options)) {
+      so.warm_vertices = *ctx.warm_tour;
+      so.warm_kicks = ctx.warm_trials != 0;  // a new start pose: the descent only
+    }
     ASSIGN_OR_RETURN(SparseTour tour, PlanSparseRankTour(drive, ranks, *a.transitions->graph, common.robot,
                                                          so, common.stop));
     vertices = std::move(tour.vertices);
     plan.path = std::move(tour.path);
     plan.termination = tour.termination;
     tour_solver = so.local_search ? "sparse" : "sparse-greedy";
+    if (SupportsWarmStart(options)) plan.tour_vertices = vertices;
   } else {
     ASSIGN_OR_RETURN(RankTourCost cost, RankTourCost::Create(drive, ranks, *a.transitions->table,
                                                              common.robot, common.stop));
@@ -206,9 +211,6 @@ absl::StatusOr<CoveragePlan> OarpPlanner::Plan(const PlanContext& ctx) const {
     plan.path = cost.BuildPath(vertices);
     plan.termination = tour.termination;
     tour_solver = std::string(orderer->name());
-    // Only the dense GTSP starts from a remembered tour; the sparse search
-    // leaves tour_vertices empty, so its plans are remembered whole (cache
-    // hits) but never offered as warm starts.
     if (SupportsWarmStart(options)) plan.tour_vertices = vertices;
   }
 

@@ -267,6 +267,10 @@ class Run {
   }
 
   absl::Status Construct(const StopToken& stop);
+  // The tour `order` (entry endpoints in visiting order) as a cycle, cut at
+  // its best place for S and E by lower bounds, either direction. False if
+  // it does not visit every rank exactly once.
+  bool ConstructFrom(const std::vector<int>& order);
   void LocalSearch(const StopToken& stop);
   // Returns true if it converged (not stopped by the budget).
   bool Iterate(const StopToken& stop, int64_t converge_after, bool until_limit);
@@ -433,6 +437,43 @@ absl::Status Run::Construct(const StopToken& stop) {
     cost_ += c;
   }
   return absl::OkStatus();
+}
+
+bool Run::ConstructFrom(const std::vector<int>& order) {
+  const int n = p_.n();
+  if (static_cast<int>(order.size()) != n || n == 0) return false;
+  std::vector<uint8_t> seen(n, 0);
+  for (int v : order) {
+    if (v < 0 || v >= 2 * n || seen[v / 2]) return false;
+    seen[v / 2] = 1;
+  }
+  // Entry of the k-th rank in direction d (0: as remembered, 1: reversed).
+  auto entry = [&](int d, int k) { return d == 0 ? order[k] : order[n - 1 - k] ^ 1; };
+  int best_d = 0, best_r = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < 2; ++d) {
+    for (int r = 0; r < n; ++r) {
+      const int in = entry(d, r), out = entry(d, (r + n - 1) % n) ^ 1;
+      const double c = L(p_.S(), in) + L(out, p_.E()) - (n > 1 ? L(out, in) : 0.0);
+      if (c < best) best = c, best_d = d, best_r = r;
+    }
+  }
+  t_.clear();
+  t_.push_back(p_.S());
+  for (int k = 0; k < n; ++k) {
+    const int e = entry(best_d, (best_r + k) % n);
+    t_.push_back(e);
+    t_.push_back(e ^ 1);
+  }
+  t_.push_back(p_.E());
+  cost_ = 0.0;
+  for (size_t i = 0; i < t_.size(); ++i) pos_[t_[i]] = static_cast<int>(i);
+  for (size_t i = 0; i + 1 < t_.size(); i += 2) {
+    const double c = C(t_[i], t_[i + 1]);
+    Link(t_[i], t_[i + 1], c);
+    cost_ += c;
+  }
+  return true;
 }
 
 void Run::ApplyTwoOpt(int i, int j, double c1, double c2) {
@@ -723,7 +764,9 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   for (int t = 0; t < threads; ++t) {
     runs.push_back(std::make_unique<Run>(&problem, gtsp_internal::SeedFor(options.seed, t)));
   }
-  RETURN_IF_ERROR(runs[0]->Construct(stop));
+  const bool warm = !options.warm_vertices.empty() && runs[0]->ConstructFrom(options.warm_vertices);
+  if (!warm) RETURN_IF_ERROR(runs[0]->Construct(stop));
+  const bool kicks = options.local_search && (!warm || options.warm_kicks);
   if (options.local_search) {
     runs[0]->PushAll();
     runs[0]->LocalSearch(budget);
@@ -732,8 +775,10 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   auto run = [&](int index) {
     Run& r = *runs[index];
     Outcome& out = outcomes[index];
-    if (options.local_search) {
+    if (kicks) {
       out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit);
+    } else if (options.local_search) {
+      out.converged = !budget.ShouldStop();  // the descent ran to its end
     }
     out.tour = r.tour();
     out.cost = r.cost();
@@ -783,6 +828,7 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   }
 
   SparseTour tour;
+  tour.warm_started = warm;
   tour.surrogate_cost = outcomes[best].cost;
   tour.exact_searches = problem.searches();
   for (int k = 0; k < n; ++k) tour.vertices.push_back(t[2 * k + 1]);
@@ -820,7 +866,9 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   tour.stopped_early = !converged;
   if (converged) {
     tour.termination = Termination::Converged(
-        options.local_search ? "sparse tour search converged" : "nearest-neighbour tour (no search)");
+        !options.local_search ? "nearest-neighbour tour (no search)"
+        : kicks               ? "sparse tour search converged"
+                              : "sparse warm start: the remembered tour, cut for this start, locally optimised");
   } else if (stop.cancelled()) {
     tour.termination = Termination::LimitReached(TerminationLimit::kCancelled,
                                                  "sparse tour search cancelled; best tour kept");

@@ -19,6 +19,7 @@
 // to candidate lists, driven by a work queue, then iterated local search
 // with local double-bridge kicks and undo: one construction and descent,
 // then one kick run per thread from it (different seeds), the best kept.
+// A warm start replaces the construction by a remembered tour.
 // Only the final tour's transitions become paths (in parallel); plan
 // durations come from those paths.
 //
@@ -52,6 +53,14 @@ struct SparseTourOptions {
   int64_t min_kicks = 500;
   double kicks_per_rank = 1.0;
   int64_t max_cached_pairs = 4'000'000;  // on-demand exact lengths kept
+  // A remembered tour to start from instead of the nearest-neighbour
+  // construction: rank-tour vertices as SparseTour::vertices, one per rank.
+  // It is taken as a cycle and cut where it suits this start and end best
+  // (either direction), then descended. Without warm_kicks no kicks follow
+  // (a new start pose's warm start); with them the kick phase runs as cold.
+  // A tour that does not visit every rank once is ignored (cold search).
+  std::vector<int> warm_vertices;
+  bool warm_kicks = true;
 };
 
 struct SparseTour {
@@ -61,6 +70,7 @@ struct SparseTour {
   bool stopped_early = false;
   Termination termination;
   int64_t exact_searches = 0;  // on-demand OctileSearch runs
+  bool warm_started = false;   // began from options.warm_vertices
 };
 
 // InvalidArgument if the start/end pose cannot join the grid or a rank is

@@ -179,6 +179,56 @@ TEST(SparseTour, ValidPlansWithinTenPercentOfTheDenseSolver) {
   RecordProperty("sparse_over_dense", std::to_string(sparse_total / dense_total));
 }
 
+// A warm start from a cold search's own tour, from another start pose:
+// every rank once in a valid plan that starts and ends where asked, at most
+// 10 % above the cold search from the same pose. A tour that repeats a rank
+// is ignored (a cold search runs).
+TEST(SparseTour, WarmStartFromARememberedTour) {
+  for (const Grid& grid : SmallGrids()) {
+    const RankPartition partition = *MinCutPartitioner().Partition(grid, StopToken());
+    auto graph = EndpointGraph::Build(grid, Endpoints(partition.ranks), {}, StopToken(), 2);
+    ASSERT_TRUE(graph.ok()) << graph.status();
+    RobotModel robot;
+    const CellIndex s = partition.ranks.back().first;
+    robot.start = Pose2{grid.CellCenter(s).x, grid.CellCenter(s).y, 0.3};
+    SparseTourOptions options;
+    options.time_limit_s = 5.0;
+    auto remembered = PlanSparseRankTour(grid, partition.ranks, **graph, robot, options, StopToken());
+    ASSERT_TRUE(remembered.ok()) << remembered.status();
+    EXPECT_FALSE(remembered->warm_started);
+
+    RobotModel moved = robot;
+    const CellIndex m = partition.ranks.front().last;
+    moved.start = Pose2{grid.CellCenter(m).x, grid.CellCenter(m).y, 1.0};
+    auto cold = PlanSparseRankTour(grid, partition.ranks, **graph, moved, options, StopToken());
+    ASSERT_TRUE(cold.ok()) << cold.status();
+    SparseTourOptions warm_options = options;
+    warm_options.warm_vertices = remembered->vertices;
+    warm_options.warm_kicks = false;
+    auto warm = PlanSparseRankTour(grid, partition.ranks, **graph, moved, warm_options, StopToken());
+    ASSERT_TRUE(warm.ok()) << warm.status();
+    EXPECT_TRUE(warm->warm_started);
+    ASSERT_EQ(warm->vertices.size(), partition.ranks.size());
+    const CoveragePlan plan = SparsePlan(grid, partition, *warm, moved);
+    EXPECT_EQ(testing::CheckOarpDetail(plan, grid), "");
+    EXPECT_EQ(testing::CheckPathStaysFree(grid, plan.path), "");
+    EXPECT_NEAR(plan.path.front().x, moved.start->x, 1e-9);
+    EXPECT_NEAR(plan.path.back().x, moved.start->x, 1e-9);  // no end: back to the start
+    EXPECT_NEAR(plan.path.back().y, moved.start->y, 1e-9);
+    EXPECT_LE(warm->surrogate_cost, 1.10 * cold->surrogate_cost)
+        << "warm " << warm->surrogate_cost << " s vs cold " << cold->surrogate_cost << " s";
+
+    if (partition.ranks.size() >= 2) {
+      SparseTourOptions bad = warm_options;
+      bad.warm_vertices[1] = bad.warm_vertices[0];  // rank twice, another never
+      auto fallback = PlanSparseRankTour(grid, partition.ranks, **graph, moved, bad, StopToken());
+      ASSERT_TRUE(fallback.ok()) << fallback.status();
+      EXPECT_FALSE(fallback->warm_started);
+      EXPECT_EQ(fallback->vertices.size(), partition.ranks.size());
+    }
+  }
+}
+
 // A comb of thin walls: `teeth` one-cell gaps below a two-row corridor, one
 // rank per gap plus the corridor's (1 px = one 0.1 m cell).
 OccupancyMap Comb(int teeth) {
