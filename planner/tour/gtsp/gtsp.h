@@ -47,7 +47,8 @@ enum class GtspEffort { kFast, kDefault, kThorough };
 
 struct GtspOptions {
   uint64_t seed = 1;
-  int num_threads = 1;            // trials run in parallel on this many threads
+  int num_threads = 1;            // trials run in parallel on this many threads; the
+                                  // effort's trials run in whole rounds of this many
   GtspEffort effort = GtspEffort::kDefault;
   int max_trials = 0;             // 0 = chosen by effort; kLocalStepOnly: no LNS trial
   static constexpr int kLocalStepOnly = -1;  // the initial (or greedy) tour, locally optimised
