@@ -706,7 +706,7 @@ void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, co
   }
   served_bytes_ += served.bytes;
   it->second = std::move(served);
-  // Oldest first, also dropping order entries whose key was replaced in place.
+  // Over a bound: drop the oldest keys (a key replaced in place keeps its place).
   while ((served_.size() > kMaxServedHits || served_bytes_ > kMaxServedHitBytes) && !served_order_.empty()) {
     auto old = served_.find(served_order_.front());
     served_order_.pop_front();
