@@ -271,6 +271,8 @@ class Run {
   // its best place for S and E by lower bounds, either direction. False if
   // it does not visit every rank exactly once.
   bool ConstructFrom(const std::vector<int>& order);
+  // Positions, mates and exact costs of the transitions of a complete t_.
+  void PriceTour();
   void LocalSearch(const StopToken& stop);
   // Returns true if it converged (not stopped by the budget).
   bool Iterate(const StopToken& stop, int64_t converge_after, bool until_limit);
@@ -429,6 +431,11 @@ absl::Status Run::Construct(const StopToken& stop) {
     cur = best ^ 1;
   }
   t_.push_back(p_.E());
+  PriceTour();
+  return absl::OkStatus();
+}
+
+void Run::PriceTour() {
   cost_ = 0.0;
   for (size_t i = 0; i < t_.size(); ++i) pos_[t_[i]] = static_cast<int>(i);
   for (size_t i = 0; i + 1 < t_.size(); i += 2) {
@@ -436,7 +443,6 @@ absl::Status Run::Construct(const StopToken& stop) {
     Link(t_[i], t_[i + 1], c);
     cost_ += c;
   }
-  return absl::OkStatus();
 }
 
 bool Run::ConstructFrom(const std::vector<int>& order) {
@@ -466,13 +472,7 @@ bool Run::ConstructFrom(const std::vector<int>& order) {
     t_.push_back(e ^ 1);
   }
   t_.push_back(p_.E());
-  cost_ = 0.0;
-  for (size_t i = 0; i < t_.size(); ++i) pos_[t_[i]] = static_cast<int>(i);
-  for (size_t i = 0; i + 1 < t_.size(); i += 2) {
-    const double c = C(t_[i], t_[i + 1]);
-    Link(t_[i], t_[i + 1], c);
-    cost_ += c;
-  }
+  PriceTour();
   return true;
 }
 
