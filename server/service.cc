@@ -635,11 +635,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       *response = *reply;
       response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
       response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
-      const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
-      metrics_->RecordSolve(solve_us * 1e-6, result->plan.stats.tour_cut_short);
-      metrics_->RecordPlanSource(PlanOriginName(result->plan.stats.plan_source));
-      const int64_t mean = mean_solve_us_.load();
-      mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+      RecordPlanSolve(start, result->plan.stats);
       return absl::OkStatus();
     }
   }
@@ -657,11 +653,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
                      response->termination().detail()));
   }
   if (request.map_ref_case() == v1::PlanRequest::kMapId) PersistPlan(request, *response);
-  const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
-  metrics_->RecordSolve(solve_us * 1e-6, retained->plan.stats.tour_cut_short);
-  metrics_->RecordPlanSource(PlanOriginName(retained->plan.stats.plan_source));
-  const int64_t mean = mean_solve_us_.load();
-  mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+  RecordPlanSolve(start, retained->plan.stats);
   plans_.Put(std::move(retained));
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
   // Only plans the store keeps too: a repeated hit is neither retained nor
@@ -670,6 +662,14 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     RememberServedHit(call.tenant_tag, *result, *response);
   }
   return absl::OkStatus();
+}
+
+void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& stats) {
+  const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
+  metrics_->RecordSolve(solve_us * 1e-6, stats.tour_cut_short);
+  metrics_->RecordPlanSource(PlanOriginName(stats.plan_source));
+  const int64_t mean = mean_solve_us_.load();
+  mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
 }
 
 std::shared_ptr<const v1::PlanResponse> CoveragePlannerService::ServedHitReply(const std::string& tenant_tag,

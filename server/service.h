@@ -159,6 +159,8 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
                        const StopToken& cancel, v1::PlanResponse* response);
   void UpdateQueueGauges();
+  // A Plan's solve metrics and the mean solve time the admission uses.
+  void RecordPlanSolve(absl::Time start, const PlanStats& stats);
   // Repeated cache hits (issue 12): the reply already sent for `hit`'s
   // remembered entry to this tenant, if that plan is still retained; else
   // null. RememberServedHit records a reply for the next ones.

@@ -78,6 +78,13 @@ class ServiceTest : public ::testing::Test {
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
     return stub_->Plan(&context, request, response);
   }
+  grpc::Status GetPlan(const std::string& plan_id, v1::PlanResponse* response) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    v1::GetPlanRequest get;
+    get.set_plan_id(plan_id);
+    return stub_->GetPlan(&context, get, response);
+  }
   std::string PutTwoRooms() {
     v1::PutMapResponse put;
     const grpc::Status status = PutMap(RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1), &put);
@@ -135,11 +142,8 @@ TEST_F(ServiceTest, PutMapThenPlanCoversEveryFreeCell) {
   EXPECT_NE(again.plan_id(), plan.plan_id());
 
   // The plan stays addressable by its id.
-  grpc::ClientContext context;
-  v1::GetPlanRequest get;
-  get.set_plan_id(plan.plan_id());
   v1::PlanResponse retained;
-  ASSERT_TRUE(stub_->GetPlan(&context, get, &retained).ok());
+  ASSERT_TRUE(GetPlan(plan.plan_id(), &retained).ok());
   EXPECT_EQ(retained.SerializeAsString(), plan.SerializeAsString());
 }
 
@@ -183,11 +187,8 @@ TEST_F(ServiceTest, PolygonMapsRegionsAndNoGoZonesOverGrpc) {
     }
   }
   // GetPlan returns the retained plan, zones included.
-  grpc::ClientContext context;
-  v1::GetPlanRequest get;
-  get.set_plan_id(plan.plan_id());
   v1::PlanResponse retained;
-  ASSERT_TRUE(stub_->GetPlan(&context, get, &retained).ok());
+  ASSERT_TRUE(GetPlan(plan.plan_id(), &retained).ok());
   EXPECT_EQ(retained.SerializeAsString(), plan.SerializeAsString());
 
   // Bad geometry: INVALID_ARGUMENT naming the ring.
@@ -447,11 +448,8 @@ TEST_F(ServiceTest, RepeatedHitsAreOnePlanUnderOneId) {
     hit.mutable_stats()->set_planning_ms(first.stats().planning_ms());
     EXPECT_EQ(hit.SerializeAsString(), first.SerializeAsString());
   }
-  grpc::ClientContext context;
-  v1::GetPlanRequest get;
-  get.set_plan_id(first.plan_id());
   v1::PlanResponse retained;
-  ASSERT_TRUE(stub_->GetPlan(&context, get, &retained).ok());
+  ASSERT_TRUE(GetPlan(first.plan_id(), &retained).ok());
   EXPECT_EQ(retained.plan_id(), first.plan_id());
   EXPECT_EQ(retained.path_size(), first.path_size());
 
