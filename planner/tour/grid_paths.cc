@@ -76,60 +76,139 @@ std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components) {
   return comp;
 }
 
+uint8_t DriveMoveMask(const Grid& g, CellIndex c) {
+  uint8_t mask = 0;
+  for (int k = 0; k < 8; ++k) {
+    const int dr = kDriveDr[k], dc = kDriveDc[k];
+    bool open;
+    if (k < 4) {
+      open = g.Passable(c.row, c.col, dr, dc);
+    } else {
+      open = g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
+             g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc) &&
+             (g.obstacle_pixels() == nullptr || !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc));
+    }
+    mask |= static_cast<uint8_t>(open) << k;
+  }
+  return mask;
+}
+
 AnyAngleSearch::AnyAngleSearch(const Grid& grid)
     : grid_(grid),
       dist_(grid.size(), kUnreached),
       parent_(grid.size(), -1),
-      closed_(grid.size(), 0) {}
+      closed_(grid.size(), 0),
+      moves_(grid.size(), 0) {}
 
 namespace {
 
-float Euclid(const Grid& g, int64_t a, int64_t b) {
-  const CellIndex ca = g.FromIndex(a), cb = g.FromIndex(b);
-  const float dr = static_cast<float>(ca.row - cb.row), dc = static_cast<float>(ca.col - cb.col);
+// Euclidean distance between cell centres, in cells. The searches compare
+// these floats exactly, so every caller uses this one formula.
+float Euclid(CellIndex a, CellIndex b) {
+  const float dr = static_cast<float>(a.row - b.row), dc = static_cast<float>(a.col - b.col);
   return std::sqrt(dr * dr + dc * dc);
 }
 
-template <typename F>
-void ForEachMove(const Grid& g, CellIndex c, F&& f) {
-  ForEachDriveMove(g, c, [&](int64_t n, bool) { f(n); });
+// Bit of the 4-neighbour move (dr, dc) in a move mask.
+constexpr int StraightBit(int dr, int dc) { return dr > 0 ? 0 : dr < 0 ? 1 : dc > 0 ? 2 : 3; }
+
+}  // namespace
+
+uint16_t AnyAngleSearch::FillMoves(int64_t i, CellIndex c) {
+  const ObstaclePixels* px = grid_.obstacle_pixels();
+  uint16_t m = static_cast<uint16_t>(DriveMoveMask(grid_, c) | kKnown);
+  if (px != nullptr && px->CellDirty(c.row, c.col)) m |= kDirty;
+  moves_[i] = m;
+  return m;
+}
+
+// The walk of LineOfSight, with each cell's passable sides and dirtiness read
+// from its move mask (filled once per cell) instead of the grid.
+bool AnyAngleSearch::Visible(CellIndex a, CellIndex b) {
+  int x = a.col, y = a.row;
+  const int dx = b.col - a.col, dy = b.row - a.row;
+  const int64_t nx = std::abs(dx), ny = std::abs(dy);
+  const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
+  if (!grid_.IsFree(y, x)) return false;
+  const ObstaclePixels* px = grid_.obstacle_pixels();
+  const Point2 pa{a.col + 0.5, a.row + 0.5}, pb{b.col + 0.5, b.row + 0.5};
+  const int cols = grid_.cols();
+  const uint16_t right = uint16_t{1} << StraightBit(0, sx), up = uint16_t{1} << StraightBit(sy, 0);
+  int64_t i = static_cast<int64_t>(y) * cols + x;
+  uint16_t m = Moves(i, {y, x});
+  auto pixels_clear = [&](uint16_t mask, int r, int c) {
+    return !(mask & kDirty) || !px->SegmentBlockedInCell(r, c, pa, pb);
+  };
+  if (!pixels_clear(m, y, x)) return false;
+  for (int64_t ix = 0, iy = 0; ix < nx || iy < ny;) {
+    const int64_t decision = (1 + 2 * ix) * ny - (1 + 2 * iy) * nx;
+    if (decision == 0) {
+      // Exactly through a grid corner: all four cells around it are touched,
+      // and no barrier may meet the corner.
+      if (!(m & right)) return false;
+      const uint16_t mx = Moves(i + sx, {y, x + sx});
+      if (!(mx & up) || !(m & up)) return false;
+      const uint16_t my = Moves(i + static_cast<int64_t>(sy) * cols, {y + sy, x});
+      if (!(my & right)) return false;
+      if (!pixels_clear(mx, y, x + sx) || !pixels_clear(my, y + sy, x)) return false;
+      x += sx, y += sy, ++ix, ++iy;
+      i += sx + static_cast<int64_t>(sy) * cols;
+    } else if (decision < 0) {
+      if (!(m & right)) return false;
+      x += sx, ++ix;
+      i += sx;
+    } else {
+      if (!(m & up)) return false;
+      y += sy, ++iy;
+      i += static_cast<int64_t>(sy) * cols;
+    }
+    m = Moves(i, {y, x});
+    if (!pixels_clear(m, y, x)) return false;
+  }
+  return true;
 }
 
 // Lazy Theta*: the parent of the cell s being settled was assumed visible
 // when s was queued; if it is not, s takes its best closed neighbour.
-void RepairParent(const Grid& g, int32_t s, CellIndex cs, float unreached, std::vector<float>& dist,
-                  std::vector<int32_t>& parent, const std::vector<uint8_t>& closed) {
-  const int32_t p = parent[s];
-  if (p == s || LineOfSight(g, g.FromIndex(p), cs)) return;
-  float best = unreached;
+void AnyAngleSearch::RepairParent(int32_t s, CellIndex cs) {
+  const int32_t p = parent_[s];
+  if (p == s || Visible(grid_.FromIndex(p), cs)) return;
+  float best = kUnreached;
   int32_t best_parent = -1;
-  ForEachMove(g, cs, [&](int64_t n) {
-    if (!closed[n]) return;
-    const float cand = dist[n] + Euclid(g, n, s);
-    if (cand < best) best = cand, best_parent = static_cast<int32_t>(n);
-  });
-  if (best_parent >= 0) dist[s] = best, parent[s] = best_parent;
+  const uint16_t m = Moves(s, cs);
+  for (int k = 0; k < 8; ++k) {
+    if (!(m >> k & 1)) continue;
+    const CellIndex cn{cs.row + kDriveDr[k], cs.col + kDriveDc[k]};
+    const int32_t n = static_cast<int32_t>(grid_.Index(cn.row, cn.col));
+    if (!closed_[n]) continue;
+    const float cand = dist_[n] + Euclid(cn, cs);
+    if (cand < best) best = cand, best_parent = n;
+  }
+  if (best_parent >= 0) dist_[s] = best, parent_[s] = best_parent;
 }
 
 // The any-angle step out of the settled cell s: each open move n is reached
-// straight from s's parent. improved(n, cost) runs before n's entries are
-// overwritten (it queues n, and may note that n was unreached).
+// straight from s's parent. improved(n, cell of n, cost) runs before n's
+// entries are overwritten (it queues n, and may note that n was unreached).
 template <typename F>
-void RelaxThroughParent(const Grid& g, int32_t s, CellIndex cs, std::vector<float>& dist,
-                        std::vector<int32_t>& parent, const std::vector<uint8_t>& closed, F&& improved) {
-  const int32_t ps = parent[s];
-  ForEachMove(g, cs, [&](int64_t n) {
-    if (closed[n]) return;
-    const float cand = dist[ps] + Euclid(g, ps, n);
-    if (cand < dist[n]) {
-      improved(n, cand);
-      dist[n] = cand;
-      parent[n] = ps;
+void AnyAngleSearch::RelaxThroughParent(int32_t s, CellIndex cs, F&& improved) {
+  const int32_t ps = parent_[s];
+  const CellIndex cp = grid_.FromIndex(ps);
+  const float dp = dist_[ps];
+  const uint16_t m = Moves(s, cs);
+  for (int k = 0; k < 8; ++k) {
+    if (!(m >> k & 1)) continue;
+    const CellIndex cn{cs.row + kDriveDr[k], cs.col + kDriveDc[k]};
+    const int32_t n = static_cast<int32_t>(grid_.Index(cn.row, cn.col));
+    if (closed_[n]) continue;
+    const float cand = dp + Euclid(cp, cn);
+    if (cand < dist_[n]) {
+      improved(n, cn, cand);
+      dist_[n] = cand;
+      parent_[n] = ps;
     }
-  });
+  }
 }
-
-}  // namespace
 
 bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
   std::fill(dist_.begin(), dist_.end(), kUnreached);
@@ -137,6 +216,7 @@ bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
   std::fill(closed_.begin(), closed_.end(), 0);
   touched_.clear();
   all_dirty_ = true;
+  resumable_ = false;
   if (!grid_.IsFree(source)) return true;
   source_ = grid_.Index(source.row, source.col);
   using Entry = std::pair<float, int32_t>;
@@ -151,15 +231,15 @@ bool AnyAngleSearch::Run(CellIndex source, const StopToken& stop) {
     if (closed_[s] || d > dist_[s]) continue;
     if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
     const CellIndex cs = grid_.FromIndex(s);
-    RepairParent(grid_, s, cs, kUnreached, dist_, parent_, closed_);
+    RepairParent(s, cs);
     closed_[s] = 1;
-    RelaxThroughParent(grid_, s, cs, dist_, parent_, closed_,
-                       [&](int64_t n, float cand) { open.push({cand, static_cast<int32_t>(n)}); });
+    RelaxThroughParent(s, cs, [&](int32_t n, CellIndex, float cand) { open.push({cand, n}); });
   }
   return true;
 }
 
 void AnyAngleSearch::Reset() {
+  resumable_ = false;
   if (all_dirty_) {
     std::fill(dist_.begin(), dist_.end(), kUnreached);
     std::fill(parent_.begin(), parent_.end(), -1);
@@ -173,35 +253,50 @@ void AnyAngleSearch::Reset() {
 
 bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& stop, int64_t max_expansions,
                            float* bound) {
-  Reset();
-  if (!grid_.IsFree(source) || !grid_.IsFree(target)) return true;
-  source_ = grid_.Index(source.row, source.col);
-  const int64_t goal = grid_.Index(target.row, target.col);
   // Ties (frequent in open areas) go to the cell nearer the goal.
-  auto h = [&](int64_t i) { return Euclid(grid_, i, goal) * (1.0f + 1e-5f); };
+  auto h = [&](CellIndex c) { return Euclid(c, target) * (1.0f + 1e-5f); };
   using Entry = std::pair<float, int32_t>;  // (g + h, cell)
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
-  dist_[source_] = 0.0f;
-  parent_[source_] = static_cast<int32_t>(source_);
-  touched_.push_back(static_cast<int32_t>(source_));
-  open.push({h(source_), static_cast<int32_t>(source_)});
-  int64_t expansions = 0;
-  while (!open.empty()) {
-    const auto [f, s] = open.top();
-    open.pop();
-    if (closed_[s] || f > dist_[s] + h(s) + 1e-4f) continue;
-    if (++expansions > max_expansions) {
+  const std::greater<Entry> later;
+  const bool resume = resumable_ && grid_.IsFree(source) && grid_.IsFree(target) &&
+                      source_ == grid_.Index(source.row, source.col) &&
+                      goal_ == grid_.Index(target.row, target.col);
+  if (!resume) {
+    Reset();
+    if (!grid_.IsFree(source) || !grid_.IsFree(target)) return true;
+    source_ = grid_.Index(source.row, source.col);
+    goal_ = grid_.Index(target.row, target.col);
+    dist_[source_] = 0.0f;
+    parent_[source_] = static_cast<int32_t>(source_);
+    touched_.push_back(static_cast<int32_t>(source_));
+    open_.clear();
+    open_.push_back({h(source), static_cast<int32_t>(source_)});
+    expansions_ = 0;
+  }
+  resumable_ = false;
+  while (!open_.empty()) {
+    std::pop_heap(open_.begin(), open_.end(), later);
+    const auto [f, s] = open_.back();
+    open_.pop_back();
+    if (closed_[s]) continue;
+    const CellIndex cs = grid_.FromIndex(s);
+    if (f > dist_[s] + h(cs) + 1e-4f) continue;
+    if (++expansions_ > max_expansions) {
+      // Put the entry back uncounted, so that a resumed call expands it.
+      open_.push_back({f, s});
+      std::push_heap(open_.begin(), open_.end(), later);
+      --expansions_;
+      resumable_ = true;
       if (bound != nullptr) *bound = f;
       return false;
     }
-    if ((expansions & 1023) == 0 && stop.ShouldStop()) return false;
-    const CellIndex cs = grid_.FromIndex(s);
-    RepairParent(grid_, s, cs, kUnreached, dist_, parent_, closed_);
+    if ((expansions_ & 1023) == 0 && stop.ShouldStop()) return false;
+    RepairParent(s, cs);
     closed_[s] = 1;
-    if (s == goal) return true;
-    RelaxThroughParent(grid_, s, cs, dist_, parent_, closed_, [&](int64_t n, float cand) {
-      if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
-      open.push({cand + h(n), static_cast<int32_t>(n)});
+    if (s == goal_) return true;
+    RelaxThroughParent(s, cs, [&](int32_t n, CellIndex cn, float cand) {
+      if (dist_[n] >= kUnreached) touched_.push_back(n);
+      open_.push_back({cand + h(cn), n});
+      std::push_heap(open_.begin(), open_.end(), later);
     });
   }
   return true;
@@ -225,12 +320,12 @@ bool AnyAngleSearch::Explore(CellIndex source, int64_t max_settled, const StopTo
     if (closed_[s] || d > dist_[s]) continue;
     if ((++expansions & 1023) == 0 && stop.ShouldStop()) return false;
     const CellIndex cs = grid_.FromIndex(s);
-    RepairParent(grid_, s, cs, kUnreached, dist_, parent_, closed_);
+    RepairParent(s, cs);
     closed_[s] = 1;
     if (!settle(s, dist_[s]) || ++settled >= max_settled) return true;
-    RelaxThroughParent(grid_, s, cs, dist_, parent_, closed_, [&](int64_t n, float cand) {
-      if (dist_[n] >= kUnreached) touched_.push_back(static_cast<int32_t>(n));
-      open.push({cand, static_cast<int32_t>(n)});
+    RelaxThroughParent(s, cs, [&](int32_t n, CellIndex, float cand) {
+      if (dist_[n] >= kUnreached) touched_.push_back(n);
+      open.push({cand, n});
     });
   }
   return true;

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -52,25 +53,21 @@ bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<b
 // names the pose in the InvalidArgument error ("start", "end").
 absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& pose, const char* what);
 
-// Calls f(neighbour index, diagonal?) for every move the drive searches allow
-// from c: 4-neighbours through passable boundaries, and diagonals whose two
-// L-shaped routes are open (no corner cutting) and whose segment touches no
-// non-free map pixel.
+// The moves the drive searches allow from a cell, as bit k of a mask for
+// the step (kDriveDr[k], kDriveDc[k]): 4-neighbours (k < 4) through passable
+// boundaries, and diagonals (k >= 4) whose two L-shaped routes are open (no
+// corner cutting) and whose segment touches no non-free map pixel.
+inline constexpr int kDriveDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+inline constexpr int kDriveDc[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+uint8_t DriveMoveMask(const Grid& g, CellIndex c);
+
+// Calls f(neighbour index, diagonal?) for every move of DriveMoveMask, in
+// the order of k.
 template <typename F>
 void ForEachDriveMove(const Grid& g, CellIndex c, F&& f) {
-  constexpr int kDr[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-  constexpr int kDc[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  const uint8_t mask = DriveMoveMask(g, c);
   for (int k = 0; k < 8; ++k) {
-    const int dr = kDr[k], dc = kDc[k];
-    if (k < 4) {
-      if (g.Passable(c.row, c.col, dr, dc)) f(g.Index(c.row + dr, c.col + dc), false);
-      continue;
-    }
-    if (g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
-        g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc) &&
-        (g.obstacle_pixels() == nullptr || !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc))) {
-      f(g.Index(c.row + dr, c.col + dc), true);
-    }
+    if (mask >> k & 1) f(g.Index(c.row + kDriveDr[k], c.col + kDriveDc[k]), k >= 4);
   }
 }
 
@@ -85,7 +82,9 @@ class AnyAngleSearch {
   // Costs only the cells it touches (no whole-grid reset), so many short
   // searches on a large grid stay cheap. False if stopped early, or after
   // `max_expansions` expansions: then `*bound` (if given) is a lower bound
-  // of the distance (the smallest g + h still open).
+  // of the distance (the smallest g + h still open). A call for the same
+  // source and target right after one that ended at `max_expansions` goes on
+  // from where it stopped (the result is that of one uninterrupted search).
   bool RunTo(CellIndex source, CellIndex target, const StopToken& stop,
              int64_t max_expansions = INT64_MAX, float* bound = nullptr);
   // Run() cut short: the same search (same order, same distances) that
@@ -99,19 +98,40 @@ class AnyAngleSearch {
   double DistanceCells(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)]; }
   // Corner cells from the source to `target`, both included; empty if unreached.
   std::vector<CellIndex> PathTo(CellIndex target) const;
-  // Scratch bytes per grid cell (distance, parent, closed flag, touched list).
-  static constexpr int64_t kBytesPerCell = 13;
+  // LineOfSight(grid, a, b), read from the search's per-cell move masks
+  // (filled on first use) instead of the grid: what the searches call.
+  bool Visible(CellIndex a, CellIndex b);
+  // Scratch bytes per grid cell (distance, parent, closed flag, touched
+  // list, move mask).
+  static constexpr int64_t kBytesPerCell = 15;
 
  private:
   static constexpr float kUnreached = 1e30f;
+  // moves_ bits: 0-7 DriveMoveMask, kDirty the cell overlaps a non-free map
+  // pixel, kKnown the entry is filled (cells are filled when first met).
+  static constexpr uint16_t kDirty = 1u << 8, kKnown = 1u << 9;
   const Grid& grid_;
   std::vector<float> dist_;
   std::vector<int32_t> parent_;
   std::vector<uint8_t> closed_;
+  std::vector<uint16_t> moves_;
+  std::vector<std::pair<float, int32_t>> open_;  // RunTo's heap (g + h, cell)
+  int64_t expansions_ = 0;                        // RunTo's, kept to resume
+  int64_t goal_ = -1;
+  bool resumable_ = false;  // the last RunTo stopped at its max_expansions
   std::vector<int32_t> touched_;  // cells written by the last RunTo
   bool all_dirty_ = false;        // Run wrote the whole grid
   int64_t source_ = -1;
   void Reset();
+  uint16_t Moves(int64_t i, CellIndex c) {
+    const uint16_t m = moves_[i];
+    return (m & kKnown) ? m : FillMoves(i, c);
+  }
+  uint16_t FillMoves(int64_t i, CellIndex c);
+  // Lazy Theta*'s parent repair and any-angle relaxation (grid_paths.cc).
+  void RepairParent(int32_t s, CellIndex cs);
+  template <typename F>
+  void RelaxThroughParent(int32_t s, CellIndex cs, F&& improved);
 };
 
 }  // namespace covplan

@@ -1,6 +1,8 @@
 #include "planner/tour/grid_paths.h"
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "gtest/gtest.h"
 #include "tests/testing/grid_fixtures.h"
@@ -167,6 +169,87 @@ TEST(AnyAngleSearch, RandomGridsPathsStayFree) {
       for (const CellIndex& p : path) wps.push_back({g.CellCenter(p).x, g.CellCenter(p).y, 0, SegmentKind::kTransition, -1});
       ASSERT_EQ(testing::CheckPathStaysFree(g, wps), "") << "seed " << seed;
     }
+  }
+}
+
+// A goal search capped at a few expansions and then asked again for the same
+// pair goes on where it stopped: its distance and path are those of one
+// uninterrupted search.
+TEST(AnyAngleSearch, CappedRunToResumesAsOneSearch) {
+  for (uint32_t seed = 0; seed < 10; ++seed) {
+    const Grid g = testing::RandomGrid(30, 40, 0.75, seed);
+    std::vector<CellIndex> free_cells;
+    for (int64_t i = 0; i < g.size(); ++i) {
+      if (g.free_flags()[i]) free_cells.push_back(g.FromIndex(i));
+    }
+    AnyAngleSearch fresh(g), capped(g);
+    std::mt19937 rng(seed);
+    int resumed = 0;
+    for (int k = 0; k < 40; ++k) {
+      const CellIndex a = free_cells[rng() % free_cells.size()], b = free_cells[rng() % free_cells.size()];
+      ASSERT_TRUE(fresh.RunTo(a, b, StopToken()));
+      float bound = -1.0f;
+      if (capped.RunTo(a, b, StopToken(), 25, &bound)) {
+        EXPECT_FLOAT_EQ(capped.DistanceCells(b), fresh.DistanceCells(b));
+        continue;
+      }
+      ++resumed;
+      EXPECT_GT(bound, 0.0f);
+      ASSERT_TRUE(capped.RunTo(a, b, StopToken()));
+      ASSERT_EQ(capped.Reached(b), fresh.Reached(b)) << "seed " << seed;
+      if (!fresh.Reached(b)) continue;
+      EXPECT_EQ(capped.DistanceCells(b), fresh.DistanceCells(b)) << "seed " << seed;
+      const std::vector<CellIndex> p1 = capped.PathTo(b), p2 = fresh.PathTo(b);
+      ASSERT_EQ(p1.size(), p2.size());
+      for (size_t i = 0; i < p1.size(); ++i) EXPECT_EQ(p1[i], p2[i]);
+    }
+    EXPECT_GT(resumed, 0) << "seed " << seed;
+  }
+}
+
+// The searches' own line-of-sight walk (move masks) agrees with LineOfSight
+// on every pair of cells of maps with thin walls (barriers), small obstacles
+// inside free cells (pixels) and blocked cells.
+TEST(AnyAngleSearch, VisibleAgreesWithLineOfSight) {
+  for (uint32_t seed = 0; seed < 6; ++seed) {
+    std::mt19937 rng(seed);
+    OccupancyMap map(60, 48, 0.1, {0.0, 0.0});
+    for (int r = 0; r < map.height(); ++r) {
+      for (int c = 0; c < map.width(); ++c) map.set(r, c, CellState::kFree);
+    }
+    for (int k = 0; k < 25; ++k) {  // specks and small blocks
+      const int r0 = static_cast<int>(rng() % map.height()), c0 = static_cast<int>(rng() % map.width());
+      const int h = 1 + static_cast<int>(rng() % 8), w = 1 + static_cast<int>(rng() % 8);
+      for (int r = r0; r < std::min(map.height(), r0 + h); ++r) {
+        for (int c = c0; c < std::min(map.width(), c0 + w); ++c) map.set(r, c, CellState::kOccupied);
+      }
+    }
+    for (int k = 0; k < 3; ++k) {  // one-pixel walls with a gap: barriers between free cells
+      const int c = 5 + static_cast<int>(rng() % (map.width() - 10));
+      const int gap = static_cast<int>(rng() % map.height());
+      for (int r = 0; r < map.height(); ++r) {
+        if (std::abs(r - gap) > 4) map.set(r, c, CellState::kOccupied);
+      }
+    }
+    GridOptions opt;
+    opt.cell_size = 0.4;
+    absl::StatusOr<Grid> g = BuildGrid(map, opt);
+    ASSERT_TRUE(g.ok()) << g.status();
+    ASSERT_NE(g->obstacle_pixels(), nullptr);
+    AnyAngleSearch search(*g);
+    int64_t visible = 0, hidden = 0;
+    for (int64_t a = 0; a < g->size(); ++a) {
+      for (int64_t b = 0; b < g->size(); ++b) {
+        const CellIndex ca = g->FromIndex(a), cb = g->FromIndex(b);
+        const bool los = LineOfSight(*g, ca, cb);
+        ASSERT_EQ(search.Visible(ca, cb), los)
+            << "seed " << seed << " (" << ca.row << "," << ca.col << ") -> (" << cb.row << "," << cb.col << ")";
+        (los ? visible : hidden) += 1;
+      }
+    }
+    EXPECT_GT(visible, 0);
+    EXPECT_GT(hidden, 0);
+    EXPECT_GT(g->CountBarriers(), 0) << "seed " << seed;
   }
 }
 
