@@ -123,7 +123,10 @@ uint16_t AnyAngleSearch::FillMoves(int64_t i, CellIndex c) {
 }
 
 // The walk of LineOfSight, with each cell's passable sides and dirtiness read
-// from its move mask (filled once per cell) instead of the grid.
+// from its move mask (filled once per cell) instead of the grid. Kept apart
+// from LineOfSight on purpose: it is the searches' hot loop, and one walk
+// shared through accessor lambdas (tried) made the sparse tour search about
+// 15 % slower. Tests check the two agree on every pair of cells.
 bool AnyAngleSearch::Visible(CellIndex a, CellIndex b) {
   int x = a.col, y = a.row;
   const int dx = b.col - a.col, dy = b.row - a.row;
