@@ -127,7 +127,8 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   bool running_start_ ABSL_GUARDED_BY(mu_) = false;
   uint64_t running_sequence_ ABSL_GUARDED_BY(mu_) = 0;
   StopToken running_stop_ ABSL_GUARDED_BY(mu_);
-  absl::Time last_message_ ABSL_GUARDED_BY(mu_);
+  // From construction: the reaper can see a session between its Add and Start.
+  absl::Time last_message_ ABSL_GUARDED_BY(mu_) = absl::Now();
 };
 
 // The live sessions of a service: a bound on their number and a reaper
