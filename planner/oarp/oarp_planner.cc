@@ -34,7 +34,7 @@ int64_t SparseTransitionBytes(int64_t grid_cells, int64_t num_ranks, int num_thr
   const int threads = std::max(1, num_threads);
   return EndpointGraph::EstimateBytes(grid_cells, 2 * num_ranks, kCandidateNeighbours, threads) +
          threads * grid_cells * AnyAngleSearch::kBytesPerCell +        // tour runs, then the legs
-         threads * num_ranks * 2 * 64 +                               // tour state per run
+         threads * (num_ranks * 2 * 64 + kSparseTourBytesPerThread) +  // tour state per run
          num_ranks * 2 * 128 +                                        // legs and waypoints
          kCachedPairs * kBytesPerCachedPair;
 }

@@ -96,6 +96,14 @@ class AnyAngleSearch {
   bool Reached(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)] < kUnreached; }
   // Path length in cell units (multiply by cell size for metres).
   double DistanceCells(CellIndex c) const { return dist_[grid_.Index(c.row, c.col)]; }
+  // After RunTo or Explore: f(cell index) for every cell it closed, whose
+  // distance and path (PathTo) are then final.
+  template <typename F>
+  void ForEachClosed(F&& f) const {
+    for (int32_t i : touched_) {
+      if (closed_[i]) f(static_cast<int64_t>(i));
+    }
+  }
   // Corner cells from the source to `target`, both included; empty if unreached.
   std::vector<CellIndex> PathTo(CellIndex target) const;
   // LineOfSight(grid, a, b), read from the search's per-cell move masks

@@ -53,7 +53,8 @@ double RobotModel::TurnTime(double angle_rad) const {
 }
 
 double HeadingChange(double from_rad, double to_rad) {
-  double d = std::fmod(std::abs(to_rad - from_rad), 2.0 * M_PI);
+  double d = std::abs(to_rad - from_rad);
+  if (!(d < 2.0 * M_PI)) d = std::fmod(d, 2.0 * M_PI);  // fmod is the identity below 2 pi, and slow
   return d > M_PI ? 2.0 * M_PI - d : d;
 }
 

@@ -8,8 +8,8 @@
 #include <mutex>
 #include <optional>
 #include <thread>
-#include <unordered_map>
 
+#include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
@@ -122,7 +122,7 @@ class Problem {
     const double h0 = ExitHeading(x);
     const bool final_turn = y != E();
     const double dx = pts_[y].x - pts_[x].x, dy = pts_[y].y - pts_[x].y;
-    if (std::hypot(dx, dy) < 1e-9) {
+    if (dx * dx + dy * dy < 1e-18) {
       if (final_turn) t += HeadingChange(h0, EntryHeading(y)) / turn_rate_;
       return t;
     }
@@ -167,6 +167,7 @@ class Problem {
     const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
     searches_.fetch_add(1, std::memory_order_relaxed);
     Store(shard, key, {c, true});
+    Harvest(x, y, *search);
     return c;
   }
 
@@ -198,9 +199,35 @@ class Problem {
     const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
     searches_.fetch_add(1, std::memory_order_relaxed);
     Store(shard, key, {c, true});
+    Harvest(x, y, *search);
     return c;
   }
+  // After a completed search from x's cell (aimed at y): every other rank
+  // endpoint z it closed has its final path, so (x, z) gets its exact cost
+  // now instead of a search of its own later (about half the searches of a
+  // run, measured in docs/benchmarks.md §14). Only while the cache is less
+  // than half full, so harvests never crowd out the pairs searched for.
+  void Harvest(int x, int y, const AnyAngleSearch& search) {
+    if (x >= 2 * n_ || cached_.load(std::memory_order_relaxed) >= max_cached_ / 2) return;
+    search.ForEachClosed([&](int64_t cell) {
+      graph_.ForEachEndpointAt(cell, [&](int z) {
+        if (z == x || z == y || cells_[z] == cells_[x] || Known(x, z)) return;
+        const uint64_t key = static_cast<uint64_t>(std::min(x, z)) * (2 * n_ + 2) + std::max(x, z);
+        Shard& shard = shards_[(key * 0x9E3779B97F4A7C15ULL) >> 58];
+        {
+          std::lock_guard<std::mutex> lock(shard.mu);
+          auto it = shard.map.find(key);
+          if (it != shard.map.end() && it->second.exact) return;
+        }
+        harvest_cells_ = search.PathTo(cells_[z]);
+        if (harvest_cells_.empty()) return;
+        Store(shard, key, {PathCost(x, z, harvest_cells_), true});
+        harvested_.fetch_add(1, std::memory_order_relaxed);
+      });
+    });
+  }
   int64_t probes() const { return probes_.load(); }
+  int64_t harvested() const { return harvested_.load(); }
   int64_t searches() const { return searches_.load(); }
   const Grid& grid() const { return grid_; }
   // True when ExactCost(x, y) needs no search (a candidate pair).
@@ -220,7 +247,7 @@ class Problem {
   };
   struct Shard {
     std::mutex mu;
-    std::unordered_map<uint64_t, Cached> map;
+    absl::flat_hash_map<uint64_t, Cached> map;
   };
   void Store(Shard& shard, uint64_t key, Cached value) {
     std::lock_guard<std::mutex> lock(shard.mu);
@@ -249,13 +276,16 @@ class Problem {
   std::vector<double> pose_costs_[2];
   std::vector<double> cand_costs_;  // parallel to the graph's candidates
   Shard shards_[64];
-  std::atomic<int64_t> cached_{0}, searches_{0}, probes_{0};
+  std::atomic<int64_t> cached_{0}, searches_{0}, probes_{0}, harvested_{0};
+  static thread_local std::vector<CellIndex> harvest_cells_;
   StopToken never_;
 };
 
 // One search run: a tour t = [S, entry, exit, entry, exit, ..., E] with
 // positions, the mate of each node across its transition edge, and that
 // edge's cost. Writes can be logged and undone (rejected kicks).
+thread_local std::vector<CellIndex> Problem::harvest_cells_;
+
 class Run {
  public:
   Run(Problem* p, uint64_t seed) : p_(*p), search_(p->grid()), rng_(seed) {
@@ -325,7 +355,15 @@ class Run {
   }
   double C(int x, int y) { return p_.ExactCost(x, y, &search_, *stop_); }
   double B(int x, int y) { return p_.ProbeCost(x, y, &search_); }
-  double L(int x, int y) const { return p_.LowerCost(x, y); }
+  // LowerCost through a direct-mapped memo: the local search asks for the
+  // same pairs' bounds again and again (after every rolled-back kick), and
+  // each costs an arc tangent and the straight-line time.
+  double L(int x, int y) {
+    const uint64_t key = (static_cast<uint64_t>(x) << 32 | static_cast<uint32_t>(y)) + 1;
+    LowerMemo& m = lower_memo_[(key * 0x9E3779B97F4A7C15ULL) >> (64 - kLowerMemoBits)];
+    if (m.key != key) m.key = key, m.value = p_.LowerCost(x, y);
+    return m.value;
+  }
 
   bool Improve(int x);
   bool TryTwoOpt(int i, int j);
@@ -348,6 +386,13 @@ class Run {
   std::deque<int> queue_;
   std::vector<uint8_t> queued_;
   std::vector<int> scratch_;
+  struct LowerMemo {
+    uint64_t key = 0;  // (x << 32 | y) + 1; 0 = empty
+    double value = 0.0;
+  };
+  static constexpr int kLowerMemoBits = 16;
+  static_assert(sizeof(LowerMemo) << kLowerMemoBits == kSparseTourBytesPerThread);
+  std::vector<LowerMemo> lower_memo_ = std::vector<LowerMemo>(size_t{1} << kLowerMemoBits);
 };
 
 absl::Status Run::Construct(const StopToken& stop) {
@@ -551,8 +596,16 @@ bool Run::TryOrOpt(int a, int b, int k, bool reversed) {
   // Known pairs first (no search), then the rest while the bound allows.
   double cost[3] = {lg, ll, lr};
   const int xs[3] = {before, left, last}, ys[3] = {after, first, right};
-  int order[3] = {0, 1, 2};
-  std::stable_sort(order, order + 3, [&](int u, int v) { return p_.Known(xs[u], ys[u]) > p_.Known(xs[v], ys[v]); });
+  // Known pairs first, otherwise in edge order (a stable partition of three).
+  int order[3];
+  bool known[3];
+  for (int e = 0; e < 3; ++e) known[e] = p_.Known(xs[e], ys[e]);
+  int filled = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int e = 0; e < 3; ++e) {
+      if (known[e] == (pass == 0)) order[filled++] = e;
+    }
+  }
   for (int o : order) {
     cost[o] = B(xs[o], ys[o]);
     if (cost[0] + cost[1] + cost[2] >= removed - kEps) return false;

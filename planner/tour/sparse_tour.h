@@ -6,7 +6,9 @@
 // time (path_timing.h) along the any-angle path, with the turn from x's rank
 // heading and onto y's. Paths of candidate pairs come from the
 // EndpointGraph; others are searched on demand (AnyAngleSearch::RunTo) and
-// their costs cached for the request. Moves are priced first with a lower
+// their costs cached for the request; a completed search also caches the
+// exact cost to every other endpoint it settled on the way (their paths are
+// final). Moves are priced first with a lower
 // bound (straight-line time of the Euclidean distance plus the turns onto
 // and off the straight line), then with a capped probe search, and only then
 // exactly, so full searches run only for moves that could still improve.
@@ -41,6 +43,10 @@
 #include "planner/tour/robot_model.h"
 
 namespace covplan {
+
+// Fixed bytes of each search thread beyond its grid-sized search scratch
+// (the memo of lower bounds).
+inline constexpr int64_t kSparseTourBytesPerThread = int64_t{16} << 16;
 
 struct SparseTourOptions {
   double time_limit_s = 1.0;  // search budget (construction and paths excluded)

@@ -207,6 +207,38 @@ TEST(AnyAngleSearch, CappedRunToResumesAsOneSearch) {
   }
 }
 
+// Every cell a goal search closed on its way has its final path: legs in line
+// of sight, lengths adding up to its distance (what the sparse tour harvests).
+TEST(AnyAngleSearch, CellsClosedOnTheWayHaveTheirPaths) {
+  for (uint32_t seed = 0; seed < 10; ++seed) {
+    const Grid g = testing::RandomGrid(30, 40, 0.75, seed);
+    std::vector<CellIndex> free_cells;
+    for (int64_t i = 0; i < g.size(); ++i) {
+      if (g.free_flags()[i]) free_cells.push_back(g.FromIndex(i));
+    }
+    std::mt19937 rng(seed);
+    AnyAngleSearch search(g);
+    const CellIndex a = free_cells[rng() % free_cells.size()], b = free_cells[rng() % free_cells.size()];
+    ASSERT_TRUE(search.RunTo(a, b, StopToken()));
+    int64_t closed = 0;
+    search.ForEachClosed([&](int64_t i) {
+      ++closed;
+      const CellIndex c = g.FromIndex(i);
+      const std::vector<CellIndex> path = search.PathTo(c);
+      ASSERT_FALSE(path.empty());
+      EXPECT_EQ(path.front(), a);
+      EXPECT_EQ(path.back(), c);
+      double len = 0.0;
+      for (size_t k = 1; k < path.size(); ++k) {
+        ASSERT_TRUE(LineOfSight(g, path[k - 1], path[k])) << "seed " << seed;
+        len += std::hypot(path[k].row - path[k - 1].row, path[k].col - path[k - 1].col);
+      }
+      EXPECT_NEAR(len, search.DistanceCells(c), 1e-3 * (1.0 + len));
+    });
+    if (search.Reached(b)) EXPECT_GE(closed, 1);
+  }
+}
+
 // The searches' own line-of-sight walk (move masks) agrees with LineOfSight
 // on every pair of cells of maps with thin walls (barriers), small obstacles
 // inside free cells (pixels) and blocked cells.
