@@ -172,16 +172,21 @@ TEST(AnyAngleSearch, RandomGridsPathsStayFree) {
   }
 }
 
+std::vector<CellIndex> FreeCells(const Grid& g) {
+  std::vector<CellIndex> cells;
+  for (int64_t i = 0; i < g.size(); ++i) {
+    if (g.free_flags()[i]) cells.push_back(g.FromIndex(i));
+  }
+  return cells;
+}
+
 // A goal search capped at a few expansions and then asked again for the same
 // pair goes on where it stopped: its distance and path are those of one
 // uninterrupted search.
 TEST(AnyAngleSearch, CappedRunToResumesAsOneSearch) {
   for (uint32_t seed = 0; seed < 10; ++seed) {
     const Grid g = testing::RandomGrid(30, 40, 0.75, seed);
-    std::vector<CellIndex> free_cells;
-    for (int64_t i = 0; i < g.size(); ++i) {
-      if (g.free_flags()[i]) free_cells.push_back(g.FromIndex(i));
-    }
+    const std::vector<CellIndex> free_cells = FreeCells(g);
     AnyAngleSearch fresh(g), capped(g);
     std::mt19937 rng(seed);
     int resumed = 0;
@@ -212,10 +217,7 @@ TEST(AnyAngleSearch, CappedRunToResumesAsOneSearch) {
 TEST(AnyAngleSearch, CellsClosedOnTheWayHaveTheirPaths) {
   for (uint32_t seed = 0; seed < 10; ++seed) {
     const Grid g = testing::RandomGrid(30, 40, 0.75, seed);
-    std::vector<CellIndex> free_cells;
-    for (int64_t i = 0; i < g.size(); ++i) {
-      if (g.free_flags()[i]) free_cells.push_back(g.FromIndex(i));
-    }
+    const std::vector<CellIndex> free_cells = FreeCells(g);
     std::mt19937 rng(seed);
     AnyAngleSearch search(g);
     const CellIndex a = free_cells[rng() % free_cells.size()], b = free_cells[rng() % free_cells.size()];
