@@ -313,8 +313,12 @@ class Run {
   void CopyTour(const Run& other) {
     t_ = other.t_, pos_ = other.pos_, mate_ = other.mate_, lc_ = other.lc_, cost_ = other.cost_;
   }
-  void PushAll() {
-    for (int v : t_) Push(v);
+  void PushAll(bool reversed) {
+    if (reversed) {
+      for (auto it = t_.rbegin(); it != t_.rend(); ++it) Push(*it);
+    } else {
+      for (int v : t_) Push(v);
+    }
   }
 
  private:
@@ -810,9 +814,9 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     bool converged = true;
   };
   std::vector<Outcome> outcomes(threads);
-  // One construction and first descent (deterministic: repeating them per
-  // thread would only duplicate work), then one kick run per thread from
-  // that tour with its own seed.
+  // One construction (deterministic: repeating it per thread would only
+  // duplicate work), then per thread a descent from it and a kick run with
+  // its own seed; the threads share the cost cache.
   std::vector<std::unique_ptr<Run>> runs;
   for (int t = 0; t < threads; ++t) {
     runs.push_back(std::make_unique<Run>(&problem, gtsp_internal::SeedFor(options.seed, t)));
@@ -820,14 +824,17 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   const bool warm = !options.warm_vertices.empty() && runs[0]->ConstructFrom(options.warm_vertices);
   if (!warm) RETURN_IF_ERROR(runs[0]->Construct(stop));
   const bool kicks = options.local_search && (!warm || options.warm_kicks);
-  if (options.local_search) {
-    runs[0]->PushAll();
-    runs[0]->LocalSearch(budget);
-  }
   for (int t = 1; t < threads; ++t) runs[t]->CopyTour(*runs[0]);
   auto run = [&](int index) {
     Run& r = *runs[index];
     Outcome& out = outcomes[index];
+    if (options.local_search) {
+      // Every thread descends from the shared start, odd threads with the
+      // work queue reversed (another local optimum), while the others' exact
+      // costs land in the shared cache.
+      r.PushAll(/*reversed=*/index % 2 == 1);
+      r.LocalSearch(budget);
+    }
     if (kicks) {
       out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit);
     } else if (options.local_search) {

@@ -19,8 +19,9 @@
 // fallback to the nearest unvisited endpoints when all candidates are
 // visited), then 2-opt and Or-opt (1-3 ranks, either direction) restricted
 // to candidate lists, driven by a work queue, then iterated local search
-// with local double-bridge kicks and undo: one construction and descent,
-// then one kick run per thread from it (different seeds), the best kept.
+// with local double-bridge kicks and undo: one construction, then per
+// thread a descent (odd threads with the work queue reversed) and a kick
+// run (different seeds), the threads sharing the cost cache, the best kept.
 // A warm start replaces the construction by a remembered tour.
 // Only the final tour's transitions become paths (in parallel); plan
 // durations come from those paths.
