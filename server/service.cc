@@ -1195,6 +1195,7 @@ void CoveragePlannerService::RecordProgress(const std::string& plan_id, const v1
 }
 
 void CoveragePlannerService::FlushProgress() {
+  absl::MutexLock in_order(&progress_write_mu_);
   std::vector<std::pair<std::string, std::string>> writes;
   {
     absl::MutexLock lock(&progress_mu_);

@@ -301,6 +301,10 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   std::set<std::string> progress_dirty_ ABSL_GUARDED_BY(progress_mu_);
   bool progress_flush_queued_ ABSL_GUARDED_BY(progress_mu_) = false;
   uint64_t progress_clock_ ABSL_GUARDED_BY(progress_mu_) = 0;
+  // Held by FlushProgress from its snapshot to its last write, so that two
+  // flushes on the I/O pool's threads write in the order they took their
+  // snapshots (else an older report could land after a newer one).
+  absl::Mutex progress_write_mu_ ABSL_ACQUIRED_BEFORE(progress_mu_);
   SessionRegistry sessions_;
   uint64_t id_salt_;
   StopToken background_stop_;  // cancelled when draining or shutting down
