@@ -43,7 +43,7 @@ struct InputLimits {
   int64_t max_grid_cells = 4'000'000;     // tool-width cells
   int64_t max_ranks = 100'000;            // coverage ranks (hard cap)
   int64_t max_transition_bytes = int64_t{1} << 30;   // transition memory per plan
-  int64_t dense_transition_bytes = int64_t{16} << 20;  // all-pairs table up to this, sparse above
+  int64_t dense_transition_bytes = int64_t{4} << 20;  // all-pairs table up to this (~100 ranks), sparse above
   int64_t max_area_vertices = 100'000;    // per polygon map, regions or no_go
 
   absl::Status Validate() const;

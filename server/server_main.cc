@@ -60,9 +60,9 @@ ABSL_FLAG(int64_t, max_ranks, 100000,
 ABSL_FLAG(int64_t, max_transition_mb, 1024,
           "Memory budget of one plan's transitions, MiB (OARP all-pairs table or sparse candidate "
           "graph; boustrophedon table); above it: RESOURCE_EXHAUSTED");
-ABSL_FLAG(int64_t, dense_transition_mb, 16,
+ABSL_FLAG(int64_t, dense_transition_mb, 4,
           "OARP uses the exact all-pairs transition table and dense GTSP while they fit in this many "
-          "MiB, the sparse candidate graph above");
+          "MiB (about 100 ranks at the default), the sparse candidate graph above");
 ABSL_FLAG(double, max_request_s, 120.0,
           "Calls without a deadline stop after this long with DEADLINE_EXCEEDED");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");

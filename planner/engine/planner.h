@@ -73,9 +73,11 @@ struct EngineLimits {
   // scratch; boustrophedon: its all-pairs table). Above it: RESOURCE_EXHAUSTED.
   int64_t max_transition_bytes = int64_t{1} << 30;
   // OARP uses the exact all-pairs table and the dense GTSP while they fit in
-  // this many bytes (about 200 ranks at the default), the sparse candidate
-  // graph and tour search above (planner/tour/sparse_tour.h).
-  int64_t dense_transition_bytes = int64_t{16} << 20;
+  // this many bytes (about 100 ranks at the default), the sparse candidate
+  // graph and tour search above (planner/tour/sparse_tour.h): on the IPA
+  // buildings the sparse tours were within 0.2 % of the dense ones from 80
+  // ranks up and 3-8x faster (docs/benchmarks.md §14).
+  int64_t dense_transition_bytes = int64_t{4} << 20;
   int64_t max_area_vertices = 100'000;  // per regions / no_go / polygon map
   // Remember plans in the artifact cache (planner/engine/plan_memory.h);
   // false: every request searches from scratch, as before issue 12.3.

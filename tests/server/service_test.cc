@@ -542,7 +542,14 @@ v1::Map PillarMap() {
   return RasterMap(AsciiToPgm(testing::PillarField(120, 100, 300, 5), 5), 0.1);
 }
 
-TEST_F(ServiceTest, DecompositionCutOffByADeadlineIsFinishedInTheBackground) {
+// The dense path: its all-pairs transition table is what the deadline cuts
+// off (the sparse path plans this map within it).
+class DenseServiceTest : public ServiceTest {
+ protected:
+  DenseServiceTest() { dense_transition_bytes_ = int64_t{1} << 30; }
+};
+
+TEST_F(DenseServiceTest, DecompositionCutOffByADeadlineIsFinishedInTheBackground) {
   // 60 x 50 cells of 0.5 m with 80 pillars: a transition table that takes far
   // longer than a 60 ms deadline (25 ms of which are kept for the reply).
   v1::PutMapResponse put;
