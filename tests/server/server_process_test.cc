@@ -7,6 +7,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -138,6 +139,7 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   const std::string map_id = PutMap(OfficeMap());
   v1::PlanResponse plan;
   ASSERT_TRUE(Plan(Request(map_id, 0.8, 0.5), &plan).ok());
+  const v1::Waypoint dock = plan.path(0);
   auto replan = [&](const v1::PlanResponse& p, v1::ReplanResponse* out) {
     v1::ReplanRequest r;
     r.set_plan_id(p.plan_id());
@@ -145,9 +147,14 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     r.mutable_progress()->set_waypoint(k);
     r.mutable_progress()->mutable_position()->set_x(p.path(k - 1).x());
     r.mutable_progress()->mutable_position()->set_y(p.path(k - 1).y());
+    // The obstacle lies on the path ahead, away from the dock the robot
+    // resumes from below (a tour cut by its deadline may pass the dock there,
+    // and a dock whose only free neighbour is blocked cannot join the grid).
+    int j = k + 3;
+    while (j + 1 < p.path_size() && std::hypot(p.path(j).x() - dock.x(), p.path(j).y() - dock.y()) < 2.5) ++j;
     v1::Point2* obstacle = r.mutable_obstacles()->add_points();
-    obstacle->set_x(p.path(k + 3).x());
-    obstacle->set_y(p.path(k + 3).y());
+    obstacle->set_x(p.path(j).x());
+    obstacle->set_y(p.path(j).y());
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     return stub_->Replan(&context, r, out);
