@@ -29,13 +29,16 @@ constexpr char kUsage[] =
     "                    [--deadline-ms D] [--resolution M] [--tool-width M]\n"
     "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n"
     "                    [--zipf S] [--seed N] [--inline] [--random-start]\n"
+    "                    [--full-replies]\n"
     "--maps: every *.yaml and *.geojson in DIR (sorted), or a comma list; each\n"
     "request picks one, map k (0-based, in that order) with weight 1/(k+1)^S\n"
     "(--zipf 0: uniform). --inline sends the map in every request instead of\n"
     "PutMap once and plan by id (any replica can then serve any map).\n"
     "--requests N stops after N requests (or --duration, whichever is first).\n"
     "--random-start: each request starts at a free cell drawn uniformly (seeded by\n"
-    "--seed) from the cells the robot can reach, heading uniform in [0, 2 pi).\n";
+    "--seed) from the cells the robot can reach, heading uniform in [0, 2 pi).\n"
+    "Replies are received in full but only their stats are decoded, so that the\n"
+    "load client's own CPU stays small; --full-replies decodes every reply.\n";
 
 // The centres of the cells a robot of `tool` width can reach on `map`: the
 // engine's own drive grid, built locally.
@@ -100,7 +103,7 @@ absl::Status Run(const std::vector<std::string>& args) {
                              WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
                                                   "deadline-ms", "resolution", "tool-width", "time-limit",
                                                   "tour", "backoff-ms", "zipf", "seed", "requests"}),
-                             {"inline", "random-start"}));
+                             {"inline", "random-start", "full-replies"}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   if (!a.Get("map") == !a.Get("maps")) {
     return absl::InvalidArgumentError("exactly one of --map FILE or --maps DIR|LIST is required");
@@ -134,6 +137,7 @@ absl::Status Run(const std::vector<std::string>& args) {
   }
   const bool send_inline = a.Has("inline");
   const bool random_start = a.Has("random-start");
+  const bool full_replies = a.Has("full-replies");
   std::vector<std::vector<Point2>> start_cells;  // per map, with --random-start
   ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, server));
   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(connection);
@@ -205,7 +209,13 @@ absl::Status Run(const std::vector<std::string>& args) {
           start->set_theta(std::uniform_real_distribution<double>(0.0, 2 * M_PI)(rng));
         }
         const absl::Time sent = absl::Now();
-        absl::StatusOr<v1::PlanResponse> reply = remote->Plan(request, absl::Milliseconds(deadline));
+        absl::StatusOr<v1::PlanStats> reply;
+        if (full_replies) {
+          absl::StatusOr<v1::PlanResponse> whole = remote->Plan(request, absl::Milliseconds(deadline));
+          reply = whole.ok() ? absl::StatusOr<v1::PlanStats>(whole->stats()) : whole.status();
+        } else {
+          reply = remote->PlanStatsOnly(request, absl::Milliseconds(deadline));
+        }
         const double ms = absl::ToDoubleMilliseconds(absl::Now() - sent);
         {
           absl::MutexLock lock(&mu);
@@ -214,9 +224,9 @@ absl::Status Run(const std::vector<std::string>& args) {
           report.latencies_ms.push_back(ms);
           if (reply.ok()) {
             ++report.ok;
-            report.cut_short += reply->stats().tour_cut_short();
-            ++report.plan_sources[SourceName(reply->stats().plan_source())];
-            report.estimated_duration_sum_s += reply->stats().estimated_duration_s();
+            report.cut_short += reply->tour_cut_short();
+            ++report.plan_sources[SourceName(reply->plan_source())];
+            report.estimated_duration_sum_s += reply->estimated_duration_s();
           }
           if (ms > static_cast<double>(deadline)) ++report.late;
         }

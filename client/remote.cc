@@ -1,6 +1,12 @@
 #include "client/remote.h"
 
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/wire_format_lite.h>
+#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
+#include <grpcpp/support/proto_buffer_reader.h>
+
+#include <limits>
 
 #include "api/convert.h"
 #include "covplan/v1/covplan.grpc.pb.h"
@@ -53,7 +59,40 @@ void AddCallCredentials(const Connection& connection, grpc::ClientContext* conte
 struct RemotePlanner::Impl {
   Connection connection;
   std::unique_ptr<v1::CoveragePlanner::Stub> stub;
+  std::unique_ptr<grpc::GenericStub> generic;
 };
+
+namespace {
+
+// The stats of a serialised PlanResponse; every other field is skipped. A
+// field that occurs more than once is merged, as protobuf parsing does.
+absl::StatusOr<v1::PlanStats> StatsOfPlanReply(grpc::ByteBuffer* reply) {
+  using google::protobuf::internal::WireFormatLite;
+  grpc::ProtoBufferReader reader(reply);
+  google::protobuf::io::CodedInputStream in(&reader);
+  in.SetTotalBytesLimit(std::numeric_limits<int>::max());
+  v1::PlanStats stats;
+  bool ok = true;
+  for (uint32_t tag = in.ReadTag(); ok && tag != 0; tag = in.ReadTag()) {
+    if (WireFormatLite::GetTagFieldNumber(tag) == v1::PlanResponse::kStatsFieldNumber &&
+        WireFormatLite::GetTagWireType(tag) == WireFormatLite::WIRETYPE_LENGTH_DELIMITED) {
+      uint32_t length = 0;
+      ok = in.ReadVarint32(&length) && length <= static_cast<uint32_t>(std::numeric_limits<int>::max());
+      if (!ok) break;
+      const auto limit = in.PushLimit(static_cast<int>(length));
+      ok = stats.MergePartialFromCodedStream(&in) && in.ConsumedEntireMessage();
+      in.PopLimit(limit);
+    } else {
+      ok = WireFormatLite::SkipField(&in, tag);
+    }
+  }
+  if (!ok || !in.ConsumedEntireMessage() || reader.status().error_code() != grpc::StatusCode::OK) {
+    return absl::DataLossError("the server's Plan reply is not a valid covplan.v1.PlanResponse");
+  }
+  return stats;
+}
+
+}  // namespace
 
 RemotePlanner::RemotePlanner(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RemotePlanner::~RemotePlanner() = default;
@@ -67,7 +106,9 @@ std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const std::string& target)
 std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const Connection& connection) {
   auto impl = std::make_unique<Impl>();
   impl->connection = connection;
-  impl->stub = v1::CoveragePlanner::NewStub(ChannelFor(connection));
+  std::shared_ptr<grpc::Channel> channel = ChannelFor(connection);
+  impl->stub = v1::CoveragePlanner::NewStub(channel);
+  impl->generic = std::make_unique<grpc::GenericStub>(channel);
   return std::unique_ptr<RemotePlanner>(new RemotePlanner(std::move(impl)));
 }
 
@@ -95,6 +136,35 @@ absl::StatusOr<v1::PlanResponse> RemotePlanner::Plan(const v1::PlanRequest& requ
     return s;
   }
   return response;
+}
+
+absl::StatusOr<v1::PlanStats> RemotePlanner::PlanStatsOnly(const v1::PlanRequest& request,
+                                                           std::optional<absl::Duration> timeout) {
+  grpc::ClientContext context;
+  AddCallCredentials(impl_->connection, &context);
+  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
+  SetMapId(&context, RoutingMapId(request));
+  grpc::ByteBuffer sent, reply;
+  bool own = false;
+  if (!grpc::SerializationTraits<v1::PlanRequest>::Serialize(request, &sent, &own).ok()) {
+    return absl::InvalidArgumentError("could not serialise the PlanRequest");
+  }
+  // Waited for on this thread, as the generated blocking stubs do (a
+  // callback would hand every reply over from another thread).
+  grpc::CompletionQueue queue;
+  std::unique_ptr<grpc::GenericClientAsyncResponseReader> call =
+      impl_->generic->PrepareUnaryCall(&context, "/covplan.v1.CoveragePlanner/Plan", sent, &queue);
+  call->StartCall();
+  grpc::Status status;
+  call->Finish(&reply, &status, &queue);
+  void* tag = nullptr;
+  bool ok = false;
+  if (!queue.Next(&tag, &ok) || !ok) return absl::InternalError("the Plan call did not complete");
+  queue.Shutdown();
+  while (queue.Next(&tag, &ok)) {
+  }
+  if (absl::Status s = FromGrpc(status); !s.ok()) return s;
+  return StatsOfPlanReply(&reply);
 }
 
 absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest& request,

@@ -46,6 +46,11 @@ class RemotePlanner {
   // No timeout: the call has no deadline (the server's default budget applies).
   absl::StatusOr<v1::PlanResponse> Plan(const v1::PlanRequest& request,
                                         std::optional<absl::Duration> timeout);
+  // The same call, for load generation: the reply's bytes are received in
+  // full but only its stats are decoded (a plan reply of tens of kB would
+  // otherwise cost the client more CPU than the server spends on a hit).
+  absl::StatusOr<v1::PlanStats> PlanStatsOnly(const v1::PlanRequest& request,
+                                              std::optional<absl::Duration> timeout);
   // `map_id` (optional) is sent as routing metadata for a replan by plan_id.
   absl::StatusOr<v1::ReplanResponse> Replan(const v1::ReplanRequest& request,
                                             std::optional<absl::Duration> timeout,

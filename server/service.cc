@@ -4,8 +4,13 @@
 #include <sys/random.h>
 
 #include <algorithm>
+#include <memory>
 #include <random>
 #include <utility>
+#include <vector>
+
+#include <grpcpp/support/byte_buffer.h>
+#include <grpcpp/support/slice.h>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -108,6 +113,42 @@ absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
 
 // Lets one worker call and the reactor share the cancellation token; the
 // reactor deletes itself when gRPC is done with the call.
+// A Plan reply's log summary, without the per-call decomposition_cached.
+std::string PlanDetail(const v1::PlanResponse& response) {
+  return absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s source=%s", response.plan_id(),
+                         response.planner(), response.stats().num_ranks(),
+                         v1::TerminationReason_Name(response.termination().reason()),
+                         v1::TerminationLimit_Name(response.termination().limit()),
+                         v1::PlanSource_Name(response.stats().plan_source()));
+}
+
+// `response`'s bytes, after those of `served` if set (a repeated hit, whose
+// stored bytes are shared with the slice, not copied).
+absl::Status SerializePlanReply(const v1::PlanResponse& response,
+                                std::shared_ptr<const CoveragePlannerService::ServedBody> served,
+                                grpc::ByteBuffer* out) {
+  grpc::ByteBuffer tail;
+  bool own = false;
+  if (!grpc::SerializationTraits<v1::PlanResponse>::Serialize(response, &tail, &own).ok()) {
+    return absl::InternalError("could not serialise the plan reply");
+  }
+  if (served == nullptr) {
+    out->Swap(&tail);
+    return absl::OkStatus();
+  }
+  std::vector<grpc::Slice> slices;
+  if (!tail.Dump(&slices).ok()) return absl::InternalError("could not serialise the plan reply");
+  const std::string& bytes = served->bytes;
+  auto* keep = new std::shared_ptr<const CoveragePlannerService::ServedBody>(std::move(served));
+  slices.insert(slices.begin(),
+                grpc::Slice(const_cast<char*>(bytes.data()), bytes.size(),
+                            [](void* p) { delete static_cast<std::shared_ptr<const CoveragePlannerService::ServedBody>*>(p); },
+                            keep));
+  grpc::ByteBuffer whole(slices.data(), slices.size());
+  out->Swap(&whole);
+  return absl::OkStatus();
+}
+
 class PlanReactor final : public grpc::ServerUnaryReactor {
  public:
   void OnCancel() override { cancel_.Cancel(); }
@@ -563,7 +604,8 @@ void CoveragePlannerService::WarmInBackground(const MapSource& source, PlanReque
 }
 
 absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
-                                             const StopToken& cancel, v1::PlanResponse* response) {
+                                             const StopToken& cancel, v1::PlanResponse* response,
+                                             std::shared_ptr<const ServedBody>* served) {
   const absl::Time start = absl::Now();
   if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
@@ -631,8 +673,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
                : result.status();
   }
   if (result->answered_by != nullptr) {
-    if (std::shared_ptr<const v1::PlanResponse> reply = ServedHitReply(call.tenant_tag, *result)) {
-      *response = *reply;
+    if (std::shared_ptr<const ServedBody> reply = ServedHitReply(call.tenant_tag, *result)) {
+      *served = std::move(reply);
       response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
       response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
       RecordPlanSolve(start, result->plan.stats);
@@ -672,10 +714,10 @@ void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& 
   mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
 }
 
-std::shared_ptr<const v1::PlanResponse> CoveragePlannerService::ServedHitReply(const std::string& tenant_tag,
-                                                                              const EngineResult& hit) {
+std::shared_ptr<const CoveragePlannerService::ServedBody> CoveragePlannerService::ServedHitReply(
+    const std::string& tenant_tag, const EngineResult& hit) {
   std::string plan_id;
-  std::shared_ptr<const v1::PlanResponse> reply;
+  std::shared_ptr<const ServedBody> reply;
   {
     absl::MutexLock lock(&served_mu_);
     auto it = served_.find(ServedHitKey(tenant_tag, hit.answered_by.get()));
@@ -695,7 +737,15 @@ void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, co
   served.plan_id = reply.plan_id();
   served.bytes = reply.ByteSizeLong();
   if (served.bytes > kMaxServedHitBytes / 4) return;  // huge plans: converted per call
-  served.reply = std::make_shared<const v1::PlanResponse>(reply);
+  // The per-call fields are cleared: proto3 does not write a zero, so a
+  // zero in the call's appended stats would not override a stored value.
+  v1::PlanResponse stored = reply;
+  stored.mutable_stats()->clear_planning_ms();
+  stored.mutable_stats()->clear_decomposition_cached();
+  auto body = std::make_shared<ServedBody>();
+  if (!stored.SerializeToString(&body->bytes)) return;
+  body->detail = PlanDetail(stored);
+  served.reply = std::move(body);
   const ServedHitKey key(tenant_tag, hit.answered_by.get());
   absl::MutexLock lock(&served_mu_);
   auto [it, inserted] = served_.try_emplace(key);
@@ -717,8 +767,8 @@ void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, co
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerContext* context,
-                                                       const v1::PlanRequest* request,
-                                                       v1::PlanResponse* response) {
+                                                       const grpc::ByteBuffer* request_bytes,
+                                                       grpc::ByteBuffer* response_bytes) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "Plan");
   if (!call.auth.ok()) {
@@ -728,6 +778,17 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   if (draining()) {
     FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
     return reactor;
+  }
+  auto request = std::make_shared<v1::PlanRequest>();
+  {
+    grpc::ByteBuffer bytes = *request_bytes;  // shares the slices; Deserialize consumes it
+    if (!grpc::SerializationTraits<v1::PlanRequest>::Deserialize(&bytes, request.get()).ok()) {
+      FinishCall(reactor, call,
+                 absl::InvalidArgumentError(absl::StrCat("request is not a valid ",
+                                                         v1::PlanRequest::descriptor()->full_name(),
+                                                         " protobuf message")));
+      return reactor;
+    }
   }
   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
     FinishCall(reactor, call, s);
@@ -763,23 +824,21 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
       return reactor;
     }
   }
-  const bool queued = pool_.TrySubmit([this, reactor, call, request, response] {
+  const bool queued = pool_.TrySubmit([this, reactor, call, request, response_bytes] {
     UpdateQueueGauges();
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
     const uint64_t solve = TrackSolve(reactor->cancel());
-    const absl::Status status = RunPlan(call, *request, reactor->cancel(), response);
+    v1::PlanResponse response;
+    std::shared_ptr<const ServedBody> served;
+    absl::Status status = RunPlan(call, *request, reactor->cancel(), &response, &served);
     UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     ReleaseSolve();
     std::string detail;
     if (status.ok()) {
-      detail = absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s cached=%d source=%s",
-                               response->plan_id(), response->planner(),
-                               response->stats().num_ranks(),
-                               v1::TerminationReason_Name(response->termination().reason()),
-                               v1::TerminationLimit_Name(response->termination().limit()),
-                               response->stats().decomposition_cached(),
-                               v1::PlanSource_Name(response->stats().plan_source()));
+      detail = absl::StrCat(served != nullptr ? served->detail : PlanDetail(response),
+                            " cached=", response.stats().decomposition_cached() ? 1 : 0);
+      status = SerializePlanReply(response, std::move(served), response_bytes);
     }
     FinishCall(reactor, call, status, detail);
     MaybeTrimMemory(absl::Now() - call.start);

@@ -97,7 +97,11 @@ struct CallInfo {
 // One log line's summary of a replan reply.
 std::string ReplanDetail(const v1::ReplanResponse& response);
 
-class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService {
+// Plan is a raw method (request and reply as bytes): the service parses the
+// request itself, and a repeated hit is sent as the bytes already serialised
+// for the first one plus this call's timings, without a protobuf copy.
+class CoveragePlannerService final
+    : public v1::CoveragePlanner::WithRawCallbackMethod_Plan<v1::CoveragePlanner::CallbackService> {
  public:
   // `tokens` (optional, outlives the service): every call must carry a
   // bearer token of a tenant, and sees only that tenant's maps and plans.
@@ -117,9 +121,10 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   grpc::ServerUnaryReactor* DeleteMap(grpc::CallbackServerContext* context,
                                       const v1::DeleteMapRequest* request,
                                       v1::DeleteMapResponse* response) override;
+  // `request` must parse as a v1::PlanRequest; `response` is a v1::PlanResponse.
   grpc::ServerUnaryReactor* Plan(grpc::CallbackServerContext* context,
-                                 const v1::PlanRequest* request,
-                                 v1::PlanResponse* response) override;
+                                 const grpc::ByteBuffer* request,
+                                 grpc::ByteBuffer* response) override;
   grpc::ServerUnaryReactor* GetPlan(grpc::CallbackServerContext* context,
                                     const v1::GetPlanRequest* request,
                                     v1::PlanResponse* response) override;
@@ -155,17 +160,26 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
   // Finishes `reactor` with `status`, records metrics and logs one line.
   void FinishCall(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
                   const absl::Status& status, const std::string& detail = "");
-  // The Plan work proper (runs on a worker).
-  absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
-                       const StopToken& cancel, v1::PlanResponse* response);
+  // A repeated hit's reply, serialised once (see ServedHit): the reply with
+  // planning_ms and decomposition_cached cleared, and its log summary.
+  struct ServedBody {
+    std::string bytes;
+    std::string detail;  // PlanDetail of the reply, without the per-call fields
+  };
+  // The Plan work proper (runs on a worker). A repeated hit sets `*served`
+  // and puts only this call's stats into `response`: the reply is then the
+  // bytes of `*served` followed by those of `response` (protobuf merges
+  // concatenated messages).
+  absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request, const StopToken& cancel,
+                       v1::PlanResponse* response, std::shared_ptr<const ServedBody>* served);
   void UpdateQueueGauges();
   // A Plan's solve metrics and the mean solve time the admission uses.
   void RecordPlanSolve(absl::Time start, const PlanStats& stats);
   // Repeated cache hits (issue 12): the reply already sent for `hit`'s
   // remembered entry to this tenant, if that plan is still retained; else
   // null. RememberServedHit records a reply for the next ones.
-  std::shared_ptr<const v1::PlanResponse> ServedHitReply(const std::string& tenant_tag,
-                                                         const EngineResult& hit);
+  std::shared_ptr<const ServedBody> ServedHitReply(const std::string& tenant_tag,
+                                                   const EngineResult& hit);
   void RememberServedHit(const std::string& tenant_tag, const EngineResult& hit,
                          const v1::PlanResponse& reply);
   // The Replan work proper (runs on a worker).
@@ -274,14 +288,14 @@ class CoveragePlannerService final : public v1::CoveragePlanner::CallbackService
       ABSL_GUARDED_BY(origins_mu_);
   // Identical requests answered from memory get the first hit's plan: its
   // plan id (plan ids name immutable plans) and its reply, so a repeated hit
-  // is one proto copy instead of a conversion, a new retained plan (which
+  // sends stored bytes instead of a conversion, a new retained plan (which
   // would push other clients' plans out of `plans_`) and a disk write.
   // Keyed by tenant and remembered entry; the weak pointer tells a live
   // entry from a new one at a reused address. Bounded by count and bytes.
   struct ServedHit {
     std::weak_ptr<const RememberedPlan> entry;
     std::string plan_id;
-    std::shared_ptr<const v1::PlanResponse> reply;
+    std::shared_ptr<const ServedBody> reply;
     size_t bytes = 0;
   };
   using ServedHitKey = std::pair<std::string, const RememberedPlan*>;

@@ -1,6 +1,7 @@
 // In-process gRPC tests of the covplan service: PutMap then Plan round trip,
 // idempotent PutMap, the registry RPCs, every bad input answered with
 // INVALID_ARGUMENT and a useful message, health, reflection and /metrics.
+#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <random>
 
 #include "absl/strings/str_cat.h"
+#include "absl/synchronization/notification.h"
+#include "client/remote.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
@@ -459,6 +462,56 @@ TEST_F(ServiceTest, RepeatedHitsAreOnePlanUnderOneId) {
   ASSERT_TRUE(Plan(other_seed, &other).ok());
   EXPECT_NE(other.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
   EXPECT_NE(other.plan_id(), first.plan_id());
+}
+
+// The load client's stats-only decode of a Plan reply gives the stats of the
+// full decode, for a cold plan, a first hit and the repeated hits that are
+// sent as stored bytes with this call's stats appended.
+TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
+  const std::string map_id = PutTwoRooms();
+  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(absl::StrCat("127.0.0.1:", server_->port()));
+  absl::StatusOr<v1::PlanStats> cold = remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
+  ASSERT_TRUE(cold.ok()) << cold.status();
+  EXPECT_EQ(cold->plan_source(), v1::PLAN_SOURCE_COLD);
+  EXPECT_GT(cold->num_ranks(), 0);
+  for (int i = 0; i < 3; ++i) {  // the first hit, then repeated hits
+    absl::StatusOr<v1::PlanResponse> full = remote->Plan(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
+    absl::StatusOr<v1::PlanStats> stats = remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
+    ASSERT_TRUE(full.ok()) << full.status();
+    ASSERT_TRUE(stats.ok()) << stats.status();
+    EXPECT_EQ(stats->plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+    EXPECT_TRUE(stats->decomposition_cached());
+    EXPECT_GT(stats->planning_ms(), 0.0);
+    v1::PlanStats expected = full->stats();
+    expected.set_planning_ms(stats->planning_ms());
+    EXPECT_EQ(stats->SerializeAsString(), expected.SerializeAsString()) << i;
+  }
+  absl::StatusOr<v1::PlanStats> missing = remote->PlanStatsOnly(PlanRequestFor(std::string(64, 'a'), 0.4),
+                                                                absl::Seconds(10));
+  EXPECT_TRUE(absl::IsNotFound(missing.status())) << missing.status();
+}
+
+// Plan takes its request as bytes: bytes that are no PlanRequest are
+// INVALID_ARGUMENT naming the message, and the server goes on serving.
+TEST_F(ServiceTest, PlanBytesThatDoNotParseAreInvalidArgument) {
+  grpc::GenericStub generic(channel_);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  grpc::Slice junk(std::string("\xff\xff\xff\xff\x0f", 5));
+  const grpc::ByteBuffer request(&junk, 1);
+  grpc::ByteBuffer response;
+  grpc::Status status;
+  absl::Notification done;
+  generic.UnaryCall(&context, "/covplan.v1.CoveragePlanner/Plan", grpc::StubOptions(), &request, &response,
+                    [&](grpc::Status s) {
+                      status = std::move(s);
+                      done.Notify();
+                    });
+  ASSERT_TRUE(done.WaitForNotificationWithTimeout(absl::Seconds(10)));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("covplan.v1.PlanRequest"));
+  v1::PlanResponse plan;
+  EXPECT_TRUE(Plan(PlanRequestFor(PutTwoRooms(), 0.4), &plan).ok());
 }
 
 // Remembered plans follow map content: the id is the content's, DeleteMap
