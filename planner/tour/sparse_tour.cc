@@ -154,21 +154,15 @@ class Problem {
       return std::numeric_limits<double>::infinity();
     }
     if (a == b) return PathCost(x, y, {a});
-    // Endpoint pairs are symmetric (the path reversed, headings flipped).
-    const uint64_t key = static_cast<uint64_t>(std::min(x, y)) * (2 * n_ + 2) + std::max(x, y);
-    Shard& shard = shards_[(key * 0x9E3779B97F4A7C15ULL) >> 58];
+    const uint64_t key = PairKey(x, y);
+    Shard& shard = ShardOf(key);
     {
       std::lock_guard<std::mutex> lock(shard.mu);
       auto it = shard.map.find(key);
       if (it != shard.map.end() && it->second.exact) return it->second.cost;
     }
     if (!search->RunTo(a, b, stop)) return std::numeric_limits<double>::infinity();
-    const std::vector<CellIndex> cells = search->PathTo(b);
-    const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
-    searches_.fetch_add(1, std::memory_order_relaxed);
-    Store(shard, key, {c, true});
-    Harvest(x, y, *search);
-    return c;
+    return PriceSearched(x, y, key, shard, *search);
   }
 
   // A cheap, tighter lower bound of ExactCost(x, y) (or the exact cost): a
@@ -181,8 +175,8 @@ class Problem {
     if (graph_.component(a) != graph_.component(b) || graph_.component(a) < 0) {
       return std::numeric_limits<double>::infinity();
     }
-    const uint64_t key = static_cast<uint64_t>(std::min(x, y)) * (2 * n_ + 2) + std::max(x, y);
-    Shard& shard = shards_[(key * 0x9E3779B97F4A7C15ULL) >> 58];
+    const uint64_t key = PairKey(x, y);
+    Shard& shard = ShardOf(key);
     {
       std::lock_guard<std::mutex> lock(shard.mu);
       auto it = shard.map.find(key);
@@ -195,12 +189,7 @@ class Problem {
       Store(shard, key, {c, false});
       return c;
     }
-    const std::vector<CellIndex> cells = search->PathTo(b);
-    const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
-    searches_.fetch_add(1, std::memory_order_relaxed);
-    Store(shard, key, {c, true});
-    Harvest(x, y, *search);
-    return c;
+    return PriceSearched(x, y, key, shard, *search);
   }
   // After a completed search from x's cell (aimed at y): every other rank
   // endpoint z it closed has its final path, so (x, z) gets its exact cost
@@ -212,8 +201,8 @@ class Problem {
     search.ForEachClosed([&](int64_t cell) {
       graph_.ForEachEndpointAt(cell, [&](int z) {
         if (z == x || z == y || cells_[z] == cells_[x] || Known(x, z)) return;
-        const uint64_t key = static_cast<uint64_t>(std::min(x, z)) * (2 * n_ + 2) + std::max(x, z);
-        Shard& shard = shards_[(key * 0x9E3779B97F4A7C15ULL) >> 58];
+        const uint64_t key = PairKey(x, z);
+        Shard& shard = ShardOf(key);
         {
           std::lock_guard<std::mutex> lock(shard.mu);
           auto it = shard.map.find(key);
@@ -249,6 +238,22 @@ class Problem {
     std::mutex mu;
     absl::flat_hash_map<uint64_t, Cached> map;
   };
+  // The cache key of the pair: endpoint pairs are symmetric (the path
+  // reversed, headings flipped).
+  uint64_t PairKey(int x, int y) const {
+    return static_cast<uint64_t>(std::min(x, y)) * (2 * n_ + 2) + std::max(x, y);
+  }
+  Shard& ShardOf(uint64_t key) { return shards_[(key * 0x9E3779B97F4A7C15ULL) >> 58]; }
+  // The exact cost x -> y once `search` has reached y's cell: cached, and
+  // the other endpoints the search closed harvested.
+  double PriceSearched(int x, int y, uint64_t key, Shard& shard, const AnyAngleSearch& search) {
+    const std::vector<CellIndex> cells = search.PathTo(cells_[y]);
+    const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
+    searches_.fetch_add(1, std::memory_order_relaxed);
+    Store(shard, key, {c, true});
+    Harvest(x, y, search);
+    return c;
+  }
   void Store(Shard& shard, uint64_t key, Cached value) {
     std::lock_guard<std::mutex> lock(shard.mu);
     auto it = shard.map.find(key);
@@ -281,10 +286,11 @@ class Problem {
   StopToken never_;
 };
 
+thread_local std::vector<CellIndex> Problem::harvest_cells_;
+
 // One search run: a tour t = [S, entry, exit, entry, exit, ..., E] with
 // positions, the mate of each node across its transition edge, and that
 // edge's cost. Writes can be logged and undone (rejected kicks).
-thread_local std::vector<CellIndex> Problem::harvest_cells_;
 
 class Run {
  public:
