@@ -51,24 +51,30 @@ absl::Status FromGrpc(const grpc::Status& s) {
 
 }  // namespace
 
-absl::StatusOr<int> HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
-                                 const std::string& service) {
+absl::StatusOr<std::string> RawUnaryCall(const std::shared_ptr<grpc::Channel>& channel,
+                                         const std::string& method, const std::string& request) {
   grpc::GenericStub stub(channel);
   grpc::CompletionQueue cq;
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
-  const std::string request = service.empty() ? "" : LengthDelimited(1, service);
-  auto call = stub.PrepareUnaryCall(&context, "/grpc.health.v1.Health/Check", ToBuffer(request), &cq);
+  auto call = stub.PrepareUnaryCall(&context, method, ToBuffer(request), &cq);
   call->StartCall();
   grpc::ByteBuffer reply;
   grpc::Status status;
   int tag = 0;
   call->Finish(&reply, &status, &tag);
-  if (!Await(cq, &tag)) return absl::DeadlineExceededError("health check did not complete");
+  if (!Await(cq, &tag)) return absl::DeadlineExceededError(method + " did not complete");
   if (!status.ok()) return FromGrpc(status);
+  return FromBuffer(reply);
+}
+
+absl::StatusOr<int> HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
+                                 const std::string& service) {
+  const std::string request = service.empty() ? "" : LengthDelimited(1, service);
+  absl::StatusOr<std::string> bytes = RawUnaryCall(channel, "/grpc.health.v1.Health/Check", request);
+  if (!bytes.ok()) return bytes.status();
   google::protobuf::UnknownFieldSet fields;
-  const std::string bytes = FromBuffer(reply);
-  if (!fields.ParseFromString(bytes)) return absl::DataLossError("bad health reply");
+  if (!fields.ParseFromString(*bytes)) return absl::DataLossError("bad health reply");
   for (int i = 0; i < fields.field_count(); ++i) {
     if (fields.field(i).number() == 1) return static_cast<int>(fields.field(i).varint());
   }

@@ -4,6 +4,7 @@
 // for /metrics.
 //
 //   absl::StatusOr<int> status = HealthStatus(channel, "");  // 1 = SERVING
+//   absl::StatusOr<std::string> reply = RawUnaryCall(channel, "/pkg.Svc/Method", bytes);
 //   absl::StatusOr<std::vector<std::string>> names = ReflectionServices(channel);
 //   absl::StatusOr<std::string> body = HttpGet(9464, "/metrics");
 //
@@ -20,6 +21,11 @@
 #include "absl/status/statusor.h"
 
 namespace covplan::testing {
+
+// One unary call of `method` ("/package.Service/Method") with `request` as
+// its raw bytes; the reply's bytes, or the call's status (code and message).
+absl::StatusOr<std::string> RawUnaryCall(const std::shared_ptr<grpc::Channel>& channel,
+                                         const std::string& method, const std::string& request);
 
 // grpc.health.v1 ServingStatus: 0 UNKNOWN, 1 SERVING, 2 NOT_SERVING.
 absl::StatusOr<int> HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
