@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/synchronization/mutex.h"
 #include "client/compare_command.h"
 #include "client/partition_command.h"
 #include "client/gtsp_command.h"
@@ -44,6 +45,9 @@ constexpr char kUsage[] =
 }  // namespace
 
 int main(int argc, char** argv) {
+  // As in covplan-server: no abseil deadlock detection (Debian builds it
+  // without NDEBUG) outside the tests.
+  absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
   if (argc < 2) {
     std::fputs(kUsage, stderr);
     return 2;

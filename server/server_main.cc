@@ -130,6 +130,11 @@ std::vector<std::string> ValidateFlags() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Debian's abseil is built without NDEBUG, so every absl::Mutex would keep
+  // a lock-order graph for deadlock detection: about 5 % of the server's CPU
+  // on repeated cache hits (perf, docs/benchmarks.md §12). The in-process
+  // tests keep it on; the binaries turn it off.
+  absl::SetMutexDeadlockDetectionMode(absl::OnDeadlockCycle::kIgnore);
   // Block the signals in every thread before any is created; one thread
   // waits for them from here on, so SIGTERM works during start-up too.
   static sigset_t signals;
