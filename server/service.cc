@@ -710,8 +710,29 @@ void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& 
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, stats.tour_cut_short);
   metrics_->RecordPlanSource(PlanOriginName(stats.plan_source));
-  const int64_t mean = mean_solve_us_.load();
-  mean_solve_us_.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+  std::atomic<int64_t>& mean_us = stats.plan_source == PlanOrigin::kCacheHit ? mean_hit_us_ : mean_solve_us_;
+  const int64_t mean = mean_us.load();
+  mean_us.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+}
+
+bool CoveragePlannerService::IsHitRequest(const std::string& key) {
+  absl::MutexLock lock(&served_mu_);
+  return hit_requests_.contains(key);
+}
+
+void CoveragePlannerService::NoteHitRequest(const std::string& key) {
+  absl::MutexLock lock(&served_mu_);
+  if (hit_requests_.size() >= kMaxHitRequests) hit_requests_.clear();
+  hit_requests_.insert(key);
+}
+
+absl::Duration ExpectedQueueWait(int ahead, int hits_ahead, int workers, absl::Duration mean_solve,
+                                 absl::Duration mean_hit) {
+  workers = std::max(1, workers);
+  if (ahead < workers) return absl::ZeroDuration();
+  hits_ahead = std::clamp(hits_ahead, 0, ahead);
+  const absl::Duration mean = (mean_hit * hits_ahead + mean_solve * (ahead - hits_ahead)) / ahead;
+  return mean * (ahead - workers + 1) / workers;
 }
 
 std::shared_ptr<const CoveragePlannerService::ServedBody> CoveragePlannerService::ServedHitReply(
@@ -804,18 +825,33 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     reject();
     return reactor;
   }
-  // Deadline-aware admission: with `ahead` solves admitted before this one
-  // and W workers, it starts after about (ahead - W + 1) / W mean solves. If
-  // that wait already reaches the reply-by time, refusing now is more useful
-  // to the client than a DEADLINE_EXCEEDED after waiting.
+  // The request's bytes, tagged with the tenant: a repeat of a request that
+  // was answered from memory is expected to be answered from memory again.
+  std::string hit_key = call.tenant_tag;
+  hit_key.push_back('\n');
+  {
+    std::vector<grpc::Slice> slices;
+    if (request_bytes->Dump(&slices).ok()) {
+      for (const grpc::Slice& slice : slices) hit_key.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+    }
+  }
+  const bool likely_hit = IsHitRequest(hit_key);
+  const int hits_ahead = likely_hit ? admitted_hits_.fetch_add(1) : admitted_hits_.load();
+  const auto release = [this, likely_hit] {
+    if (likely_hit) admitted_hits_.fetch_sub(1);
+    ReleaseSolve();
+  };
+  // Deadline-aware admission: if the expected wait for a worker already
+  // reaches the reply-by time, refusing now is more useful to the client
+  // than a DEADLINE_EXCEEDED after waiting.
   if (call.deadline != absl::InfiniteFuture()) {
     const int ahead = admitted_.load() - 1;
-    const int workers = std::max(1, options_.worker_threads);
     const absl::Duration wait =
-        absl::Microseconds(mean_solve_us_.load()) * std::max(0, ahead - workers + 1) / workers;
+        ExpectedQueueWait(ahead, hits_ahead, options_.worker_threads, absl::Microseconds(mean_solve_us_.load()),
+                          absl::Microseconds(mean_hit_us_.load()));
     const absl::Time reply_by = call.deadline - options_.deadline_margin;
-    if (ahead >= workers && absl::Now() + wait >= reply_by) {
-      ReleaseSolve();
+    if (ahead >= std::max(1, options_.worker_threads) && absl::Now() + wait >= reply_by) {
+      release();
       FinishCall(reactor, call,
                  absl::ResourceExhaustedError(absl::StrFormat(
                      "server busy: expected queue wait of %d ms exceeds the call's deadline; "
@@ -824,7 +860,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
       return reactor;
     }
   }
-  const bool queued = pool_.TrySubmit([this, reactor, call, request, response_bytes] {
+  const bool queued = pool_.TrySubmit([this, reactor, call, request, response_bytes, release,
+                                       hit_key = std::move(hit_key)] {
     UpdateQueueGauges();
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
     const uint64_t solve = TrackSolve(reactor->cancel());
@@ -833,7 +870,11 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     absl::Status status = RunPlan(call, *request, reactor->cancel(), &response, &served);
     UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
-    ReleaseSolve();
+    release();
+    if (status.ok() && request->map_ref_case() == v1::PlanRequest::kMapId &&
+        (served != nullptr || response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT)) {
+      NoteHitRequest(hit_key);
+    }
     std::string detail;
     if (status.ok()) {
       detail = absl::StrCat(served != nullptr ? served->detail : PlanDetail(response),
@@ -845,7 +886,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   });
   UpdateQueueGauges();
   if (!queued) {
-    ReleaseSolve();
+    release();
     reject();
   }
   return reactor;

@@ -38,6 +38,7 @@
 #include <string>
 #include <utility>
 
+#include "absl/container/flat_hash_set.h"
 #include "absl/status/status.h"
 #include "absl/time/time.h"
 #include "covplan/v1/covplan.grpc.pb.h"
@@ -100,6 +101,15 @@ std::string ReplanDetail(const v1::ReplanResponse& response);
 // Plan is a raw method (request and reply as bytes): the service parses the
 // request itself, and a repeated hit is sent as the bytes already serialised
 // for the first one plus this call's timings, without a protobuf copy.
+// The deadline-aware admission's expected queue wait of a call that has
+// `ahead` admitted calls before it and `workers` workers: it starts after
+// about (ahead - workers + 1) / workers calls, each costing the mean of the
+// calls ahead, of which `hits_ahead` are expected to be repeated cache hits
+// (`mean_hit` each) and the rest searches (`mean_solve`). Zero when a worker
+// is free.
+absl::Duration ExpectedQueueWait(int ahead, int hits_ahead, int workers, absl::Duration mean_solve,
+                                 absl::Duration mean_hit);
+
 class CoveragePlannerService final
     : public v1::CoveragePlanner::WithRawCallbackMethod_Plan<v1::CoveragePlanner::CallbackService> {
  public:
@@ -173,6 +183,10 @@ class CoveragePlannerService final
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request, const StopToken& cancel,
                        v1::PlanResponse* response, std::shared_ptr<const ServedBody>* served);
   void UpdateQueueGauges();
+  // Whether these request bytes (tenant-tagged) were answered by a cache hit
+  // before, and recording that they were.
+  bool IsHitRequest(const std::string& key);
+  void NoteHitRequest(const std::string& key);
   // A Plan's solve metrics and the mean solve time the admission uses.
   void RecordPlanSolve(absl::Time start, const PlanStats& stats);
   // Repeated cache hits (issue 12): the reply already sent for `hit`'s
@@ -309,6 +323,15 @@ class CoveragePlannerService final
   // deadline-aware admission: a call whose expected queue wait would leave no
   // time to plan before its deadline is refused at once.
   std::atomic<int64_t> mean_solve_us_{0};
+  // The same for Plans answered from memory (PLAN_SOURCE_CACHE_HIT), and the
+  // admitted Plan calls expected to be such hits: their request bytes (with
+  // the tenant) were answered by a hit before. Without this, the burst of
+  // hits that follows a cold solve was priced at the cold solve's time and
+  // partly refused.
+  std::atomic<int64_t> mean_hit_us_{0};
+  std::atomic<int> admitted_hits_{0};
+  static constexpr size_t kMaxHitRequests = 4096;  // then forgotten at once
+  absl::flat_hash_set<std::string> hit_requests_ ABSL_GUARDED_BY(served_mu_);
   // Latest progress per plan (bounded), and those not yet written.
   absl::Mutex progress_mu_;
   std::map<std::string, std::pair<uint64_t, v1::RobotProgress>> progress_ ABSL_GUARDED_BY(progress_mu_);

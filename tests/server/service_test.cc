@@ -11,6 +11,8 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "client/remote.h"
@@ -498,6 +500,50 @@ TEST_F(ServiceTest, PlanBytesThatDoNotParseAreInvalidArgument) {
   EXPECT_THAT(reply.status().message(), HasSubstr("covplan.v1.PlanRequest"));
   v1::PlanResponse plan;
   EXPECT_TRUE(Plan(PlanRequestFor(PutTwoRooms(), 0.4), &plan).ok());
+}
+
+// The admission's expected queue wait: nothing while a worker is free, and
+// the calls ahead priced by their kind.
+TEST(ExpectedQueueWaitTest, PricesHitsAheadAsHits) {
+  const absl::Duration solve = absl::Milliseconds(300), hit = absl::Milliseconds(1);
+  EXPECT_EQ(ExpectedQueueWait(1, 0, 2, solve, hit), absl::ZeroDuration());
+  EXPECT_EQ(ExpectedQueueWait(0, 0, 1, solve, hit), absl::ZeroDuration());
+  // 15 searches ahead of 2 workers: 14 / 2 searches.
+  EXPECT_EQ(ExpectedQueueWait(15, 0, 2, solve, hit), absl::Milliseconds(2100));
+  EXPECT_EQ(ExpectedQueueWait(15, 15, 2, solve, hit), absl::Milliseconds(7));
+  // 3 searches and 1 hit ahead of 2 workers: 3 calls of their mean (225.25 ms) / 2.
+  EXPECT_EQ(ExpectedQueueWait(4, 1, 2, solve, hit), absl::Microseconds(337875));
+  // Out-of-range counts are clamped; no worker count below 1.
+  EXPECT_EQ(ExpectedQueueWait(3, 7, 0, solve, hit), absl::Milliseconds(3));
+  EXPECT_EQ(ExpectedQueueWait(3, -1, 1, solve, hit), absl::Milliseconds(900));
+}
+
+// A burst of identical requests right after a cold solve and its first hit
+// is answered from memory in full: the admission prices the calls ahead as
+// hits, not at the cold solve's time (which refused part of such a burst).
+TEST_F(ServiceTest, ABurstOfHitsAfterAColdSolveIsNotRefused) {
+  const std::string map_id = PutTwoRooms();
+  const absl::Time t0 = absl::Now();
+  v1::PlanResponse cold, first;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &cold).ok());
+  const absl::Duration cold_time = absl::Now() - t0;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &first).ok());
+  ASSERT_EQ(first.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  // A deadline the cold solve's time would refuse behind a few calls.
+  const absl::Duration deadline = std::max(cold_time, absl::Milliseconds(150));
+  constexpr int kCalls = 16;
+  std::vector<grpc::Status> statuses(kCalls);
+  std::vector<std::thread> callers;
+  for (int i = 0; i < kCalls; ++i) {
+    callers.emplace_back([&, i] {
+      grpc::ClientContext context;
+      context.set_deadline(absl::ToChronoTime(absl::Now() + deadline));
+      v1::PlanResponse response;
+      statuses[i] = stub_->Plan(&context, PlanRequestFor(map_id, 0.4), &response);
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  for (const grpc::Status& status : statuses) EXPECT_TRUE(status.ok()) << status.error_message();
 }
 
 // Remembered plans follow map content: the id is the content's, DeleteMap
