@@ -138,12 +138,11 @@ absl::Status SerializePlanReply(const v1::PlanResponse& response,
   }
   std::vector<grpc::Slice> slices;
   if (!tail.Dump(&slices).ok()) return absl::InternalError("could not serialise the plan reply");
+  using Body = std::shared_ptr<const CoveragePlannerService::ServedBody>;
   const std::string& bytes = served->bytes;
-  auto* keep = new std::shared_ptr<const CoveragePlannerService::ServedBody>(std::move(served));
-  slices.insert(slices.begin(),
-                grpc::Slice(const_cast<char*>(bytes.data()), bytes.size(),
-                            [](void* p) { delete static_cast<std::shared_ptr<const CoveragePlannerService::ServedBody>*>(p); },
-                            keep));
+  auto* keep = new Body(std::move(served));  // released with the slice
+  slices.insert(slices.begin(), grpc::Slice(const_cast<char*>(bytes.data()), bytes.size(),
+                                            [](void* p) { delete static_cast<Body*>(p); }, keep));
   grpc::ByteBuffer whole(slices.data(), slices.size());
   out->Swap(&whole);
   return absl::OkStatus();
@@ -826,16 +825,20 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     return reactor;
   }
   // The request's bytes, tagged with the tenant: a repeat of a request that
-  // was answered from memory is expected to be answered from memory again.
-  std::string hit_key = call.tenant_tag;
-  hit_key.push_back('\n');
-  {
+  // was answered from memory is expected to be answered from memory again
+  // (only requests by map id, which are small, are remembered).
+  std::string hit_key;
+  if (request->map_ref_case() == v1::PlanRequest::kMapId) {
+    hit_key = call.tenant_tag;
+    hit_key.push_back('\n');
     std::vector<grpc::Slice> slices;
     if (request_bytes->Dump(&slices).ok()) {
-      for (const grpc::Slice& slice : slices) hit_key.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+      for (const grpc::Slice& slice : slices) {
+        hit_key.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+      }
     }
   }
-  const bool likely_hit = IsHitRequest(hit_key);
+  const bool likely_hit = !hit_key.empty() && IsHitRequest(hit_key);
   const int hits_ahead = likely_hit ? admitted_hits_.fetch_add(1) : admitted_hits_.load();
   const auto release = [this, likely_hit] {
     if (likely_hit) admitted_hits_.fetch_sub(1);
@@ -847,8 +850,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   if (call.deadline != absl::InfiniteFuture()) {
     const int ahead = admitted_.load() - 1;
     const absl::Duration wait =
-        ExpectedQueueWait(ahead, hits_ahead, options_.worker_threads, absl::Microseconds(mean_solve_us_.load()),
-                          absl::Microseconds(mean_hit_us_.load()));
+        ExpectedQueueWait(ahead, hits_ahead, options_.worker_threads,
+                          absl::Microseconds(mean_solve_us_.load()), absl::Microseconds(mean_hit_us_.load()));
     const absl::Time reply_by = call.deadline - options_.deadline_margin;
     if (ahead >= std::max(1, options_.worker_threads) && absl::Now() + wait >= reply_by) {
       release();
@@ -871,7 +874,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     release();
-    if (status.ok() && request->map_ref_case() == v1::PlanRequest::kMapId &&
+    if (status.ok() && !hit_key.empty() &&
         (served != nullptr || response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT)) {
       NoteHitRequest(hit_key);
     }

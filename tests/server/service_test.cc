@@ -476,7 +476,8 @@ TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
   EXPECT_GT(cold->num_ranks(), 0);
   for (int i = 0; i < 3; ++i) {  // the first hit, then repeated hits
     absl::StatusOr<v1::PlanResponse> full = remote->Plan(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
-    absl::StatusOr<v1::PlanStats> stats = remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
+    absl::StatusOr<v1::PlanStats> stats =
+        remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
     ASSERT_TRUE(full.ok()) << full.status();
     ASSERT_TRUE(stats.ok()) << stats.status();
     EXPECT_EQ(stats->plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
@@ -494,8 +495,8 @@ TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
 // Plan takes its request as bytes: bytes that are no PlanRequest are
 // INVALID_ARGUMENT naming the message, and the server goes on serving.
 TEST_F(ServiceTest, PlanBytesThatDoNotParseAreInvalidArgument) {
-  absl::StatusOr<std::string> reply =
-      testing::RawUnaryCall(channel_, "/covplan.v1.CoveragePlanner/Plan", std::string("\xff\xff\xff\xff\x0f", 5));
+  const std::string junk("\xff\xff\xff\xff\x0f", 5);
+  absl::StatusOr<std::string> reply = testing::RawUnaryCall(channel_, "/covplan.v1.CoveragePlanner/Plan", junk);
   EXPECT_TRUE(absl::IsInvalidArgument(reply.status())) << reply.status();
   EXPECT_THAT(reply.status().message(), HasSubstr("covplan.v1.PlanRequest"));
   v1::PlanResponse plan;
