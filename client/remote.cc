@@ -159,10 +159,11 @@ absl::StatusOr<v1::PlanStats> RemotePlanner::PlanStatsOnly(const v1::PlanRequest
   call->Finish(&reply, &status, &queue);
   void* tag = nullptr;
   bool ok = false;
-  if (!queue.Next(&tag, &ok) || !ok) return absl::InternalError("the Plan call did not complete");
-  queue.Shutdown();
-  while (queue.Next(&tag, &ok)) {
+  const bool completed = queue.Next(&tag, &ok) && ok;
+  queue.Shutdown();  // drained before it is destroyed, on every path
+  for (void* t = nullptr; queue.Next(&t, &ok);) {
   }
+  if (!completed) return absl::InternalError("the Plan call did not complete");
   if (absl::Status s = FromGrpc(status); !s.ok()) return s;
   return StatsOfPlanReply(&reply);
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <random>
 #include <utility>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <grpcpp/support/byte_buffer.h>
 #include <grpcpp/support/slice.h>
 
+#include "absl/hash/hash.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -111,8 +113,6 @@ absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
   return status;
 }
 
-// Lets one worker call and the reactor share the cancellation token; the
-// reactor deletes itself when gRPC is done with the call.
 // A Plan reply's log summary, without the per-call decomposition_cached.
 std::string PlanDetail(const v1::PlanResponse& response) {
   return absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s source=%s", response.plan_id(),
@@ -122,8 +122,33 @@ std::string PlanDetail(const v1::PlanResponse& response) {
                          v1::PlanSource_Name(response.stats().plan_source()));
 }
 
-// `response`'s bytes, after those of `served` if set (a repeated hit, whose
-// stored bytes are shared with the slice, not copied).
+
+// Lets one worker call and the reactor share the cancellation token; the
+// reactor deletes itself when gRPC is done with the call.
+class PlanReactor final : public grpc::ServerUnaryReactor {
+ public:
+  void OnCancel() override { cancel_.Cancel(); }
+  void OnDone() override { delete this; }
+  const StopToken& cancel() const { return cancel_; }
+
+ private:
+  StopToken cancel_;
+};
+
+}  // namespace
+
+std::shared_ptr<const CoveragePlannerService::ServedBody> ServedBodyFor(const v1::PlanResponse& reply) {
+  // The per-call fields are cleared: proto3 does not write a zero, so a
+  // zero in the call's appended stats would not override a stored value.
+  v1::PlanResponse stored = reply;
+  stored.mutable_stats()->clear_planning_ms();
+  stored.mutable_stats()->clear_decomposition_cached();
+  auto body = std::make_shared<CoveragePlannerService::ServedBody>();
+  if (!stored.SerializeToString(&body->bytes)) return nullptr;
+  body->detail = PlanDetail(stored);
+  return body;
+}
+
 absl::Status SerializePlanReply(const v1::PlanResponse& response,
                                 std::shared_ptr<const CoveragePlannerService::ServedBody> served,
                                 grpc::ByteBuffer* out) {
@@ -148,17 +173,6 @@ absl::Status SerializePlanReply(const v1::PlanResponse& response,
   return absl::OkStatus();
 }
 
-class PlanReactor final : public grpc::ServerUnaryReactor {
- public:
-  void OnCancel() override { cancel_.Cancel(); }
-  void OnDone() override { delete this; }
-  const StopToken& cancel() const { return cancel_; }
-
- private:
-  StopToken cancel_;
-};
-
-}  // namespace
 
 absl::Status ServiceOptions::Validate() const {
   if (absl::Status s = limits.Validate(); !s.ok()) return s;
@@ -709,18 +723,25 @@ void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& 
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, stats.tour_cut_short);
   metrics_->RecordPlanSource(PlanOriginName(stats.plan_source));
-  std::atomic<int64_t>& mean_us = stats.plan_source == PlanOrigin::kCacheHit ? mean_hit_us_ : mean_solve_us_;
-  const int64_t mean = mean_us.load();
-  mean_us.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+  const auto update = [solve_us](std::atomic<int64_t>& mean_us) {
+    const int64_t mean = mean_us.load();
+    mean_us.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);
+  };
+  update(mean_solve_us_);
+  if (stats.plan_source == PlanOrigin::kCacheHit) update(mean_hit_us_);
 }
 
-bool CoveragePlannerService::IsHitRequest(const std::string& key) {
+bool CoveragePlannerService::IsHitRequest(uint64_t key) {
   absl::MutexLock lock(&served_mu_);
   return hit_requests_.contains(key);
 }
 
-void CoveragePlannerService::NoteHitRequest(const std::string& key) {
+void CoveragePlannerService::NoteHitRequest(uint64_t key, bool hit) {
   absl::MutexLock lock(&served_mu_);
+  if (!hit) {
+    hit_requests_.erase(key);
+    return;
+  }
   if (hit_requests_.size() >= kMaxHitRequests) hit_requests_.clear();
   hit_requests_.insert(key);
 }
@@ -757,15 +778,8 @@ void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, co
   served.plan_id = reply.plan_id();
   served.bytes = reply.ByteSizeLong();
   if (served.bytes > kMaxServedHitBytes / 4) return;  // huge plans: converted per call
-  // The per-call fields are cleared: proto3 does not write a zero, so a
-  // zero in the call's appended stats would not override a stored value.
-  v1::PlanResponse stored = reply;
-  stored.mutable_stats()->clear_planning_ms();
-  stored.mutable_stats()->clear_decomposition_cached();
-  auto body = std::make_shared<ServedBody>();
-  if (!stored.SerializeToString(&body->bytes)) return;
-  body->detail = PlanDetail(stored);
-  served.reply = std::move(body);
+  served.reply = ServedBodyFor(reply);
+  if (served.reply == nullptr) return;
   const ServedHitKey key(tenant_tag, hit.answered_by.get());
   absl::MutexLock lock(&served_mu_);
   auto [it, inserted] = served_.try_emplace(key);
@@ -791,14 +805,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
                                                        grpc::ByteBuffer* response_bytes) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, "Plan");
-  if (!call.auth.ok()) {
-    FinishCall(reactor, call, call.auth);
-    return reactor;
-  }
-  if (draining()) {
-    FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
-    return reactor;
-  }
+  // Parsed first, as gRPC parses the other methods' requests before their
+  // handlers (and their auth checks) run.
   auto request = std::make_shared<v1::PlanRequest>();
   {
     grpc::ByteBuffer bytes = *request_bytes;  // shares the slices; Deserialize consumes it
@@ -809,6 +817,14 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
                                                          " protobuf message")));
       return reactor;
     }
+  }
+  if (!call.auth.ok()) {
+    FinishCall(reactor, call, call.auth);
+    return reactor;
+  }
+  if (draining()) {
+    FinishCall(reactor, call, absl::UnavailableError("server is shutting down"));
+    return reactor;
   }
   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) {
     FinishCall(reactor, call, s);
@@ -827,18 +843,19 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   // The request's bytes, tagged with the tenant: a repeat of a request that
   // was answered from memory is expected to be answered from memory again
   // (only requests by map id, which are small, are remembered).
-  std::string hit_key;
-  if (request->map_ref_case() == v1::PlanRequest::kMapId) {
-    hit_key = call.tenant_tag;
-    hit_key.push_back('\n');
+  std::optional<uint64_t> hit_key;
+  if (request->map_ref_case() == v1::PlanRequest::kMapId && request_bytes->Length() <= kMaxHitRequestBytes) {
     std::vector<grpc::Slice> slices;
     if (request_bytes->Dump(&slices).ok()) {
+      std::string bytes = call.tenant_tag;
+      bytes.push_back('\n');
       for (const grpc::Slice& slice : slices) {
-        hit_key.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+        bytes.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
       }
+      hit_key = absl::HashOf(bytes);
     }
   }
-  const bool likely_hit = !hit_key.empty() && IsHitRequest(hit_key);
+  const bool likely_hit = hit_key.has_value() && IsHitRequest(*hit_key);
   const int hits_ahead = likely_hit ? admitted_hits_.fetch_add(1) : admitted_hits_.load();
   const auto release = [this, likely_hit] {
     if (likely_hit) admitted_hits_.fetch_sub(1);
@@ -863,8 +880,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
       return reactor;
     }
   }
-  const bool queued = pool_.TrySubmit([this, reactor, call, request, response_bytes, release,
-                                       hit_key = std::move(hit_key)] {
+  const bool queued = pool_.TrySubmit([this, reactor, call, request, response_bytes, release, hit_key] {
     UpdateQueueGauges();
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
     const uint64_t solve = TrackSolve(reactor->cancel());
@@ -874,9 +890,11 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     UntrackSolve(solve);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
     release();
-    if (status.ok() && !hit_key.empty() &&
-        (served != nullptr || response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT)) {
-      NoteHitRequest(hit_key);
+    if (status.ok() && hit_key.has_value()) {
+      // Remembered while it is answered from memory; forgotten once it is
+      // not (the plan or its map was evicted or deleted).
+      NoteHitRequest(*hit_key,
+                     served != nullptr || response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT);
     }
     std::string detail;
     if (status.ok()) {

@@ -183,10 +183,10 @@ class CoveragePlannerService final
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request, const StopToken& cancel,
                        v1::PlanResponse* response, std::shared_ptr<const ServedBody>* served);
   void UpdateQueueGauges();
-  // Whether these request bytes (tenant-tagged) were answered by a cache hit
-  // before, and recording that they were.
-  bool IsHitRequest(const std::string& key);
-  void NoteHitRequest(const std::string& key);
+  // Whether the request with this key (a hash of the tenant and the request
+  // bytes) was answered from memory last time, and recording whether it was.
+  bool IsHitRequest(uint64_t key);
+  void NoteHitRequest(uint64_t key, bool hit);
   // A Plan's solve metrics and the mean solve time the admission uses.
   void RecordPlanSolve(absl::Time start, const PlanStats& stats);
   // Repeated cache hits (issue 12): the reply already sent for `hit`'s
@@ -319,19 +319,21 @@ class CoveragePlannerService final
   std::map<ServedHitKey, ServedHit> served_ ABSL_GUARDED_BY(served_mu_);
   std::deque<ServedHitKey> served_order_ ABSL_GUARDED_BY(served_mu_);  // oldest first
   size_t served_bytes_ ABSL_GUARDED_BY(served_mu_) = 0;
-  // Exponentially weighted mean wall time of a solve (microseconds), for the
+  // Exponentially weighted mean wall time of a Plan (microseconds), for the
   // deadline-aware admission: a call whose expected queue wait would leave no
   // time to plan before its deadline is refused at once.
   std::atomic<int64_t> mean_solve_us_{0};
-  // The same for Plans answered from memory (PLAN_SOURCE_CACHE_HIT), and the
-  // admitted Plan calls expected to be such hits: their request bytes (with
-  // the tenant) were answered by a hit before. Without this, the burst of
-  // hits that follows a cold solve was priced at the cold solve's time and
-  // partly refused.
+  // The same for Plans answered from memory (PLAN_SOURCE_CACHE_HIT) alone,
+  // and the admitted Plan calls expected to be such hits: the hash of their
+  // request bytes (with the tenant) was answered from memory last time. They
+  // are priced at the hits' mean, other calls at the mean of all Plans.
+  // Without this, the burst of hits that follows a cold solve was priced at
+  // the cold solve's time and partly refused.
   std::atomic<int64_t> mean_hit_us_{0};
   std::atomic<int> admitted_hits_{0};
-  static constexpr size_t kMaxHitRequests = 4096;  // then forgotten at once
-  absl::flat_hash_set<std::string> hit_requests_ ABSL_GUARDED_BY(served_mu_);
+  static constexpr size_t kMaxHitRequests = 4096;     // then forgotten at once
+  static constexpr size_t kMaxHitRequestBytes = 4096;  // larger requests are not keyed
+  absl::flat_hash_set<uint64_t> hit_requests_ ABSL_GUARDED_BY(served_mu_);
   // Latest progress per plan (bounded), and those not yet written.
   absl::Mutex progress_mu_;
   std::map<std::string, std::pair<uint64_t, v1::RobotProgress>> progress_ ABSL_GUARDED_BY(progress_mu_);
@@ -351,6 +353,17 @@ class CoveragePlannerService final
   WorkerPool pool_;       // Plan solves
   WorkerPool warm_pool_;  // artifacts cut off by a caller's deadline
 };
+
+// A repeated hit's stored reply: `reply` serialised with the per-call stats
+// fields (planning_ms, decomposition_cached) cleared, so that the call's own
+// values, written after it by SerializePlanReply, win even when they are
+// zero or false; null if it cannot be serialised.
+std::shared_ptr<const CoveragePlannerService::ServedBody> ServedBodyFor(const v1::PlanResponse& reply);
+// A Plan reply's bytes: `response`'s, after those of `served` if set (a
+// repeated hit, whose stored bytes are shared with the slice, not copied).
+absl::Status SerializePlanReply(const v1::PlanResponse& response,
+                                std::shared_ptr<const CoveragePlannerService::ServedBody> served,
+                                grpc::ByteBuffer* out);
 
 }  // namespace covplan
 

@@ -19,6 +19,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "server/service.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/test_maps.h"
 
@@ -492,11 +493,46 @@ TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
   EXPECT_TRUE(absl::IsNotFound(missing.status())) << missing.status();
 }
 
+// A repeated hit's reply is the stored bytes and then this call's stats:
+// the call's values win even when they are zero or false (proto3 writes no
+// zero, so the stored copy must not hold the first call's values).
+TEST(ServedPlanReplyTest, TheCallsStatsOverrideTheStoredReply) {
+  v1::PlanResponse first;
+  first.set_plan_id("p-1");
+  first.add_path()->set_x(1.5);
+  first.mutable_stats()->set_num_ranks(12);
+  first.mutable_stats()->set_planning_ms(5.0);
+  first.mutable_stats()->set_decomposition_cached(true);
+  first.mutable_stats()->set_plan_source(v1::PLAN_SOURCE_CACHE_HIT);
+  std::shared_ptr<const CoveragePlannerService::ServedBody> body = ServedBodyFor(first);
+  ASSERT_NE(body, nullptr);
+  for (const auto& [ms, cached] : {std::pair{0.0, false}, std::pair{0.25, true}}) {
+    v1::PlanResponse call;
+    call.mutable_stats()->set_planning_ms(ms);
+    call.mutable_stats()->set_decomposition_cached(cached);
+    grpc::ByteBuffer bytes;
+    ASSERT_TRUE(SerializePlanReply(call, body, &bytes).ok());
+    std::vector<grpc::Slice> slices;
+    ASSERT_TRUE(bytes.Dump(&slices).ok());
+    std::string flat;
+    for (const grpc::Slice& slice : slices) {
+      flat.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+    }
+    v1::PlanResponse parsed;
+    ASSERT_TRUE(parsed.ParseFromString(flat));
+    v1::PlanResponse expected = first;
+    expected.mutable_stats()->set_planning_ms(ms);
+    expected.mutable_stats()->set_decomposition_cached(cached);
+    EXPECT_EQ(parsed.SerializeAsString(), expected.SerializeAsString()) << ms;
+  }
+}
+
 // Plan takes its request as bytes: bytes that are no PlanRequest are
 // INVALID_ARGUMENT naming the message, and the server goes on serving.
 TEST_F(ServiceTest, PlanBytesThatDoNotParseAreInvalidArgument) {
   const std::string junk("\xff\xff\xff\xff\x0f", 5);
-  absl::StatusOr<std::string> reply = testing::RawUnaryCall(channel_, "/covplan.v1.CoveragePlanner/Plan", junk);
+  absl::StatusOr<std::string> reply =
+      testing::RawUnaryCall(channel_, "/covplan.v1.CoveragePlanner/Plan", junk);
   EXPECT_TRUE(absl::IsInvalidArgument(reply.status())) << reply.status();
   EXPECT_THAT(reply.status().message(), HasSubstr("covplan.v1.PlanRequest"));
   v1::PlanResponse plan;
