@@ -15,6 +15,7 @@
 #include <csignal>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "gmock/gmock.h"
@@ -140,6 +141,7 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   v1::PlanResponse plan;
   ASSERT_TRUE(Plan(Request(map_id, 0.8, 0.5), &plan).ok());
   const v1::Waypoint dock = plan.path(0);
+  std::string trace = absl::StrFormat("dock (%.3f, %.3f)", dock.x(), dock.y());  // for a failure's message
   auto replan = [&](const v1::PlanResponse& p, v1::ReplanResponse* out) {
     v1::ReplanRequest r;
     r.set_plan_id(p.plan_id());
@@ -155,6 +157,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     v1::Point2* obstacle = r.mutable_obstacles()->add_points();
     obstacle->set_x(p.path(j).x());
     obstacle->set_y(p.path(j).y());
+    absl::StrAppendFormat(&trace, "; obstacle at (%.3f, %.3f), waypoint %d of %d", p.path(j).x(), p.path(j).y(), j,
+                          p.path_size());
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     return stub_->Replan(&context, r, out);
@@ -228,7 +232,7 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     status = stub_->Resume(&context, resume, &resumed);
   }
-  ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << server_->log();
+  ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << trace << "\n" << server_->log();
   EXPECT_EQ(resumed.replan().progress_source(), "recorded");
   EXPECT_GT(resumed.replan().covered_cells_before(), 0);
   EXPECT_EQ(resumed.replan().covered_cells_before() + resumed.replan().remaining_cells(),
