@@ -122,7 +122,6 @@ std::string PlanDetail(const v1::PlanResponse& response) {
                          v1::PlanSource_Name(response.stats().plan_source()));
 }
 
-
 // Lets one worker call and the reactor share the cancellation token; the
 // reactor deletes itself when gRPC is done with the call.
 class PlanReactor final : public grpc::ServerUnaryReactor {
@@ -172,7 +171,6 @@ absl::Status SerializePlanReply(const v1::PlanResponse& response,
   out->Swap(&whole);
   return absl::OkStatus();
 }
-
 
 absl::Status ServiceOptions::Validate() const {
   if (absl::Status s = limits.Validate(); !s.ok()) return s;

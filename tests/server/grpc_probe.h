@@ -13,6 +13,7 @@
 #define COVPLAN_TESTS_SERVER_GRPC_PROBE_H_
 
 #include <grpcpp/channel.h>
+#include <grpcpp/support/byte_buffer.h>
 
 #include <memory>
 #include <string>
@@ -21,6 +22,9 @@
 #include "absl/status/statusor.h"
 
 namespace covplan::testing {
+
+// The bytes of a ByteBuffer, flattened (empty if it cannot be read).
+std::string FromBuffer(const grpc::ByteBuffer& buffer);
 
 // One unary call of `method` ("/package.Service/Method") with `request` as
 // its raw bytes; the reply's bytes, or the call's status (code and message).

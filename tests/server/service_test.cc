@@ -512,14 +512,8 @@ TEST(ServedPlanReplyTest, TheCallsStatsOverrideTheStoredReply) {
     call.mutable_stats()->set_decomposition_cached(cached);
     grpc::ByteBuffer bytes;
     ASSERT_TRUE(SerializePlanReply(call, body, &bytes).ok());
-    std::vector<grpc::Slice> slices;
-    ASSERT_TRUE(bytes.Dump(&slices).ok());
-    std::string flat;
-    for (const grpc::Slice& slice : slices) {
-      flat.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
-    }
     v1::PlanResponse parsed;
-    ASSERT_TRUE(parsed.ParseFromString(flat));
+    ASSERT_TRUE(parsed.ParseFromString(testing::FromBuffer(bytes)));
     v1::PlanResponse expected = first;
     expected.mutable_stats()->set_planning_ms(ms);
     expected.mutable_stats()->set_decomposition_cached(cached);
