@@ -262,7 +262,7 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
     auto oarp = std::make_shared<OarpOptions>();
     switch (partition) {
       case v1::PARTITION_SOLVER_UNSPECIFIED:
-        break;  // the planner's default (matching)
+        break;  // the planner's default (push-relabel)
       case v1::MINCUT:
         oarp->partition_solver = PartitionSolver::kMinCut;
         break;
@@ -271,6 +271,9 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
         break;
       case v1::MATCHING:
         oarp->partition_solver = PartitionSolver::kMatching;
+        break;
+      case v1::PUSH_RELABEL:
+        oarp->partition_solver = PartitionSolver::kPushRelabel;
         break;
       default:
         return absl::InvalidArgumentError(

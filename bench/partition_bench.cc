@@ -1,6 +1,7 @@
-// Partition time: min-cut (Boost BK), bipartite matching (Hopcroft-Karp)
-// and the thesis LP (GLPK simplex) on building-like grids and open fields of
-// 10^4, 10^5 and 10^6 cells.
+// Partition time: min-cut (Boost BK, and push-relabel on the grid),
+// bipartite matching (multi-source BFS, Hopcroft-Karp, PF+) and the thesis
+// LP (GLPK simplex) on building-like grids and open fields of 10^4, 10^5 and
+// 10^6 cells.
 //
 //   build/bin/partition_bench --benchmark_filter='MinCut|Matching'
 //   build/bin/partition_bench --benchmark_filter='Lp/10000'
@@ -12,6 +13,7 @@
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/matching_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
+#include "planner/partition/push_relabel_partitioner.h"
 
 namespace covplan {
 namespace {
@@ -113,6 +115,28 @@ BENCHMARK_TEMPLATE(BM_Matching, BuildingGrid)->Name("BM_MatchingBuilding")
     ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_TEMPLATE(BM_Matching, FieldGrid)->Name("BM_MatchingField")
     ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// The same cut graph as BM_MinCut*, by push-relabel on the implicit grid.
+template <Grid (*MakeGrid)(int64_t, uint32_t)>
+void BM_PushRelabel(benchmark::State& state) {
+  const Grid grid = MakeGrid(state.range(0), 42);
+  int64_t ranks = 0;
+  for (auto _ : state) {
+    auto p = PushRelabelPartitioner().Partition(grid, StopToken());
+    if (!p.ok()) {
+      state.SkipWithError(std::string(p.status().message()).c_str());
+      break;
+    }
+    ranks = static_cast<int64_t>(p->ranks.size());
+  }
+  state.counters["cells"] = static_cast<double>(grid.size());
+  state.counters["free_cells"] = static_cast<double>(grid.CountFree());
+  state.counters["ranks"] = static_cast<double>(ranks);
+}
+BENCHMARK_TEMPLATE(BM_PushRelabel, BuildingGrid)->Name("BM_PushRelabelBuilding")
+    ->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_TEMPLATE(BM_PushRelabel, FieldGrid)->Name("BM_PushRelabelField")
+    ->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_Lp(benchmark::State& state) {
   const Grid grid = BuildingGrid(state.range(0), 42);

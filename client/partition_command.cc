@@ -19,6 +19,7 @@
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/matching_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
+#include "planner/partition/push_relabel_partitioner.h"
 
 namespace covplan {
 namespace {
@@ -31,7 +32,9 @@ constexpr char kUsage[] =
     "and prints one JSON object: rows, cols, free_cells, num_ranks, partition_ms (the\n"
     "median of --repeat N timed runs, default 1, each on the ready grid) and grid_ms\n"
     "(building the grid from the map). Solvers:\n"
-    "  matching      maximum bipartite matching, multi-source BFS (the planner's default)\n"
+    "  pushrelabel   s-t minimum cut, push-relabel with global relabelling on the grid\n"
+    "                (the planner's default)\n"
+    "  matching      maximum bipartite matching, multi-source BFS\n"
     "  matching-hk   the same matching by Hopcroft-Karp\n"
     "  matching-pf   the same matching by Pothen-Fan (PF+)\n"
     "  mincut        s-t minimum cut, Boykov-Kolmogorov with a greedy preflow\n"
@@ -39,6 +42,7 @@ constexpr char kUsage[] =
     "  lp            the thesis LP with GLPK (slow on big grids)\n";
 
 absl::StatusOr<std::unique_ptr<RankPartitioner>> SolverNamed(const std::string& name) {
+  if (name == "pushrelabel") return std::make_unique<PushRelabelPartitioner>();
   if (name == "matching") return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kMultiSourceBfs);
   if (name == "matching-hk") return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kHopcroftKarp);
   if (name == "matching-pf") return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kPothenFan);
@@ -46,7 +50,7 @@ absl::StatusOr<std::unique_ptr<RankPartitioner>> SolverNamed(const std::string& 
   if (name == "mincut-bk") return std::make_unique<MinCutPartitioner>(false);
   if (name == "lp") return std::make_unique<LpPartitioner>();
   return absl::InvalidArgumentError(absl::StrCat(
-      "--solver must be one of matching, matching-hk, matching-pf, mincut, mincut-bk, lp; got '",
+      "--solver must be one of pushrelabel, matching, matching-hk, matching-pf, mincut, mincut-bk, lp; got '",
       name.substr(0, 64), "'"));
 }
 
@@ -59,7 +63,7 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
                                            {"negate"}));
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   const std::string map_path = *a.Get("map");
-  const std::string solver_name = a.Get("solver").value_or("matching");
+  const std::string solver_name = a.Get("solver").value_or("pushrelabel");
   ASSIGN_OR_RETURN(std::unique_ptr<RankPartitioner> solver, SolverNamed(solver_name));
   ASSIGN_OR_RETURN(std::optional<int64_t> repeat, a.GetInt("repeat"));
   if (repeat && (*repeat < 1 || *repeat > 1000)) {

@@ -2,7 +2,7 @@
 // [--repeat N]`: the minimum rank partition alone, in this process, on the
 // coverage grid `covplan plan` would partition (same map reading, same grid
 // options), and prints one JSON object:
-//   {"map": "...", "solver": "matching", "tool_width_m": 0.8, "rows": 40,
+//   {"map": "...", "solver": "pushrelabel", "tool_width_m": 0.8, "rows": 40,
 //    "cols": 60, "free_cells": 1822, "num_ranks": 84, "partition_ms": 1.9,
 //    "partition_ms_runs": [...], "grid_ms": 12.0}
 // partition_ms is the median of N timed runs (default 1) of the solver on a

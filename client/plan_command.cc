@@ -44,7 +44,7 @@ constexpr char kUsage[] =
     "usage: covplan plan --map FILE [--resolution M] [--tool-width M]\n"
     "                    [--local | --server HOST:PORT] [--out plan.json] [--svg plan.svg]\n"
     "                    [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
-    "                    [--time-limit S] [--seed N] [--partition matching|mincut|lp] [--tour gtsp|greedy]\n"
+    "                    [--time-limit S] [--seed N] [--partition pushrelabel|matching|mincut|lp] [--tour gtsp|greedy]\n"
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D] [--improve-remembered]\n"
@@ -296,7 +296,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     if (*p == "mincut") r.set_partition_solver(v1::MINCUT);
     else if (*p == "lp") r.set_partition_solver(v1::LP);
     else if (*p == "matching") r.set_partition_solver(v1::MATCHING);
-    else return absl::InvalidArgumentError(absl::StrCat("--partition must be mincut, matching or lp, got '", *p, "'"));
+    else if (*p == "pushrelabel") r.set_partition_solver(v1::PUSH_RELABEL);
+    else return absl::InvalidArgumentError(absl::StrCat("--partition must be pushrelabel, matching, mincut or lp, got '", *p, "'"));
   }
   if (auto t = a.Get("tour")) {
     if (*t == "gtsp") r.set_tour_solver(v1::GTSP);

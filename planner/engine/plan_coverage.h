@@ -24,7 +24,7 @@ namespace covplan {
 struct PlanOptions {
   std::string planner = PlannerRegistry::kDefault;  // a registered name; OARP fields apply to "oarp"
   RobotModel robot;
-  PartitionSolver partition_solver = PartitionSolver::kMatching;
+  PartitionSolver partition_solver = PartitionSolver::kPushRelabel;
   TourSolver tour_solver = TourSolver::kGtsp;
   double min_free_fraction = 0.5;
   double time_limit_s = 1.0;

@@ -41,7 +41,7 @@ int64_t SparseTransitionBytes(int64_t grid_cells, int64_t num_ranks, int num_thr
 
 absl::Status OarpOptions::Validate() const {
   if (partition_solver != PartitionSolver::kMinCut && partition_solver != PartitionSolver::kLp &&
-      partition_solver != PartitionSolver::kMatching) {
+      partition_solver != PartitionSolver::kMatching && partition_solver != PartitionSolver::kPushRelabel) {
     return absl::InvalidArgumentError("oarp.partition_solver: unknown solver");
   }
   if (tour_solver != TourSolver::kGreedy && tour_solver != TourSolver::kGtsp) {

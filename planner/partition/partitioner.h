@@ -1,10 +1,11 @@
 // Minimum rank partition (OARP, thesis ch. 3): orient every free cell H or V
-// so that the number of ranks is minimal. Three exact solvers share this
-// interface: the s-t minimum cut, a maximum bipartite matching on the
+// so that the number of ranks is minimal. Four exact solvers share this
+// interface: the s-t minimum cut (by push-relabel on the grid, the default,
+// or by Boost's Boykov-Kolmogorov), a maximum bipartite matching on the
 // conflict graph (König), and the thesis's GLPK LP (reference). All return
 // an optimal partition; ties may differ.
 //
-//   std::unique_ptr<RankPartitioner> p = MakePartitioner(PartitionSolver::kMatching);
+//   std::unique_ptr<RankPartitioner> p = MakePartitioner(PartitionSolver::kPushRelabel);
 //   absl::StatusOr<RankPartition> part = p->Partition(grid, StopToken());
 //
 // Thread-safety: implementations are stateless; Partition() is reentrant.
@@ -21,7 +22,7 @@
 
 namespace covplan {
 
-enum class PartitionSolver { kMinCut, kLp, kMatching };
+enum class PartitionSolver { kMinCut, kLp, kMatching, kPushRelabel };
 
 class RankPartitioner {
  public:

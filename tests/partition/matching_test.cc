@@ -16,25 +16,12 @@
 namespace covplan {
 namespace {
 
+using ::covplan::testing::BruteForceMinRanks;
 using ::covplan::testing::CheckExactCover;
 using ::covplan::testing::RandomGrid;
 
 constexpr MatchingAlgorithm kAlgorithms[] = {MatchingAlgorithm::kMultiSourceBfs,
                                              MatchingAlgorithm::kHopcroftKarp, MatchingAlgorithm::kPothenFan};
-
-int64_t BruteForceMinRanks(const Grid& grid) {
-  std::vector<int64_t> free_cells;
-  for (int64_t i = 0; i < grid.size(); ++i) {
-    if (grid.free_flags()[i]) free_cells.push_back(i);
-  }
-  int64_t best = INT64_MAX;
-  std::vector<uint8_t> orient(grid.size(), 0);
-  for (uint32_t mask = 0; mask < (1u << free_cells.size()); ++mask) {
-    for (size_t k = 0; k < free_cells.size(); ++k) orient[free_cells[k]] = (mask >> k) & 1;
-    best = std::min(best, CountRankStarts(grid, orient));
-  }
-  return best;
-}
 
 // Every variant (each algorithm, with and without the greedy start) on `g`:
 // an exact cover whose rank count is `expected`. Returns "" or the first failure.
@@ -181,6 +168,7 @@ TEST(MatchingPartitioner, IsMadeByTheFactory) {
   EXPECT_EQ(MakePartitioner(PartitionSolver::kMatching)->name(), "matching");
   EXPECT_EQ(MakePartitioner(PartitionSolver::kMinCut)->name(), "mincut");
   EXPECT_EQ(MakePartitioner(PartitionSolver::kLp)->name(), "lp");
+  EXPECT_EQ(MakePartitioner(PartitionSolver::kPushRelabel)->name(), "pushrelabel");
 }
 
 }  // namespace

@@ -12,23 +12,9 @@
 namespace covplan {
 namespace {
 
+using ::covplan::testing::BruteForceMinRanks;
 using ::covplan::testing::CheckExactCover;
 using ::covplan::testing::RandomGrid;
-
-// Independent reference: enumerate every orientation assignment.
-int64_t BruteForceMinRanks(const Grid& grid) {
-  std::vector<int64_t> free_cells;
-  for (int64_t i = 0; i < grid.size(); ++i) {
-    if (grid.free_flags()[i]) free_cells.push_back(i);
-  }
-  int64_t best = INT64_MAX;
-  std::vector<uint8_t> orient(grid.size(), 0);
-  for (uint32_t mask = 0; mask < (1u << free_cells.size()); ++mask) {
-    for (size_t k = 0; k < free_cells.size(); ++k) orient[free_cells[k]] = (mask >> k) & 1;
-    best = std::min(best, CountRankStarts(grid, orient));
-  }
-  return best;
-}
 
 TEST(MinCutPartitioner, SingleRowIsOneHorizontalRank) {
   Grid g = Grid::FromAscii({"....."});
@@ -192,11 +178,15 @@ TEST(Partitioners, RanksAreMaximalRuns) {
     const uint8_t o = static_cast<uint8_t>(r.orientation);
     if (r.orientation == Orientation::kHorizontal) {
       for (int c : {r.first.col - 1, r.last.col + 1}) {
-        if (g.IsFree(r.first.row, c)) EXPECT_NE(cut->orientation[g.Index(r.first.row, c)], o);
+        if (g.IsFree(r.first.row, c)) {
+          EXPECT_NE(cut->orientation[g.Index(r.first.row, c)], o);
+        }
       }
     } else {
       for (int row : {r.first.row - 1, r.last.row + 1}) {
-        if (g.IsFree(row, r.first.col)) EXPECT_NE(cut->orientation[g.Index(row, r.first.col)], o);
+        if (g.IsFree(row, r.first.col)) {
+          EXPECT_NE(cut->orientation[g.Index(row, r.first.col)], o);
+        }
       }
     }
   }

@@ -84,19 +84,23 @@ TEST(PlanCoverage, OfficeMapConforms) {
 }
 
 TEST(PlanCoverage, ExactSolversGiveSameRankCount) {
-  PlanOptions a, b, c;  // a: the default (matching)
-  a.tour_solver = b.tour_solver = c.tour_solver = TourSolver::kGreedy;
+  PlanOptions a, b, c, d;  // a: the default (push-relabel)
+  a.tour_solver = b.tour_solver = c.tour_solver = d.tour_solver = TourSolver::kGreedy;
   b.partition_solver = PartitionSolver::kLp;
   c.partition_solver = PartitionSolver::kMinCut;
+  d.partition_solver = PartitionSolver::kMatching;
   auto pa = PlanCoverage(OfficeMap(), a);
   auto pb = PlanCoverage(OfficeMap(), b);
   auto pc = PlanCoverage(OfficeMap(), c);
-  ASSERT_TRUE(pa.ok() && pb.ok() && pc.ok());
+  auto pd = PlanCoverage(OfficeMap(), d);
+  ASSERT_TRUE(pa.ok() && pb.ok() && pc.ok() && pd.ok());
   EXPECT_EQ(pa->detail_as<OarpDetail>()->ranks.size(), pb->detail_as<OarpDetail>()->ranks.size());
   EXPECT_EQ(pc->detail_as<OarpDetail>()->ranks.size(), pb->detail_as<OarpDetail>()->ranks.size());
-  EXPECT_EQ(pa->stats.partition_solver, "matching");
+  EXPECT_EQ(pd->detail_as<OarpDetail>()->ranks.size(), pb->detail_as<OarpDetail>()->ranks.size());
+  EXPECT_EQ(pa->stats.partition_solver, "pushrelabel");
   EXPECT_EQ(pb->stats.partition_solver, "lp");
   EXPECT_EQ(pc->stats.partition_solver, "mincut");
+  EXPECT_EQ(pd->stats.partition_solver, "matching");
 }
 
 TEST(PlanCoverage, BadInputIsInvalidArgument) {

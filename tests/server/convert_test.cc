@@ -184,6 +184,11 @@ TEST(PlanRequestFromProtoTest, ValidatesRobotAndSolvers) {
   ASSERT_TRUE(options.ok()) << options.status();
   EXPECT_EQ(dynamic_cast<const OarpOptions*>(options->options.get())->partition_solver,
             PartitionSolver::kMatching);
+  request.set_partition_solver(v1::PUSH_RELABEL);
+  options = PlanRequestFromProto(request);
+  ASSERT_TRUE(options.ok()) << options.status();
+  EXPECT_EQ(dynamic_cast<const OarpOptions*>(options->options.get())->partition_solver,
+            PartitionSolver::kPushRelabel);
   request.set_partition_solver(v1::LP);
 
   // The oneof wins over the top-level solver fields, and its errors name it.

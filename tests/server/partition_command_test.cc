@@ -74,7 +74,7 @@ TEST(PartitionCommand, EverySolverFindsTheLpOptimumOnThePlanningGrid) {
     std::printf("%s\n", lp->c_str());
     const double ranks = Field(*lp, "num_ranks");
     EXPECT_GT(ranks, 0);
-    for (const char* solver : {"matching", "matching-hk", "matching-pf", "mincut", "mincut-bk"}) {
+    for (const char* solver : {"pushrelabel", "matching", "matching-hk", "matching-pf", "mincut", "mincut-bk"}) {
       std::vector<std::string> args = base;
       args.insert(args.end(), {"--solver", solver, "--repeat", "2"});
       absl::StatusOr<std::string> json = PartitionCommandJson(args);

@@ -2,6 +2,8 @@
 #ifndef COVPLAN_TESTS_TESTING_GRID_FIXTURES_H_
 #define COVPLAN_TESTS_TESTING_GRID_FIXTURES_H_
 
+#include <algorithm>
+#include <cstdint>
 #include <random>
 #include <string>
 #include <vector>
@@ -69,6 +71,22 @@ inline std::string CheckExactCover(const Grid& grid, const std::vector<Rank>& ra
     }
   }
   return "";
+}
+
+// Independent reference for tiny grids: the fewest rank starts over every
+// orientation assignment (2^free cells of them).
+inline int64_t BruteForceMinRanks(const Grid& grid) {
+  std::vector<int64_t> free_cells;
+  for (int64_t i = 0; i < grid.size(); ++i) {
+    if (grid.free_flags()[i]) free_cells.push_back(i);
+  }
+  int64_t best = INT64_MAX;
+  std::vector<uint8_t> orient(grid.size(), 0);
+  for (uint32_t mask = 0; mask < (1u << free_cells.size()); ++mask) {
+    for (size_t k = 0; k < free_cells.size(); ++k) orient[free_cells[k]] = (mask >> k) & 1;
+    best = std::min(best, CountRankStarts(grid, orient));
+  }
+  return best;
 }
 
 }  // namespace covplan::testing
