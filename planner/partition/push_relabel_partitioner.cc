@@ -74,14 +74,13 @@ class GridFlow {
           state_[u] |= kSinkUsed, --excess_[u], ++flow_;
           continue;
         }
-        const int32_t v = Admissible(u);
-        if (v >= 0) {
-          Push(u, v);
-          if (!(state_[v] & kQueued)) state_[v] |= kQueued, queue.push_back(v);
+        const int32_t v = AdmissibleOrRelabel(u);
+        if (v < 0) {
+          ++relabels;
           continue;
         }
-        Relabel(u);
-        ++relabels;
+        Push(u, v);
+        if (!(state_[v] & kQueued)) state_[v] |= kQueued, queue.push_back(v);
       }
       if (relabels >= relabels_per_global) {
         relabels = 0;
@@ -119,14 +118,23 @@ class GridFlow {
   int64_t constant() const { return constant_; }
 
  private:
-  // The first residual arc out of u that goes one label down, or -1.
-  int32_t Admissible(int32_t u) const {
+  // The first residual arc out of u that goes one label down. If there is
+  // none, u is relabelled to one above its lowest residual neighbour (t
+  // counts as label 0 while u's sink arc is unused) and -1 is returned.
+  int32_t AdmissibleOrRelabel(int32_t u) {
     const int32_t want = label_[u] - 1;
     const uint8_t s = state_[u];
-    if ((s & (kArcCol | kFlowCol)) == kArcCol && label_[u + 1] == want) return u + 1;
-    if ((s & (kArcRow | kFlowRow)) == kArcRow && label_[u + cols_] == want) return u + cols_;
-    if (u >= cols_ && (state_[u - cols_] & kFlowRow) && label_[u - cols_] == want) return u - cols_;
-    if (u > 0 && (state_[u - 1] & kFlowCol) && label_[u - 1] == want) return u - 1;
+    int32_t lowest = (s & (kSink | kSinkUsed)) == kSink ? 0 : kInf_;
+    auto down = [&](int32_t v) {
+      const int32_t l = label_[v];
+      lowest = std::min(lowest, l);
+      return l == want;
+    };
+    if ((s & (kArcCol | kFlowCol)) == kArcCol && down(u + 1)) return u + 1;
+    if ((s & (kArcRow | kFlowRow)) == kArcRow && down(u + cols_)) return u + cols_;
+    if (u >= cols_ && (state_[u - cols_] & kFlowRow) && down(u - cols_)) return u - cols_;
+    if (u > 0 && (state_[u - 1] & kFlowCol) && down(u - 1)) return u - 1;
+    label_[u] = std::min(lowest + 1, kInf_);
     return -1;
   }
 
@@ -143,17 +151,6 @@ class GridFlow {
       state_[v] &= static_cast<uint8_t>(~kFlowCol);
     }
     --excess_[u], ++excess_[v];
-  }
-
-  void Relabel(int32_t u) {
-    int32_t best = kInf_;
-    const uint8_t s = state_[u];
-    if ((s & (kSink | kSinkUsed)) == kSink) best = 1;
-    if ((s & (kArcCol | kFlowCol)) == kArcCol) best = std::min(best, label_[u + 1] + 1);
-    if ((s & (kArcRow | kFlowRow)) == kArcRow) best = std::min(best, label_[u + cols_] + 1);
-    if (u >= cols_ && (state_[u - cols_] & kFlowRow)) best = std::min(best, label_[u - cols_] + 1);
-    if (u > 0 && (state_[u - 1] & kFlowCol)) best = std::min(best, label_[u - 1] + 1);
-    label_[u] = std::min(best, kInf_);
   }
 
   // Exact distances to t in the residual graph, by one breadth-first search
