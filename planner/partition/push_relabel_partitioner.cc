@@ -15,6 +15,9 @@ namespace {
 // unit. A sink cell drains one unit to t (kSinkUsed once it has).
 constexpr uint8_t kArcCol = 1, kArcRow = 2, kSink = 4, kFlowCol = 8, kFlowRow = 16, kSinkUsed = 32,
                   kQueued = 64;
+// The residual arcs out of a cell: its free arcs forward, and the arcs that
+// carry flow into it, backwards.
+enum Residual : int8_t { kNone = -1, kForwardCol, kForwardRow, kBackRow, kBackCol };
 constexpr uint32_t kPollMask = (1u << 14) - 1;  // poll the stop token every 16,384 steps
 
 absl::Status Stopped() { return absl::DeadlineExceededError("partition stopped during push-relabel"); }
@@ -53,6 +56,12 @@ class GridFlow {
 
   // Phase one of push-relabel: a maximum preflow. Returns the flow into t.
   absl::StatusOr<int64_t> MaxPreflow(const StopToken& stop) {
+    // On open ground every source may reach a sink along forward arcs alone
+    // (an empty lawn: one L-shaped path per row); a greedy pass then is the
+    // whole maximum flow. It stops at the first source it cannot route, and
+    // its flow is undone: elsewhere its long greedy paths cost more pushes
+    // to reroute than they save (docs/benchmarks.md §1d).
+    if (!GreedyRoutesEverySource()) UndoFlow();
     if (!GlobalRelabel(stop)) return Stopped();
     std::vector<int32_t> queue;
     for (int32_t i : sources_) {
@@ -74,12 +83,12 @@ class GridFlow {
           state_[u] |= kSinkUsed, --excess_[u], ++flow_;
           continue;
         }
-        const int32_t v = AdmissibleOrRelabel(u);
-        if (v < 0) {
+        const Residual arc = AdmissibleOrRelabel(u);
+        if (arc == kNone) {
           ++relabels;
           continue;
         }
-        Push(u, v);
+        const int32_t v = Push(u, arc);
         if (!(state_[v] & kQueued)) state_[v] |= kQueued, queue.push_back(v);
       }
       if (relabels >= relabels_per_global) {
@@ -118,10 +127,51 @@ class GridFlow {
   int64_t constant() const { return constant_; }
 
  private:
+  // Routes the sources' units along free forward arcs (+row first, then
+  // +col) to unused sinks by depth-first search; a cell found to lead to no
+  // sink is marked and never entered again, so the pass is O(cells). False
+  // at the first source it cannot route.
+  bool GreedyRoutesEverySource() {
+    std::fill(seen_.begin(), seen_.end(), 0);  // dead ends
+    auto dead = [&](int32_t u) { return (seen_[static_cast<uint32_t>(u) >> 6] >> (u & 63)) & 1; };
+    std::vector<int32_t> path;
+    std::vector<uint8_t> arcs;  // arcs[k]: kFlowCol or kFlowRow from path[k] to path[k + 1]
+    for (int32_t src : sources_) {
+      path.assign(1, src);
+      arcs.clear();
+      while (true) {
+        if (path.empty()) return false;
+        const int32_t u = path.back();
+        if ((state_[u] & (kSink | kSinkUsed)) == kSink) {
+          state_[u] |= kSinkUsed, ++flow_, --excess_[src];
+          for (size_t k = 0; k < arcs.size(); ++k) state_[path[k]] |= arcs[k];
+          break;
+        }
+        const uint8_t s = state_[u];
+        if ((s & (kArcRow | kFlowRow)) == kArcRow && !dead(u + cols_)) {
+          path.push_back(u + cols_), arcs.push_back(kFlowRow);
+        } else if ((s & (kArcCol | kFlowCol)) == kArcCol && !dead(u + 1)) {
+          path.push_back(u + 1), arcs.push_back(kFlowCol);
+        } else {
+          seen_[static_cast<uint32_t>(u) >> 6] |= uint64_t{1} << (u & 63);
+          path.pop_back();
+          if (!arcs.empty()) arcs.pop_back();
+        }
+      }
+    }
+    return true;
+  }
+
+  void UndoFlow() {
+    for (uint8_t& s : state_) s &= static_cast<uint8_t>(~(kFlowCol | kFlowRow | kSinkUsed));
+    for (int32_t src : sources_) excess_[src] = 1;
+    flow_ = 0;
+  }
+
   // The first residual arc out of u that goes one label down. If there is
   // none, u is relabelled to one above its lowest residual neighbour (t
-  // counts as label 0 while u's sink arc is unused) and -1 is returned.
-  int32_t AdmissibleOrRelabel(int32_t u) {
+  // counts as label 0 while u's sink arc is unused) and kNone is returned.
+  Residual AdmissibleOrRelabel(int32_t u) {
     const int32_t want = label_[u] - 1;
     const uint8_t s = state_[u];
     int32_t lowest = (s & (kSink | kSinkUsed)) == kSink ? 0 : kInf_;
@@ -130,27 +180,27 @@ class GridFlow {
       lowest = std::min(lowest, l);
       return l == want;
     };
-    if ((s & (kArcCol | kFlowCol)) == kArcCol && down(u + 1)) return u + 1;
-    if ((s & (kArcRow | kFlowRow)) == kArcRow && down(u + cols_)) return u + cols_;
-    if (u >= cols_ && (state_[u - cols_] & kFlowRow) && down(u - cols_)) return u - cols_;
-    if (u > 0 && (state_[u - 1] & kFlowCol) && down(u - 1)) return u - 1;
+    if ((s & (kArcCol | kFlowCol)) == kArcCol && down(u + 1)) return kForwardCol;
+    if ((s & (kArcRow | kFlowRow)) == kArcRow && down(u + cols_)) return kForwardRow;
+    if (u >= cols_ && (state_[u - cols_] & kFlowRow) && down(u - cols_)) return kBackRow;
+    if (u > 0 && (state_[u - 1] & kFlowCol) && down(u - 1)) return kBackCol;
     label_[u] = std::min(lowest + 1, kInf_);
-    return -1;
+    return kNone;
   }
 
-  // Sends one unit along the residual arc u -> v: along a free arc, or
-  // back along an arc that carries flow into u.
-  void Push(int32_t u, int32_t v) {
-    if (v == u + 1) {
-      state_[u] |= kFlowCol;
-    } else if (v == u + cols_) {
-      state_[u] |= kFlowRow;
-    } else if (v == u - cols_) {
-      state_[v] &= static_cast<uint8_t>(~kFlowRow);
-    } else {
-      state_[v] &= static_cast<uint8_t>(~kFlowCol);
+  // Sends one unit out of u along `arc`: along a free arc, or back along an
+  // arc that carries flow into u. Returns the cell it reaches.
+  int32_t Push(int32_t u, Residual arc) {
+    int32_t v = u;
+    switch (arc) {
+      case kForwardCol: v = u + 1, state_[u] |= kFlowCol; break;
+      case kForwardRow: v = u + cols_, state_[u] |= kFlowRow; break;
+      case kBackRow: v = u - cols_, state_[v] &= static_cast<uint8_t>(~kFlowRow); break;
+      case kBackCol: v = u - 1, state_[v] &= static_cast<uint8_t>(~kFlowCol); break;
+      case kNone: return u;
     }
     --excess_[u], ++excess_[v];
+    return v;
   }
 
   // Exact distances to t in the residual graph, by one breadth-first search

@@ -1,8 +1,10 @@
 // PushRelabelPartitioner (the cut graph by push-relabel on the grid) against
 // brute force, the LP, Boost's Boykov-Kolmogorov and the matching.
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gmock/gmock.h"
@@ -110,6 +112,23 @@ TEST(PushRelabelPartitioner, EqualsBoykovKolmogorovAndMatchingOnOpenFields) {
     ASSERT_TRUE(bk.ok() && matching.ok());
     ASSERT_EQ(bk->ranks.size(), matching->ranks.size()) << "seed " << seed;
     ASSERT_EQ(CheckPushRelabel(g, static_cast<int64_t>(bk->ranks.size())), "") << "seed " << seed;
+  }
+}
+
+// An empty lawn: every source reaches a sink along forward arcs, so the
+// greedy start is the whole flow; one post breaks that and the greedy flow
+// is undone.
+TEST(PushRelabelPartitioner, OpenRectanglesWithAndWithoutAPost) {
+  for (const auto& [rows, cols] : std::vector<std::pair<int, int>>{{1, 9}, {9, 1}, {2, 2}, {7, 30}, {30, 7}, {64, 64}, {120, 45}}) {
+    Grid lawn = RandomGrid(rows, cols, 1.0, 1);
+    EXPECT_EQ(CheckPushRelabel(lawn, std::min(rows, cols)), "") << rows << " x " << cols;
+    std::vector<uint8_t> free = lawn.free_flags();
+    free[static_cast<size_t>(rows / 2) * cols + cols / 2] = 0;
+    Grid post(rows, cols, 1.0, {0, 0}, std::move(free));
+    if (post.CountFree() == 0) continue;
+    auto bk = MinCutPartitioner().Partition(post, StopToken());
+    ASSERT_TRUE(bk.ok());
+    EXPECT_EQ(CheckPushRelabel(post, static_cast<int64_t>(bk->ranks.size())), "") << rows << " x " << cols << " with a post";
   }
 }
 
