@@ -49,17 +49,25 @@ Grid BuildingGrid(int64_t cells, uint32_t seed) {
   return Grid(rows, cols, 0.8, {0, 0}, std::move(free));
 }
 
-void BM_MinCut(benchmark::State& state) {
-  const Grid grid = BuildingGrid(state.range(0), 42);
+// Times `partitioner` on `grid`; reports the grid's cells, free cells and
+// the rank count found.
+void TimePartition(benchmark::State& state, const Grid& grid, const RankPartitioner& partitioner) {
   int64_t ranks = 0;
   for (auto _ : state) {
-    auto p = MinCutPartitioner(state.range(1) != 0).Partition(grid, StopToken());
-    if (!p.ok()) state.SkipWithError(std::string(p.status().message()).c_str());
+    auto p = partitioner.Partition(grid, StopToken());
+    if (!p.ok()) {
+      state.SkipWithError(std::string(p.status().message()).c_str());
+      break;
+    }
     ranks = static_cast<int64_t>(p->ranks.size());
   }
   state.counters["cells"] = static_cast<double>(grid.size());
   state.counters["free_cells"] = static_cast<double>(grid.CountFree());
   state.counters["ranks"] = static_cast<double>(ranks);
+}
+
+void BM_MinCut(benchmark::State& state) {
+  TimePartition(state, BuildingGrid(state.range(0), 42), MinCutPartitioner(state.range(1) != 0));
 }
 BENCHMARK(BM_MinCut)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
@@ -75,16 +83,7 @@ Grid FieldGrid(int64_t cells, uint32_t seed) {
 }
 
 void BM_MinCutField(benchmark::State& state) {
-  const Grid grid = FieldGrid(state.range(0), 42);
-  int64_t ranks = 0;
-  for (auto _ : state) {
-    auto p = MinCutPartitioner(state.range(1) != 0).Partition(grid, StopToken());
-    if (!p.ok()) state.SkipWithError(std::string(p.status().message()).c_str());
-    ranks = static_cast<int64_t>(p->ranks.size());
-  }
-  state.counters["cells"] = static_cast<double>(grid.size());
-  state.counters["free_cells"] = static_cast<double>(grid.CountFree());
-  state.counters["ranks"] = static_cast<double>(ranks);
+  TimePartition(state, FieldGrid(state.range(0), 42), MinCutPartitioner(state.range(1) != 0));
 }
 BENCHMARK(BM_MinCutField)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
@@ -92,24 +91,12 @@ BENCHMARK(BM_MinCutField)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->
 // multi-source BFS without the greedy initial matching, /3 = Pothen-Fan (PF+).
 template <Grid (*MakeGrid)(int64_t, uint32_t)>
 void BM_Matching(benchmark::State& state) {
-  const Grid grid = MakeGrid(state.range(0), 42);
-  int64_t ranks = 0;
-  for (auto _ : state) {
-    const int variant = static_cast<int>(state.range(1));
-    const MatchingPartitioner partitioner(variant == 1   ? MatchingAlgorithm::kHopcroftKarp
-                                          : variant == 3 ? MatchingAlgorithm::kPothenFan
-                                                         : MatchingAlgorithm::kMultiSourceBfs,
-                                          variant != 2);
-    auto p = partitioner.Partition(grid, StopToken());
-    if (!p.ok()) {
-      state.SkipWithError(std::string(p.status().message()).c_str());
-      break;
-    }
-    ranks = static_cast<int64_t>(p->ranks.size());
-  }
-  state.counters["cells"] = static_cast<double>(grid.size());
-  state.counters["free_cells"] = static_cast<double>(grid.CountFree());
-  state.counters["ranks"] = static_cast<double>(ranks);
+  const int variant = static_cast<int>(state.range(1));
+  const MatchingPartitioner partitioner(variant == 1   ? MatchingAlgorithm::kHopcroftKarp
+                                        : variant == 3 ? MatchingAlgorithm::kPothenFan
+                                                       : MatchingAlgorithm::kMultiSourceBfs,
+                                        variant != 2);
+  TimePartition(state, MakeGrid(state.range(0), 42), partitioner);
 }
 BENCHMARK_TEMPLATE(BM_Matching, BuildingGrid)->Name("BM_MatchingBuilding")
     ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
@@ -119,19 +106,7 @@ BENCHMARK_TEMPLATE(BM_Matching, FieldGrid)->Name("BM_MatchingField")
 // The same cut graph as BM_MinCut*, by push-relabel on the implicit grid.
 template <Grid (*MakeGrid)(int64_t, uint32_t)>
 void BM_PushRelabel(benchmark::State& state) {
-  const Grid grid = MakeGrid(state.range(0), 42);
-  int64_t ranks = 0;
-  for (auto _ : state) {
-    auto p = PushRelabelPartitioner().Partition(grid, StopToken());
-    if (!p.ok()) {
-      state.SkipWithError(std::string(p.status().message()).c_str());
-      break;
-    }
-    ranks = static_cast<int64_t>(p->ranks.size());
-  }
-  state.counters["cells"] = static_cast<double>(grid.size());
-  state.counters["free_cells"] = static_cast<double>(grid.CountFree());
-  state.counters["ranks"] = static_cast<double>(ranks);
+  TimePartition(state, MakeGrid(state.range(0), 42), PushRelabelPartitioner());
 }
 BENCHMARK_TEMPLATE(BM_PushRelabel, BuildingGrid)->Name("BM_PushRelabelBuilding")
     ->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
@@ -139,19 +114,8 @@ BENCHMARK_TEMPLATE(BM_PushRelabel, FieldGrid)->Name("BM_PushRelabelField")
     ->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_Lp(benchmark::State& state) {
-  const Grid grid = BuildingGrid(state.range(0), 42);
-  int64_t ranks = 0;
-  for (auto _ : state) {
-    // GLPK cannot be interrupted: cap at 5 minutes.
-    auto p = LpPartitioner(300.0).Partition(grid, StopToken());
-    if (!p.ok()) {
-      state.SkipWithError(std::string(p.status().message()).c_str());
-      break;
-    }
-    ranks = static_cast<int64_t>(p->ranks.size());
-  }
-  state.counters["cells"] = static_cast<double>(grid.size());
-  state.counters["ranks"] = static_cast<double>(ranks);
+  // GLPK cannot be interrupted: cap at 5 minutes.
+  TimePartition(state, BuildingGrid(state.range(0), 42), LpPartitioner(300.0));
 }
 BENCHMARK(BM_Lp)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
