@@ -6,15 +6,17 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "planner/common/status_macros.h"
 
 namespace covplan {
 namespace {
 
 // Per-cell state bits. An arc runs from a cell to its neighbour in +col
 // (kArcCol) or +row (kArcRow); kFlowCol / kFlowRow say it carries its one
-// unit. A sink cell drains one unit to t (kSinkUsed once it has).
+// unit. A source cell gets one unit from s; a sink cell drains one unit to t
+// (kSinkUsed once it has). kQueued: in the FIFO of cells with excess.
 constexpr uint8_t kArcCol = 1, kArcRow = 2, kSink = 4, kFlowCol = 8, kFlowRow = 16, kSinkUsed = 32,
-                  kQueued = 64;
+                  kQueued = 64, kSource = 128;
 // The residual arcs out of a cell: its free arcs forward, and the arcs that
 // carry flow into it, backwards.
 enum Residual : int8_t { kNone = -1, kForwardCol, kForwardRow, kBackRow, kBackCol };
@@ -38,10 +40,10 @@ class GridFlow {
         ++free_cells_;
         uint8_t s = (next_col ? kArcCol : 0) | (next_row ? kArcRow : 0);
         // ranks = free - links + (cells linked in -col and +row) + max flow;
-        // see algorithms.md §2 for the unary terms that leave the sources and sinks.
+        // the header derives the terms.
         constant_ -= static_cast<int64_t>(next_col) + static_cast<int64_t>(next_row);
         if (prev_col && next_row) ++constant_;
-        if (next_row && !prev_col) excess_[i] = 1, sources_.push_back(i);
+        if (next_row && !prev_col) s |= kSource, excess_[i] = 1, sources_.push_back(i);
         if (prev_col && !next_row) s |= kSink, sinks_.push_back(i);
         state_[i] = s;
       }
@@ -56,12 +58,15 @@ class GridFlow {
 
   // Phase one of push-relabel: a maximum preflow. Returns the flow into t.
   absl::StatusOr<int64_t> MaxPreflow(const StopToken& stop) {
-    // On open ground every source may reach a sink along forward arcs alone
-    // (an empty lawn: one L-shaped path per row); a greedy pass then is the
-    // whole maximum flow. It stops at the first source it cannot route, and
-    // its flow is undone: elsewhere its long greedy paths cost more pushes
-    // to reroute than they save (docs/benchmarks.md §1d).
-    if (!GreedyRoutesEverySource()) UndoFlow();
+    // On open ground every source, or every sink, may be served along
+    // forward arcs alone (an empty lawn: nested L-shaped paths); a greedy
+    // pass then is a maximum flow, as no flow can exceed the sources' or the
+    // sinks' count. It stops at the first source it cannot route, and
+    // unless every sink is used by then its flow is undone: elsewhere its
+    // long greedy paths cost more pushes to reroute than they save
+    // (docs/benchmarks.md §1d).
+    ASSIGN_OR_RETURN(const bool every_source, GreedyRoutesEverySource(stop));
+    if (!every_source && flow_ < static_cast<int64_t>(sinks_.size())) UndoFlow();
     if (!GlobalRelabel(stop)) return Stopped();
     std::vector<int32_t> queue;
     for (int32_t i : sources_) {
@@ -126,20 +131,52 @@ class GridFlow {
 
   int64_t constant() const { return constant_; }
 
+  // Internal unless the preflow is feasible: flow only on arcs, at most the
+  // arc's one unit (a bit); into every cell as much as out of it plus its
+  // excess, which is never negative; and the units counted into t are the
+  // sinks used. The rank check after the cut is a proof of optimality only
+  // for a feasible flow.
+  absl::Status AuditFlow() const {
+    int64_t sinks_used = 0;
+    for (int32_t i = 0; i < n_; ++i) {
+      const uint8_t s = state_[i];
+      if (((s & kFlowCol) && !(s & kArcCol)) || ((s & kFlowRow) && !(s & kArcRow))) {
+        return absl::InternalError(absl::StrFormat("push-relabel: flow on a missing arc at cell %d", i));
+      }
+      if ((s & kSinkUsed) && !(s & kSink)) {
+        return absl::InternalError(absl::StrFormat("push-relabel: flow to t from a non-sink cell %d", i));
+      }
+      sinks_used += (s & kSinkUsed) != 0;
+      const int in = ((s & kSource) ? 1 : 0) + (i > 0 && (state_[i - 1] & kFlowCol) ? 1 : 0) +
+                     (i >= cols_ && (state_[i - cols_] & kFlowRow) ? 1 : 0);
+      const int out = ((s & kFlowCol) ? 1 : 0) + ((s & kFlowRow) ? 1 : 0) + ((s & kSinkUsed) ? 1 : 0);
+      if (excess_[i] < 0 || in - out != excess_[i]) {
+        return absl::InternalError(absl::StrFormat("push-relabel: flow not conserved at cell %d", i));
+      }
+    }
+    if (sinks_used != flow_) {
+      return absl::InternalError(
+          absl::StrFormat("push-relabel: %d units into t but %d sinks used", flow_, sinks_used));
+    }
+    return absl::OkStatus();
+  }
+
  private:
   // Routes the sources' units along free forward arcs (+row first, then
   // +col) to unused sinks by depth-first search; a cell found to lead to no
   // sink is marked and never entered again, so the pass is O(cells). False
   // at the first source it cannot route.
-  bool GreedyRoutesEverySource() {
+  absl::StatusOr<bool> GreedyRoutesEverySource(const StopToken& stop) {
     std::fill(seen_.begin(), seen_.end(), 0);  // dead ends
     auto dead = [&](int32_t u) { return (seen_[static_cast<uint32_t>(u) >> 6] >> (u & 63)) & 1; };
     std::vector<int32_t> path;
     std::vector<uint8_t> arcs;  // arcs[k]: kFlowCol or kFlowRow from path[k] to path[k + 1]
+    uint32_t steps = 0;
     for (int32_t src : sources_) {
       path.assign(1, src);
       arcs.clear();
       while (true) {
+        if ((++steps & kPollMask) == 0 && stop.ShouldStop()) return Stopped();
         if (path.empty()) return false;
         const int32_t u = path.back();
         if ((state_[u] & (kSink | kSinkUsed)) == kSink) {
@@ -242,7 +279,7 @@ class GridFlow {
   const int32_t cols_, n_;
   int32_t kInf_ = 0;
   std::vector<uint8_t> state_;
-  std::vector<int8_t> excess_;  // at most 3: a source unit and two arcs in
+  std::vector<int8_t> excess_;  // at most 2: two units in (a source cell has no -col arc)
   std::vector<int32_t> label_, sources_, sinks_, bfs_;
   std::vector<uint64_t> seen_;
   int64_t free_cells_ = 0, constant_ = 0, flow_ = 0;
@@ -254,18 +291,16 @@ absl::StatusOr<RankPartition> PushRelabelPartitioner::Partition(const Grid& grid
                                                                 const StopToken& stop) const {
   if (grid.size() == 0) return absl::InvalidArgumentError("grid is empty");
   if (grid.size() > INT32_MAX / 2) return absl::InvalidArgumentError("grid too large for push-relabel");
+  if (stop.ShouldStop()) return absl::DeadlineExceededError("partition stopped before push-relabel");
   GridFlow flow(grid);
   if (flow.free_cells() == 0) return absl::InvalidArgumentError("grid has no free cell");
-  absl::StatusOr<int64_t> value = flow.MaxPreflow(stop);
-  if (!value.ok()) return value.status();
-  absl::StatusOr<std::vector<uint8_t>> sink_side = flow.SinkSide(stop);
-  if (!sink_side.ok()) return sink_side.status();
-
+  ASSIGN_OR_RETURN(const int64_t value, flow.MaxPreflow(stop));
+  RETURN_IF_ERROR(flow.AuditFlow());
   RankPartition result;
-  result.orientation = *std::move(sink_side);
+  ASSIGN_OR_RETURN(result.orientation, flow.SinkSide(stop));
   for (uint8_t& o : result.orientation) o = o ? 0 : 1;  // sink side = H (0), source side = V (1)
   result.ranks = RanksFromOrientation(grid, result.orientation);
-  const int64_t optimum = flow.constant() + *value;
+  const int64_t optimum = flow.constant() + value;
   result.objective = static_cast<double>(optimum);
   if (static_cast<int64_t>(result.ranks.size()) != optimum) {
     return absl::InternalError(absl::StrFormat("push-relabel flow bound %d disagrees with %d ranks from the cut",

@@ -1,22 +1,35 @@
-// Exact minimum rank partition as the s-t minimum cut of algorithms.md §2,
-// solved by FIFO push-relabel with global relabelling on the grid itself.
+// Exact minimum rank partition as an s-t minimum cut, solved by FIFO
+// push-relabel with global relabelling on the grid itself.
 //
-// The cut graph of the partition is a planar DAG laid on the grid: every
-// arc joins a cell to its neighbour in +col or +row, each with capacity 1;
-// a cell linked in +row but not in -col is fed by the source, a cell linked
-// in -col but not in +row drains to the sink (mirror images of the arcs
-// MinCutPartitioner builds for Boost). Interior cells have no terminal arc,
-// so the flow, a few units per blocked cell, must cross open ground to reach
-// a sink: on an open field augmenting paths are hundreds to thousands of
-// cells long, which is what makes Boykov-Kolmogorov and the matching's
-// augmenting searches slow there (docs/benchmarks.md §1). Push-relabel moves
-// all excess at once along exact distance labels, recomputed by one
-// breadth-first search from the sinks every so often.
+// The cut graph. Write x_c = 1 when cell c is horizontal (H). The ranks of
+// an orientation are the free cells minus the links kept: a +col link a-b
+// is kept when both cells are H, a +row link when both are V. Per link,
+//   -[a H][b H]  = -[b H] + [a V][b H]    (+col link a -> b)
+//   -[a V][b V]  = -[a V] + [a V][b H]    (+row link a -> b)
+// so ranks = constant + sum of unary terms + sum over links of [a V][b H],
+// where constant = free cells - col links - row links + the cells linked in
+// both -col and +row, and a cell's unary terms cancel unless it is linked in
+// exactly one of them: [c H] if only in +row (an arc s -> c), [c V] if only
+// in -col (an arc c -> t). [a V][b H] is an arc a -> b, cut when a is on the
+// source side (V) and b on the sink side (H). Every arc has capacity 1 and
+// runs towards +col or +row: a planar DAG laid on the grid. (MinCutPartitioner
+// writes the same minimum with the opposite pair term, [a H][b V], for Boost;
+// algorithms.md §2 derives that one.)
 //
-// Nothing is built but a byte of state and a distance label per cell: the
-// arcs and their flow live in bit flags. The answer is checked before it is
-// returned: the ranks counted from the cut must equal the constant plus the
-// flow that reached the sink (weak duality), else Internal.
+// Interior cells have no terminal arc, so the flow, a few units per blocked
+// cell, must cross open ground to reach a sink: on an open field augmenting
+// paths are hundreds to thousands of cells long, which is what makes
+// Boykov-Kolmogorov and the matching's augmenting searches slow there
+// (docs/benchmarks.md §1). Push-relabel moves all excess at once along
+// exact distance labels, recomputed by one breadth-first search from the
+// sinks every n / 24 relabels.
+//
+// Memory: the arcs and their flow live in bit flags, one byte per cell, plus
+// the excess (1 byte), the label (4 bytes) and at most 8 bytes of queues per
+// cell. The answer is checked before it is returned: the flow is audited
+// (capacities, conservation, the units that reached t), and the ranks
+// counted from the cut must equal the constant plus that flow (weak
+// duality); else Internal.
 //
 //   PushRelabelPartitioner p;
 //   absl::StatusOr<RankPartition> part = p.Partition(grid, stop);

@@ -1,9 +1,11 @@
 // PushRelabelPartitioner (the cut graph by push-relabel on the grid) against
 // brute force, the LP, Boost's Boykov-Kolmogorov and the matching.
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <random>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -115,9 +117,9 @@ TEST(PushRelabelPartitioner, EqualsBoykovKolmogorovAndMatchingOnOpenFields) {
   }
 }
 
-// An empty lawn: every source reaches a sink along forward arcs, so the
-// greedy start is the whole flow; one post breaks that and the greedy flow
-// is undone.
+// An empty lawn: every source (wide lawns) or every sink (tall ones) is
+// served along forward arcs, so the greedy start is a maximum flow and is
+// kept; one post breaks that and the greedy flow is undone.
 TEST(PushRelabelPartitioner, OpenRectanglesWithAndWithoutAPost) {
   for (const auto& [rows, cols] : std::vector<std::pair<int, int>>{{1, 9}, {9, 1}, {2, 2}, {7, 30}, {30, 7}, {64, 64}, {120, 45}}) {
     Grid lawn = RandomGrid(rows, cols, 1.0, 1);
@@ -139,6 +141,20 @@ TEST(PushRelabelPartitioner, StopsWhenCancelledOrPastTheDeadline) {
   EXPECT_EQ(PushRelabelPartitioner().Partition(g, cancelled).status().code(), absl::StatusCode::kDeadlineExceeded);
   const StopToken late = StopToken::WithDeadline(absl::Now() - absl::Seconds(1));
   EXPECT_EQ(PushRelabelPartitioner().Partition(g, late).status().code(), absl::StatusCode::kDeadlineExceeded);
+}
+
+TEST(PushRelabelPartitioner, StopsWhenCancelledWhileRunning) {
+  // The 10^6 field takes hundreds of milliseconds (seconds under the
+  // sanitizers); it is cancelled 50 ms in, wherever it is by then.
+  Grid g = RandomGrid(1000, 1000, 0.99, 7);
+  StopToken stop;
+  std::thread canceller([stop]() mutable {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    stop.Cancel();
+  });
+  const absl::StatusCode code = PushRelabelPartitioner().Partition(g, stop).status().code();
+  canceller.join();
+  EXPECT_EQ(code, absl::StatusCode::kDeadlineExceeded);
 }
 
 TEST(PushRelabelPartitioner, StopsOnAShortDeadline) {

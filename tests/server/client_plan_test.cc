@@ -116,6 +116,33 @@ TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
   }
 }
 
+TEST(ClientPlanTest, PartitionFlagSelectsTheSolverAndTheDefaultIsPushRelabel) {
+  const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
+  const std::string out = (std::filesystem::temp_directory_path() /
+                           absl::StrCat("covplan_partition_flag_", ::getpid(), ".json"))
+                              .string();
+  auto solver_of = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"--map", map, "--local", "--tour", "greedy", "--out", out};
+    args.insert(args.end(), extra.begin(), extra.end());
+    EXPECT_EQ(RunPlanCommand(args), 0);
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    v1::PlanResponse r;
+    EXPECT_TRUE(google::protobuf::util::JsonStringToMessage(ss.str(), &r).ok());
+    return std::make_pair(r.stats().partition_solver(), r.stats().num_ranks());
+  };
+  const auto [default_solver, ranks] = solver_of({});
+  EXPECT_EQ(default_solver, "pushrelabel");
+  for (const char* name : {"pushrelabel", "matching", "mincut", "lp"}) {
+    const auto [solver, solver_ranks] = solver_of({"--partition", name});
+    EXPECT_EQ(solver, name);
+    EXPECT_EQ(solver_ranks, ranks) << name;
+  }
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--partition", "bk"}), 0);
+  std::filesystem::remove(out);
+}
+
 TEST(ClientPlanTest, StartAndEndPoseFlagsReachThePlanAndUnreachableCellsAreReported) {
   const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
   const std::string out = (std::filesystem::temp_directory_path() /

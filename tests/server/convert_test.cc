@@ -163,6 +163,13 @@ TEST(PlanRequestFromProtoTest, ValidatesRobotAndSolvers) {
   request.set_partition_solver(static_cast<v1::PartitionSolver>(42));
   EXPECT_THAT(PlanRequestFromProto(request), StatusIs(kInvalid, "partition_solver"));
 
+  // Unset, the planner's default solver: push-relabel.
+  request = RequestWithTool(0.5);
+  absl::StatusOr<PlanRequest> unset = PlanRequestFromProto(request);
+  ASSERT_TRUE(unset.ok()) << unset.status();
+  EXPECT_EQ(dynamic_cast<const OarpOptions*>(unset->options.get())->partition_solver,
+            PartitionSolver::kPushRelabel);
+
   request = RequestWithTool(0.5);
   request.set_partition_solver(v1::LP);
   request.set_tour_solver(v1::GREEDY);
