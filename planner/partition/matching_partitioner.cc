@@ -388,20 +388,12 @@ absl::StatusOr<RankPartition> MatchingPartitioner::Partition(const Grid& grid,
     return absl::InternalError(absl::StrFormat("König set has %d adjacencies, expected %d", kept, expected_kept));
   }
 
-  RankPartition result;
-  result.orientation.assign(grid.size(), 0);
+  std::vector<uint8_t> orientation(grid.size(), 0);
   for (int64_t i = 0; i < grid.size(); ++i) {
     if (held[i] == 3) return absl::InternalError("König set keeps an H and a V adjacency of one cell");
-    if (held[i] == 2) result.orientation[i] = 1;
+    if (held[i] == 2) orientation[i] = 1;
   }
-  result.ranks = RanksFromOrientation(grid, result.orientation);
-  const int64_t optimum = g.num_free - expected_kept;
-  result.objective = static_cast<double>(optimum);
-  if (static_cast<int64_t>(result.ranks.size()) != optimum) {
-    return absl::InternalError(absl::StrFormat("matching optimum %d disagrees with %d ranks from the cover",
-                                               optimum, result.ranks.size()));
-  }
-  return result;
+  return CheckedPartition(grid, std::move(orientation), g.num_free - expected_kept, "matching");
 }
 
 }  // namespace covplan

@@ -9,7 +9,6 @@
 #include <boost/property_map/property_map.hpp>
 #include <boost/range/iterator_range.hpp>
 
-#include "absl/strings/str_format.h"
 
 namespace covplan {
 namespace {
@@ -40,17 +39,6 @@ void ForEachArc(const Grid& grid, const std::vector<uint32_t>& node, uint32_t s,
       arc(below_free ? node[grid.Index(r - 1, c)] : s, v);
     }
   }
-}
-
-// Ranks from the cut, checked against the cut value (the LP optimum).
-absl::StatusOr<RankPartition> Finish(const Grid& grid, RankPartition result, int64_t cut_value) {
-  result.ranks = RanksFromOrientation(grid, result.orientation);
-  result.objective = static_cast<double>(cut_value);
-  if (static_cast<int64_t>(result.ranks.size()) != cut_value) {
-    return absl::InternalError(absl::StrFormat("min-cut value %d disagrees with %d ranks from the cut",
-                                               cut_value, result.ranks.size()));
-  }
-  return result;
 }
 
 }  // namespace
@@ -141,8 +129,7 @@ absl::StatusOr<RankPartition> MinCutPartitioner::Partition(const Grid& grid,
   auto vertex_index = boost::get(boost::vertex_index, g);
   std::vector<int32_t> residual(m, 0);
   int64_t flow = 0;
-  RankPartition result;
-  result.orientation.assign(grid.size(), 1);
+  std::vector<uint8_t> orientation(grid.size(), 1);
   {
     std::vector<EdgeDesc> predecessor(num_nodes);
     std::vector<boost::default_color_type> color(num_nodes);
@@ -156,10 +143,11 @@ absl::StatusOr<RankPartition> MinCutPartitioner::Partition(const Grid& grid,
         boost::make_iterator_property_map(distance.begin(), vertex_index), vertex_index, s, t);
     // Source side (black: reachable from s in the residual graph) = horizontal.
     for (int64_t i = 0; i < grid.size(); ++i) {
-      if (node[i] != kNone && color[node[i]] == boost::black_color) result.orientation[i] = 0;
+      if (node[i] != kNone && color[node[i]] == boost::black_color) orientation[i] = 0;
     }
   }
-  return Finish(grid, std::move(result), preflow + flow + constant);
+  // The cut value is the LP optimum.
+  return CheckedPartition(grid, std::move(orientation), preflow + flow + constant, "min-cut");
 }
 
 }  // namespace covplan

@@ -12,8 +12,10 @@
 #ifndef COVPLAN_PLANNER_PARTITION_PARTITIONER_H_
 #define COVPLAN_PLANNER_PARTITION_PARTITIONER_H_
 
+#include <cstdint>
 #include <memory>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "planner/common/stop_token.h"
@@ -34,6 +36,11 @@ class RankPartitioner {
 };
 
 std::unique_ptr<RankPartitioner> MakePartitioner(PartitionSolver solver);
+
+// The ranks of an exact solver's `orientation`, checked against the optimum
+// the solver proved: Internal, naming `solver`, if their counts differ.
+absl::StatusOr<RankPartition> CheckedPartition(const Grid& grid, std::vector<uint8_t> orientation,
+                                               int64_t optimum, std::string_view solver);
 
 }  // namespace covplan
 

@@ -296,17 +296,9 @@ absl::StatusOr<RankPartition> PushRelabelPartitioner::Partition(const Grid& grid
   if (flow.free_cells() == 0) return absl::InvalidArgumentError("grid has no free cell");
   ASSIGN_OR_RETURN(const int64_t value, flow.MaxPreflow(stop));
   RETURN_IF_ERROR(flow.AuditFlow());
-  RankPartition result;
-  ASSIGN_OR_RETURN(result.orientation, flow.SinkSide(stop));
-  for (uint8_t& o : result.orientation) o = o ? 0 : 1;  // sink side = H (0), source side = V (1)
-  result.ranks = RanksFromOrientation(grid, result.orientation);
-  const int64_t optimum = flow.constant() + value;
-  result.objective = static_cast<double>(optimum);
-  if (static_cast<int64_t>(result.ranks.size()) != optimum) {
-    return absl::InternalError(absl::StrFormat("push-relabel flow bound %d disagrees with %d ranks from the cut",
-                                               optimum, result.ranks.size()));
-  }
-  return result;
+  ASSIGN_OR_RETURN(std::vector<uint8_t> orientation, flow.SinkSide(stop));
+  for (uint8_t& o : orientation) o = o ? 0 : 1;  // sink side = H (0), source side = V (1)
+  return CheckedPartition(grid, std::move(orientation), flow.constant() + value, "push-relabel");
 }
 
 }  // namespace covplan
