@@ -120,13 +120,13 @@ class GridFlow {
     return flow_;
   }
 
-  // After MaxPreflow: 1 for cells that can still reach t in the residual
-  // graph (the sink side of a minimum cut, horizontal), else 0.
-  absl::StatusOr<std::vector<uint8_t>> SinkSide(const StopToken& stop) {
+  // After MaxPreflow, the orientation of a minimum cut: H (0) for the cells
+  // that can still reach t in the residual graph (the sink side), else V (1).
+  absl::StatusOr<std::vector<uint8_t>> CutOrientation(const StopToken& stop) {
     if (!GlobalRelabel(stop)) return Stopped();
-    std::vector<uint8_t> side(n_, 0);
-    for (int32_t i = 0; i < n_; ++i) side[i] = label_[i] < kInf_;
-    return side;
+    std::vector<uint8_t> orientation(n_, 0);
+    for (int32_t i = 0; i < n_; ++i) orientation[i] = label_[i] < kInf_ ? 0 : 1;
+    return orientation;
   }
 
   int64_t constant() const { return constant_; }
@@ -167,8 +167,7 @@ class GridFlow {
   // sink is marked and never entered again, so the pass is O(cells). False
   // at the first source it cannot route.
   absl::StatusOr<bool> GreedyRoutesEverySource(const StopToken& stop) {
-    std::fill(seen_.begin(), seen_.end(), 0);  // dead ends
-    auto dead = [&](int32_t u) { return (seen_[static_cast<uint32_t>(u) >> 6] >> (u & 63)) & 1; };
+    std::fill(seen_.begin(), seen_.end(), 0);  // here: cells that lead to no sink
     std::vector<int32_t> path;
     std::vector<uint8_t> arcs;  // arcs[k]: kFlowCol or kFlowRow from path[k] to path[k + 1]
     uint32_t steps = 0;
@@ -185,12 +184,12 @@ class GridFlow {
           break;
         }
         const uint8_t s = state_[u];
-        if ((s & (kArcRow | kFlowRow)) == kArcRow && !dead(u + cols_)) {
+        if ((s & (kArcRow | kFlowRow)) == kArcRow && !Seen(u + cols_)) {
           path.push_back(u + cols_), arcs.push_back(kFlowRow);
-        } else if ((s & (kArcCol | kFlowCol)) == kArcCol && !dead(u + 1)) {
+        } else if ((s & (kArcCol | kFlowCol)) == kArcCol && !Seen(u + 1)) {
           path.push_back(u + 1), arcs.push_back(kFlowCol);
         } else {
-          seen_[static_cast<uint32_t>(u) >> 6] |= uint64_t{1} << (u & 63);
+          MarkSeen(u);
           path.pop_back();
           if (!arcs.empty()) arcs.pop_back();
         }
@@ -240,6 +239,10 @@ class GridFlow {
     return v;
   }
 
+  // One bit per cell in `seen_`, for the pass at hand.
+  bool Seen(int32_t u) const { return (seen_[static_cast<uint32_t>(u) >> 6] >> (u & 63)) & 1; }
+  void MarkSeen(int32_t u) { seen_[static_cast<uint32_t>(u) >> 6] |= uint64_t{1} << (u & 63); }
+
   // Exact distances to t in the residual graph, by one breadth-first search
   // backwards from the unused sinks; kInf_ where t is out of reach. Visited
   // marks live in a bitmap (n / 8 bytes, cache resident) and the queue is
@@ -250,9 +253,7 @@ class GridFlow {
     std::fill(seen_.begin(), seen_.end(), 0);
     bfs_.clear();
     auto reach = [&](int32_t u) {
-      uint64_t& word = seen_[static_cast<uint32_t>(u) >> 6];
-      const uint64_t bit = uint64_t{1} << (u & 63);
-      if (!(word & bit)) word |= bit, bfs_.push_back(u);
+      if (!Seen(u)) MarkSeen(u), bfs_.push_back(u);
     };
     for (int32_t i : sinks_) {
       if (!(state_[i] & kSinkUsed)) reach(i);
@@ -296,8 +297,7 @@ absl::StatusOr<RankPartition> PushRelabelPartitioner::Partition(const Grid& grid
   if (flow.free_cells() == 0) return absl::InvalidArgumentError("grid has no free cell");
   ASSIGN_OR_RETURN(const int64_t value, flow.MaxPreflow(stop));
   RETURN_IF_ERROR(flow.AuditFlow());
-  ASSIGN_OR_RETURN(std::vector<uint8_t> orientation, flow.SinkSide(stop));
-  for (uint8_t& o : orientation) o = o ? 0 : 1;  // sink side = H (0), source side = V (1)
+  ASSIGN_OR_RETURN(std::vector<uint8_t> orientation, flow.CutOrientation(stop));
   return CheckedPartition(grid, std::move(orientation), flow.constant() + value, "push-relabel");
 }
 
