@@ -112,8 +112,9 @@ absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanReque
   return r;
 }
 
-absl::Status PlanningEngine::Setup(const MapSource& source, const PlanRequest& request,
-                                   const Resolved& resolved, PlanContext* ctx, bool* all_cached) const {
+absl::StatusOr<bool> PlanningEngine::Setup(const MapSource& source, const PlanRequest& request,
+                                           const Resolved& resolved, ArtifactUse use, PlanContext* ctx,
+                                           bool* all_cached) const {
   const CommonOptions& common = request.common;
   GridOptions grid_options;
   grid_options.cell_size = common.robot.tool_width_m;
@@ -123,28 +124,39 @@ absl::Status PlanningEngine::Setup(const MapSource& source, const PlanRequest& r
       source.map_id, "grid",
       absl::StrFormat("cell=%.9g;minfree=%.9g", grid_options.cell_size, grid_options.min_free_fraction));
   bool hit = false;
-  ASSIGN_OR_RETURN(std::shared_ptr<const GridArtifact> grid,
-                   GetOrBuild(*cache_, grid_key, common.stop,
-                              [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const GridArtifact>> {
-                                if (!source.load) return absl::InternalError("map source without loader");
-                                ASSIGN_OR_RETURN(SiteMap site, source.load());
-                                return BuildGridArtifact(site, grid_options);
-                              },
-                              &hit));
-  *all_cached = *all_cached && hit;
+  std::shared_ptr<const GridArtifact> grid;
+  if (use == ArtifactUse::kCachedOnly) {
+    grid = std::dynamic_pointer_cast<const GridArtifact>(cache_->Find(grid_key.text()));
+    if (grid == nullptr) return false;
+  } else {
+    ASSIGN_OR_RETURN(grid,
+                     GetOrBuild(*cache_, grid_key, common.stop,
+                                [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const GridArtifact>> {
+                                  if (!source.load) return absl::InternalError("map source without loader");
+                                  ASSIGN_OR_RETURN(SiteMap site, source.load());
+                                  return BuildGridArtifact(site, grid_options);
+                                },
+                                &hit));
+    *all_cached = *all_cached && hit;
+  }
   const Grid& g = *grid->grid;
   const Point2 lo = g.origin();
   const Point2 hi{lo.x + g.cols() * g.cell_size(), lo.y + g.rows() * g.cell_size()};
   RETURN_IF_ERROR(CheckInsideMap(request.regions, "regions", lo, hi));
   RETURN_IF_ERROR(CheckInsideMap(request.no_go, "no_go", lo, hi));
   const auto area_key = grid_key.Derive<CoverageArea>("area", resolved.zones.CacheText());
-  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area,
-                   GetOrBuild(*cache_, area_key, common.stop,
-                              [&](const StopToken&) {
-                                return BuildCoverageArea(*grid, resolved.zones, common.min_free_fraction);
-                              },
-                              &hit));
-  *all_cached = *all_cached && hit;
+  std::shared_ptr<const CoverageArea> area;
+  if (use == ArtifactUse::kCachedOnly) {
+    area = std::dynamic_pointer_cast<const CoverageArea>(cache_->Find(area_key.text()));
+    if (area == nullptr) return false;
+  } else {
+    ASSIGN_OR_RETURN(area, GetOrBuild(*cache_, area_key, common.stop,
+                                      [&](const StopToken&) {
+                                        return BuildCoverageArea(*grid, resolved.zones, common.min_free_fraction);
+                                      },
+                                      &hit));
+    *all_cached = *all_cached && hit;
+  }
   ctx->common = &request.common;
   ctx->options = resolved.options.get();
   ctx->area = std::move(area);
@@ -152,14 +164,14 @@ absl::Status PlanningEngine::Setup(const MapSource& source, const PlanRequest& r
   ctx->cache = cache_;
   ctx->limits = limits_;
   ctx->all_cached = all_cached;
-  return absl::OkStatus();
+  return true;
 }
 
 absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest& request) const {
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
   PlanContext ctx;
   bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  RETURN_IF_ERROR(Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
   return resolved.planner->Prepare(ctx);
 }
 
@@ -168,7 +180,7 @@ absl::StatusOr<std::shared_ptr<const CoverageArea>> PlanningEngine::AreaFor(
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
   PlanContext ctx;
   bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  RETURN_IF_ERROR(Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
   return ctx.area;
 }
 
@@ -233,19 +245,58 @@ absl::Status PlanningEngine::Finish(const PlanRequest& request, const Resolved& 
   return absl::OkStatus();
 }
 
+namespace {
+
+// A battery tour starts and ends at the station unless told otherwise.
+PlanRequest WithStationPoses(const PlanRequest& original) {
+  PlanRequest request = original;
+  if (request.battery.has_value()) {
+    if (!request.common.robot.start) request.common.robot.start = request.battery->station;
+    if (!request.common.robot.end) request.common.robot.end = request.battery->station;
+  }
+  return request;
+}
+
+// True when `remembered` is the answer to `request` without a search.
+bool AnswersAtOnce(const RememberedPlan* remembered, const PlanRequest& request) {
+  return remembered != nullptr && !request.improve_remembered &&
+         remembered->Answers(request.common.time_limit_s);
+}
+
+}  // namespace
+
+PlanMemoryKeys PlanningEngine::MemoryKeys(const PlanRequest& request, const Resolved& resolved,
+                                          const PlanContext& ctx) const {
+  return PlanMemoryKeysFor(ctx.area_key, resolved.planner->name(), *resolved.options, request.common,
+                           request.battery);
+}
+
+absl::StatusOr<std::optional<Recalled>> PlanningEngine::Recall(const MapSource& source,
+                                                               const PlanRequest& original) const {
+  if (!limits_.plan_memory || original.improve_remembered) return std::nullopt;
+  const absl::Time t0 = absl::Now();
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
+  const PlanRequest request = WithStationPoses(original);
+  PlanContext ctx;
+  bool all_cached = true;
+  ASSIGN_OR_RETURN(const bool cached,
+                   Setup(source, request, resolved, ArtifactUse::kCachedOnly, &ctx, &all_cached));
+  if (!cached) return std::nullopt;
+  if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
+  std::shared_ptr<const RememberedPlan> entry =
+      FindRemembered<RememberedPlan>(*cache_, MemoryKeys(request, resolved, ctx).exact);
+  if (!AnswersAtOnce(entry.get(), request)) return std::nullopt;
+  return Recalled{std::move(entry), std::move(ctx.area), absl::ToDoubleMilliseconds(absl::Now() - t0)};
+}
+
 absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
                                                   const PlanRequest& original) const {
   const absl::Time t0 = absl::Now();
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
-  PlanRequest request = original;
-  if (request.battery.has_value()) {
-    // A battery tour starts and ends at the station.
-    if (!request.common.robot.start) request.common.robot.start = request.battery->station;
-    if (!request.common.robot.end) request.common.robot.end = request.battery->station;
-  }
+  PlanRequest request = WithStationPoses(original);
   PlanContext ctx;
   bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, &ctx, &all_cached));
+  RETURN_IF_ERROR(Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
   if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
 
   // Remembered plans (plan_memory.h).
@@ -254,11 +305,9 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   std::shared_ptr<const RememberedTour> remembered_tour;
   PlanOrigin plan_source = PlanOrigin::kCold;
   if (limits_.plan_memory) {
-    keys = PlanMemoryKeysFor(ctx.area_key, resolved.planner->name(), *resolved.options, request.common,
-                             request.battery);
+    keys = MemoryKeys(request, resolved, ctx);
     remembered = FindRemembered<RememberedPlan>(*cache_, keys->exact);
-    if (remembered != nullptr && !request.improve_remembered &&
-        remembered->Answers(request.common.time_limit_s)) {
+    if (AnswersAtOnce(remembered.get(), request)) {
       // Copied outside the cache's lock; the entry itself stays shared.
       EngineResult hit{remembered->plan, ctx.area, remembered};
       hit.plan.grid = ctx.area->drive;

@@ -87,7 +87,8 @@ struct RetainedPlan {
   size_t MemoryBytes() const { return sizeof(*this) + plan.MemoryBytes(); }
 };
 
-class RememberedPlan;  // plan_memory.h
+class RememberedPlan;   // plan_memory.h
+struct PlanMemoryKeys;  // plan_memory.h
 
 struct EngineResult {
   CoveragePlan plan;
@@ -98,12 +99,30 @@ struct EngineResult {
   std::shared_ptr<const RememberedPlan> answered_by;
 };
 
+// A remembered answer found by PlanningEngine::Recall.
+struct Recalled {
+  // The answer, statistics filled; its plan has no grid (`area` holds it)
+  // and is not copied: entries are immutable.
+  std::shared_ptr<const RememberedPlan> entry;
+  std::shared_ptr<const CoverageArea> area;
+  double lookup_ms = 0.0;  // the look-up's own time
+};
+
 class PlanningEngine {
  public:
   PlanningEngine(const PlannerRegistry* registry, ArtifactCache* cache, EngineLimits limits)
       : registry_(registry), cache_(cache), limits_(limits) {}
 
   absl::StatusOr<EngineResult> Plan(const MapSource& source, const PlanRequest& request) const;
+  // The plan Plan would answer at once from memory ("cache_hit"), found
+  // without loading the map, building an artifact, searching or copying
+  // the plan; it marks the entries used, as Plan does. nullopt when Plan
+  // would have to do any of that: plan memory off, improve_remembered, an
+  // artifact not cached, no remembered plan, or one that does not answer
+  // this time limit. A request Plan would refuse is refused alike (or, when
+  // the refusal needs the map, nullopt). Cheap enough for a server's
+  // network thread.
+  absl::StatusOr<std::optional<Recalled>> Recall(const MapSource& source, const PlanRequest& request) const;
   // Builds every per-map artifact `request` needs, without planning.
   absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
   // The coverage area `request` plans on (validated like Plan), e.g. to
@@ -121,8 +140,12 @@ class PlanningEngine {
     AreaZones zones;
   };
   absl::StatusOr<Resolved> Resolve(const PlanRequest& request) const;
-  absl::Status Setup(const MapSource& source, const PlanRequest& request, const Resolved& resolved,
-                     PlanContext* ctx, bool* all_cached) const;
+  enum class ArtifactUse { kBuild, kCachedOnly };
+  // Finds (or with kBuild, builds) the grid and coverage area of `request`
+  // and fills `ctx`. False with kCachedOnly when one is not cached.
+  absl::StatusOr<bool> Setup(const MapSource& source, const PlanRequest& request, const Resolved& resolved,
+                             ArtifactUse use, PlanContext* ctx, bool* all_cached) const;
+  PlanMemoryKeys MemoryKeys(const PlanRequest& request, const Resolved& resolved, const PlanContext& ctx) const;
   // Path checks and path-derived statistics of a planner's result.
   absl::Status Finish(const PlanRequest& request, const Resolved& resolved, const CoverageArea& area,
                       bool all_cached, CoveragePlan* plan) const;

@@ -5,11 +5,13 @@
 // the same seed gives the same plan.
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gtest/gtest.h"
 #include "planner/engine/engine.h"
+#include "planner/engine/plan_memory.h"
 #include "planner/oarp/oarp_planner.h"
 #include "tests/testing/plan_conformance.h"
 #include "tests/testing/shipped_maps.h"
@@ -233,9 +235,16 @@ TEST_F(PlanMemoryTest, TimeLimitedPlanAnswersNoLongerBudgetAndImprovesWithMore) 
   r.common.time_limit_s = 0.2;
   const EngineResult timed = MustPlan(engine, r);
   ASSERT_EQ(timed.plan.termination.limit, TerminationLimit::kTime);
+  const auto recalled = [&] {
+    absl::StatusOr<std::optional<Recalled>> found = engine.Recall(Source(), r);
+    EXPECT_TRUE(found.ok()) << found.status();
+    return found.ok() && found->has_value();
+  };
   r.common.time_limit_s = 0.1;
+  EXPECT_TRUE(recalled());
   EXPECT_EQ(MustPlan(engine, r).plan.stats.plan_source, PlanOrigin::kCacheHit);
   r.common.time_limit_s = 0.4;
+  EXPECT_FALSE(recalled());  // more time than it was searched for: Plan searches on
   const EngineResult more = MustPlan(engine, r);
   EXPECT_EQ(more.plan.stats.plan_source, PlanOrigin::kImproved);
   EXPECT_LE(more.plan.stats.estimated_duration_s, timed.plan.stats.estimated_duration_s);
@@ -243,6 +252,69 @@ TEST_F(PlanMemoryTest, TimeLimitedPlanAnswersNoLongerBudgetAndImprovesWithMore) 
   const EngineResult hit = MustPlan(engine, r);
   EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
   ExpectSamePath(more.plan, hit.plan);
+}
+
+// Recall finds what Plan would answer at once, and nothing else, without
+// loading the map or building anything.
+TEST_F(PlanMemoryTest, RecallFindsExactlyWhatPlanAnswersAtOnce) {
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry_, &cache, EngineLimits{});
+  int loads = 0;
+  MapSource counted = Source();
+  counted.load = [&, load = counted.load] { ++loads; return load(); };
+
+  absl::StatusOr<std::optional<Recalled>> none = engine.Recall(counted, Request());
+  ASSERT_TRUE(none.ok()) << none.status();
+  EXPECT_FALSE(none->has_value());
+  EXPECT_EQ(loads, 0);
+  // Nothing was built: the first plan still builds the grid.
+  absl::StatusOr<EngineResult> cold = engine.Plan(counted, Request());
+  ASSERT_TRUE(cold.ok()) << cold.status();
+  EXPECT_EQ(loads, 1);
+  EXPECT_FALSE(cold->plan.stats.decomposition_cached);
+
+  PlanRequest again = Request();
+  again.common.time_limit_s = 5;
+  absl::StatusOr<std::optional<Recalled>> recalled = engine.Recall(counted, again);
+  ASSERT_TRUE(recalled.ok()) << recalled.status();
+  ASSERT_TRUE(recalled->has_value());
+  const Recalled& r = **recalled;
+  ExpectSamePath(cold->plan, r.entry->plan);
+  EXPECT_EQ(r.area.get(), cold->area.get());
+  EXPECT_GE(r.lookup_ms, 0.0);
+  const EngineResult hit = MustPlan(engine, again);
+  EXPECT_EQ(hit.plan.stats.plan_source, PlanOrigin::kCacheHit);
+  EXPECT_EQ(hit.answered_by.get(), r.entry.get());
+  EXPECT_EQ(loads, 1);
+
+  // What Plan would search for is not recalled.
+  PlanRequest improve = Request();
+  improve.improve_remembered = true;
+  PlanRequest seed = Request();
+  seed.common.seed = 4;
+  PlanRequest tool = Request();
+  tool.common.robot.tool_width_m = 0.7;  // another grid, not cached
+  for (const PlanRequest& other : {improve, seed, tool}) {
+    absl::StatusOr<std::optional<Recalled>> miss = engine.Recall(counted, other);
+    ASSERT_TRUE(miss.ok()) << miss.status();
+    EXPECT_FALSE(miss->has_value());
+  }
+  EXPECT_EQ(loads, 1);
+  // Bad input is refused as Plan refuses it.
+  PlanRequest bad = Request();
+  bad.common.time_limit_s = -1;
+  EXPECT_EQ(engine.Recall(counted, bad).status().code(), absl::StatusCode::kInvalidArgument);
+  bad = Request();
+  bad.regions = {{{{100, 100}, {101, 100}, {101, 101}, {100, 100}}, {}}};  // outside the map
+  EXPECT_EQ(engine.Recall(counted, bad).status().code(), absl::StatusCode::kInvalidArgument);
+
+  // Without plan memory nothing is recalled.
+  EngineLimits forgetful;
+  forgetful.plan_memory = false;
+  PlanningEngine without(&registry_, &cache, forgetful);
+  absl::StatusOr<std::optional<Recalled>> off = without.Recall(counted, Request());
+  ASSERT_TRUE(off.ok()) << off.status();
+  EXPECT_FALSE(off->has_value());
 }
 
 TEST_F(PlanMemoryTest, BadInputIsStillInvalidArgumentWhenAPlanIsRemembered) {
