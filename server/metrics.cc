@@ -65,6 +65,9 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                              "search on from it (improved), search from a remembered tour (warm_start)")
                        .Register(r);
   for (const char* s : {"cold", "cache_hit", "improved", "warm_start"}) plan_sources_->Add({{"source", s}});
+  hits_without_worker_ = NewCounter(r, "covplan_plan_hits_without_worker_total",
+                                    "Repeated cache hits answered on the network thread, without a worker "
+                                    "(also counted as cache_hit in covplan_plan_source_total)");
   replan_duration_ = &prometheus::BuildHistogram()
                           .Name("covplan_replan_duration_seconds")
                           .Help("Compute time of one replan")

@@ -56,6 +56,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Gauge& drive_sessions() { return *drive_sessions_; }
   prometheus::Counter& drive_superseded() { return *drive_superseded_; }
   prometheus::Gauge& store_writable() { return *store_writable_; }
+  prometheus::Counter& hits_without_worker() { return *hits_without_worker_; }
 
   // CacheObserver.
   void OnCacheHit() override { cache_hits_->Increment(); }
@@ -89,6 +90,7 @@ class ServerMetrics : public CacheObserver {
   prometheus::Family<prometheus::Gauge>* estimator_;
   prometheus::Gauge* drive_sessions_;
   prometheus::Counter* drive_superseded_;
+  prometheus::Counter* hits_without_worker_;
 };
 
 }  // namespace covplan

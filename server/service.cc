@@ -18,6 +18,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "planner/common/status_macros.h"
+#include "planner/engine/plan_memory.h"
 #include "planner/grid/grid.h"
 #include "server/log.h"
 #include "server/request_limits.h"
@@ -614,10 +615,10 @@ void CoveragePlannerService::WarmInBackground(const MapSource& source, PlanReque
   }
 }
 
-absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
-                                             const StopToken& cancel, v1::PlanResponse* response,
-                                             std::shared_ptr<const ServedBody>* served) {
-  const absl::Time start = absl::Now();
+absl::StatusOr<PlanRequest> CoveragePlannerService::EngineRequestFor(const CallInfo& call,
+                                                                     const v1::PlanRequest& request,
+                                                                     const StopToken& cancel,
+                                                                     absl::Time start) const {
   if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
   ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
@@ -647,7 +648,11 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   }
   options.time_limit_s = std::max(budget_s, 1e-3);
   options.stop = stop;
+  return plan_request;
+}
 
+absl::StatusOr<MapSource> CoveragePlannerService::PlanMapSource(const CallInfo& call,
+                                                                const v1::PlanRequest& request) {
   std::string map_id;
   std::shared_ptr<const v1::Map> inline_map;
   switch (request.map_ref_case()) {
@@ -667,7 +672,16 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     default:
       return absl::InvalidArgumentError("PlanRequest needs map_id or an inline map");
   }
-  const MapSource source = SourceFor(map_id, inline_map);
+  return SourceFor(map_id, inline_map);
+}
+
+absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
+                                             const StopToken& cancel, v1::PlanResponse* response,
+                                             std::shared_ptr<const ServedBody>* served) {
+  const absl::Time start = absl::Now();
+  ASSIGN_OR_RETURN(PlanRequest plan_request, EngineRequestFor(call, request, cancel, start));
+  ASSIGN_OR_RETURN(const MapSource source, PlanMapSource(call, request));
+  const std::string& map_id = source.map_id;
   absl::StatusOr<EngineResult> result = engine_.Plan(source, plan_request);
   if (!result.ok()) {
     if (IsStop(result.status()) && !cancel.cancelled() && call.deadline != absl::InfiniteFuture()) {
@@ -684,7 +698,7 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
                : result.status();
   }
   if (result->answered_by != nullptr) {
-    if (std::shared_ptr<const ServedBody> reply = ServedHitReply(call.tenant_tag, *result)) {
+    if (std::shared_ptr<const ServedBody> reply = ServedHitReply(call.tenant_tag, result->answered_by)) {
       *served = std::move(reply);
       response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
       response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
@@ -715,6 +729,33 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
     RememberServedHit(call.tenant_tag, *result, *response);
   }
   return absl::OkStatus();
+}
+
+bool CoveragePlannerService::ServeRecalledHit(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
+                                              const v1::PlanRequest& request, const StopToken& cancel,
+                                              grpc::ByteBuffer* response_bytes) {
+  const absl::Time start = absl::Now();
+  absl::StatusOr<PlanRequest> plan_request = EngineRequestFor(call, request, cancel, start);
+  if (!plan_request.ok()) return false;
+  absl::StatusOr<MapSource> source = PlanMapSource(call, request);
+  if (!source.ok()) return false;
+  absl::StatusOr<std::optional<Recalled>> recalled = engine_.Recall(*source, *plan_request);
+  if (!recalled.ok() || !recalled->has_value()) return false;
+  std::shared_ptr<const ServedBody> served = ServedHitReply(call.tenant_tag, (*recalled)->entry);
+  if (served == nullptr) return false;
+  // As RunPlan answers a repeated hit: the served bytes, then this call's stats.
+  PlanStats stats = (*recalled)->entry->plan.stats;
+  stats.plan_source = PlanOrigin::kCacheHit;
+  stats.planning_ms = (*recalled)->lookup_ms;
+  stats.decomposition_cached = true;
+  v1::PlanResponse response;
+  response.mutable_stats()->set_planning_ms(stats.planning_ms);
+  response.mutable_stats()->set_decomposition_cached(true);
+  RecordPlanSolve(start, stats);
+  metrics_->hits_without_worker().Increment();
+  const std::string detail = absl::StrCat(served->detail, " cached=1");
+  FinishCall(reactor, call, SerializePlanReply(response, std::move(served), response_bytes), detail);
+  return true;
 }
 
 void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& stats) {
@@ -754,13 +795,13 @@ absl::Duration ExpectedQueueWait(int ahead, int hits_ahead, int workers, absl::D
 }
 
 std::shared_ptr<const CoveragePlannerService::ServedBody> CoveragePlannerService::ServedHitReply(
-    const std::string& tenant_tag, const EngineResult& hit) {
+    const std::string& tenant_tag, const std::shared_ptr<const RememberedPlan>& entry) {
   std::string plan_id;
   std::shared_ptr<const ServedBody> reply;
   {
     absl::MutexLock lock(&served_mu_);
-    auto it = served_.find(ServedHitKey(tenant_tag, hit.answered_by.get()));
-    if (it == served_.end() || it->second.entry.lock() != hit.answered_by) return nullptr;
+    auto it = served_.find(ServedHitKey(tenant_tag, entry.get()));
+    if (it == served_.end() || it->second.entry.lock() != entry) return nullptr;
     plan_id = it->second.plan_id;
     reply = it->second.reply;
   }
@@ -828,16 +869,6 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     FinishCall(reactor, call, s);
     return reactor;
   }
-  const auto reject = [&] {
-    FinishCall(reactor, call,
-               absl::ResourceExhaustedError(absl::StrFormat(
-                   "server busy: %d workers and a queue of %d are full; retry later",
-                   options_.worker_threads, options_.max_queue)));
-  };
-  if (!TryAdmitSolve()) {
-    reject();
-    return reactor;
-  }
   // The request's bytes, tagged with the tenant: a repeat of a request that
   // was answered from memory is expected to be answered from memory again
   // (only requests by map id, which are small, are remembered).
@@ -854,6 +885,21 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
     }
   }
   const bool likely_hit = hit_key.has_value() && IsHitRequest(*hit_key);
+  // A repeat whose reply was served before takes microseconds: answered
+  // here, it neither waits behind searches nor costs a thread hand-off.
+  if (likely_hit && ServeRecalledHit(reactor, call, *request, reactor->cancel(), response_bytes)) {
+    return reactor;
+  }
+  const auto reject = [&] {
+    FinishCall(reactor, call,
+               absl::ResourceExhaustedError(absl::StrFormat(
+                   "server busy: %d workers and a queue of %d are full; retry later",
+                   options_.worker_threads, options_.max_queue)));
+  };
+  if (!TryAdmitSolve()) {
+    reject();
+    return reactor;
+  }
   const int hits_ahead = likely_hit ? admitted_hits_.fetch_add(1) : admitted_hits_.load();
   const auto release = [this, likely_hit] {
     if (likely_hit) admitted_hits_.fetch_sub(1);

@@ -182,6 +182,21 @@ class CoveragePlannerService final
   // concatenated messages).
   absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request, const StopToken& cancel,
                        v1::PlanResponse* response, std::shared_ptr<const ServedBody>* served);
+  // RunPlan's first steps. The engine request of a Plan call started at
+  // `start`: its time budget is the request's limit (or the default),
+  // capped by the call's deadline minus the reply margin.
+  absl::StatusOr<PlanRequest> EngineRequestFor(const CallInfo& call, const v1::PlanRequest& request,
+                                               const StopToken& cancel, absl::Time start) const;
+  // Where a Plan call's map comes from: a stored map the tenant owns, or the
+  // inline one.
+  absl::StatusOr<MapSource> PlanMapSource(const CallInfo& call, const v1::PlanRequest& request);
+  // A repeated hit answered on the network thread, without a worker: when
+  // the engine recalls the remembered plan at once (PlanningEngine::Recall)
+  // and its reply was served before, that reply is sent and true returned.
+  // Otherwise nothing is sent and the call goes to the worker pool as usual.
+  bool ServeRecalledHit(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
+                        const v1::PlanRequest& request, const StopToken& cancel,
+                        grpc::ByteBuffer* response_bytes);
   void UpdateQueueGauges();
   // Whether the request with this key (a hash of the tenant and the request
   // bytes) was answered from memory last time, and recording whether it was.
@@ -193,7 +208,7 @@ class CoveragePlannerService final
   // remembered entry to this tenant, if that plan is still retained; else
   // null. RememberServedHit records a reply for the next ones.
   std::shared_ptr<const ServedBody> ServedHitReply(const std::string& tenant_tag,
-                                                   const EngineResult& hit);
+                                                   const std::shared_ptr<const RememberedPlan>& entry);
   void RememberServedHit(const std::string& tenant_tag, const EngineResult& hit,
                          const v1::PlanResponse& reply);
   // The Replan work proper (runs on a worker).

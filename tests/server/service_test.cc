@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/remote.h"
 #include "gmock/gmock.h"
@@ -50,7 +51,8 @@ class ServiceTest : public ::testing::Test {
     // only the metrics test starts it.
     config.metrics_port = with_metrics_ ? 0 : -1;
     config.store_dir = dir_ + "/maps";
-    config.service.worker_threads = 2;
+    config.service.worker_threads = worker_threads_;
+    config.service.max_queue = max_queue_;
     config.service.limits.max_image_bytes = 1 << 20;
     config.service.limits.max_map_pixels = 1'000'000;
     config.service.limits.max_ranks = max_ranks_;
@@ -97,6 +99,8 @@ class ServiceTest : public ::testing::Test {
   }
 
   bool with_metrics_ = false;
+  int worker_threads_ = 2;
+  int max_queue_ = ServiceOptions().max_queue;
   int64_t max_ranks_ = 1000;
   int64_t dense_transition_bytes_ = InputLimits().dense_transition_bytes;
   absl::Duration max_request_time_ = absl::Seconds(120);
@@ -575,6 +579,81 @@ TEST_F(ServiceTest, ABurstOfHitsAfterAColdSolveIsNotRefused) {
   }
   for (std::thread& caller : callers) caller.join();
   for (const grpc::Status& status : statuses) EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+// A repeat of a hit whose reply was served before is answered on the
+// network thread: while the only worker is busy and the queue holds
+// nothing, searches are refused but repeated hits are still answered.
+class OneWorkerServiceTest : public ServiceTest {
+ protected:
+  OneWorkerServiceTest() {
+    worker_threads_ = 1;
+    max_queue_ = 0;
+    with_metrics_ = true;
+    max_ranks_ = 5000;
+  }
+};
+
+TEST_F(OneWorkerServiceTest, RepeatedHitsAreAnsweredWhileTheWorkerIsBusy) {
+  const std::string map_id = PutTwoRooms();
+  v1::PlanResponse cold, first;
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &cold).ok());
+  ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &first).ok());  // its reply is kept for the repeats
+  ASSERT_EQ(first.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(RasterMap(AsciiToPgm(testing::PillarField(240, 180, 600, 5), 4), 0.025), &put).ok());
+  const auto metrics = [&] {
+    absl::StatusOr<std::string> body = testing::HttpGet(server_->metrics_port(), "/metrics");
+    return body.ok() ? *body : std::string();
+  };
+
+  // A long search on the worker: a cold plan of 600 pillars at a 5 cm tool,
+  // cancelled once the checks are done.
+  grpc::ClientContext busy_context;
+  busy_context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  std::thread busy([&] {
+    v1::PlanRequest request = PlanRequestFor(put.map_id(), 0.05);
+    request.set_time_limit_s(30);
+    v1::PlanResponse response;
+    stub_->Plan(&busy_context, request, &response);
+  });
+  bool running = false;
+  for (int i = 0; i < 1000 && !running; ++i) {
+    running = absl::StrContains(metrics(), "\ncovplan_solves_in_flight 1\n");
+    if (!running) absl::SleepFor(absl::Milliseconds(10));
+  }
+  // A search is refused: the worker is busy and the queue holds none.
+  const auto refused = [&] {
+    v1::PlanResponse response;
+    return Plan(PlanRequestFor(map_id, 0.3), &response).error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
+  };
+  const bool refused_before = running && refused();
+  constexpr int kRepeats = 20;
+  std::vector<grpc::Status> statuses(kRepeats);
+  std::vector<v1::PlanResponse> repeats(kRepeats);
+  for (int i = 0; i < kRepeats && refused_before; ++i) {
+    statuses[i] = Plan(PlanRequestFor(map_id, 0.4), &repeats[i]);
+  }
+  const bool refused_after = refused_before && refused();
+  busy_context.TryCancel();
+  busy.join();
+
+  ASSERT_TRUE(running) << "the long search never started";
+  ASSERT_TRUE(refused_before) << "a search was admitted beside the long one";
+  EXPECT_TRUE(refused_after) << "the long search ended before the repeats were checked";
+  for (int i = 0; i < kRepeats; ++i) {
+    ASSERT_TRUE(statuses[i].ok()) << statuses[i].error_message();
+    const v1::PlanResponse& again = repeats[i];
+    EXPECT_EQ(again.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+    EXPECT_EQ(again.plan_id(), first.plan_id());
+    EXPECT_TRUE(again.stats().decomposition_cached());
+    ASSERT_EQ(again.path_size(), first.path_size());
+    for (int k = 0; k < again.path_size(); ++k) {
+      EXPECT_EQ(again.path(k).x(), first.path(k).x());
+      EXPECT_EQ(again.path(k).y(), first.path(k).y());
+    }
+  }
+  EXPECT_THAT(metrics(), HasSubstr(absl::StrCat("\ncovplan_plan_hits_without_worker_total ", kRepeats, "\n")));
 }
 
 // Remembered plans follow map content: the id is the content's, DeleteMap
