@@ -9,7 +9,7 @@
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
 #include "planner/oarp/oarp_planner.h"
-#include "planner/partition/mincut_partitioner.h"
+#include "planner/partition/push_relabel_partitioner.h"
 #include "planner/replan/rank_replan.h"
 #include "planner/replan/replan_walk.h"
 #include "planner/tour/grid_paths.h"
@@ -407,7 +407,7 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
     const absl::Time t0 = absl::Now();
     std::vector<Rank> ranks;
     if (st.remaining_cells > 0) {
-      absl::StatusOr<RankPartition> p = MinCutPartitioner().Partition(w, call_stop);
+      absl::StatusOr<RankPartition> p = PushRelabelPartitioner().Partition(w, call_stop);
       if (!p.ok() && !absl::IsDeadlineExceeded(p.status()) && !absl::IsCancelled(p.status())) {
         return p.status();
       }
