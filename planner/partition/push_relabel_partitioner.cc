@@ -131,6 +131,28 @@ class GridFlow {
 
   int64_t constant() const { return constant_; }
 
+  // push_relabel_internal::AuditDamagedFlow: false when no cell fits.
+  bool Damage(push_relabel_internal::FlowDamage damage) {
+    using push_relabel_internal::FlowDamage;
+    for (int32_t i = 0; i < n_; ++i) {
+      uint8_t& s = state_[i];
+      switch (damage) {
+        case FlowDamage::kNone:
+          return true;
+        case FlowDamage::kFlowOnMissingArc:
+          if (i % cols_ + 1 < cols_ && !(s & kArcCol)) return s |= kFlowCol, true;
+          break;
+        case FlowDamage::kUnitLost:
+          if (s & kFlowRow) return s &= static_cast<uint8_t>(~kFlowRow), true;
+          break;
+        case FlowDamage::kExtraUnitToT:
+          if ((s & (kSink | kSinkUsed)) == kSink) return s |= kSinkUsed, ++flow_, true;
+          break;
+      }
+    }
+    return false;
+  }
+
   // Internal unless the preflow is feasible: flow only on arcs, at most the
   // arc's one unit (a bit); into every cell as much as out of it plus its
   // excess, which is never negative; and the units counted into t are the
@@ -287,6 +309,18 @@ class GridFlow {
 };
 
 }  // namespace
+
+namespace push_relabel_internal {
+
+absl::Status AuditDamagedFlow(const Grid& grid, FlowDamage damage) {
+  if (grid.size() == 0 || grid.CountFree() == 0) return absl::FailedPreconditionError("no free cell");
+  GridFlow flow(grid);
+  RETURN_IF_ERROR(flow.MaxPreflow(StopToken()).status());
+  if (!flow.Damage(damage)) return absl::FailedPreconditionError("no cell to damage");
+  return flow.AuditFlow();
+}
+
+}  // namespace push_relabel_internal
 
 absl::StatusOr<RankPartition> PushRelabelPartitioner::Partition(const Grid& grid,
                                                                 const StopToken& stop) const {

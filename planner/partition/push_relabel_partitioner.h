@@ -49,6 +49,21 @@ class PushRelabelPartitioner final : public RankPartitioner {
   absl::StatusOr<RankPartition> Partition(const Grid& grid, const StopToken& stop) const override;
 };
 
+namespace push_relabel_internal {
+
+// Test seam for the flow audit: one kind of damage to a maximum preflow.
+enum class FlowDamage {
+  kNone,
+  kFlowOnMissingArc,  // a cell sends a unit across a side it has no link on
+  kUnitLost,          // a unit vanishes from an arc that carried it
+  kExtraUnitToT,      // an unused sink drains a unit it never received
+};
+// Runs phase one on `grid`, applies `damage` at the first cell it applies
+// to and returns the audit's verdict: Internal naming what is wrong, or OK
+// for kNone. FailedPrecondition when the grid offers no place for it.
+absl::Status AuditDamagedFlow(const Grid& grid, FlowDamage damage);
+
+}  // namespace push_relabel_internal
 }  // namespace covplan
 
 #endif  // COVPLAN_PLANNER_PARTITION_PUSH_RELABEL_PARTITIONER_H_

@@ -173,5 +173,23 @@ TEST(PushRelabelPartitioner, RejectsGridsWithoutFreeCells) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// The flow audit that runs before every answer catches a damaged flow
+// (and passes an undamaged one), so the rank check after it is a proof.
+TEST(PushRelabelPartitioner, FlowAuditCatchesADamagedFlow) {
+  using push_relabel_internal::AuditDamagedFlow;
+  using push_relabel_internal::FlowDamage;
+  for (const Grid& g : {RandomGrid(40, 30, 0.92, 7), RandomGrid(25, 60, 0.8, 11)}) {
+    EXPECT_TRUE(AuditDamagedFlow(g, FlowDamage::kNone).ok());
+    const absl::Status missing = AuditDamagedFlow(g, FlowDamage::kFlowOnMissingArc);
+    EXPECT_TRUE(absl::IsInternal(missing)) << missing;
+    EXPECT_THAT(missing.message(), ::testing::HasSubstr("flow on a missing arc"));
+    for (FlowDamage damage : {FlowDamage::kUnitLost, FlowDamage::kExtraUnitToT}) {
+      const absl::Status broken = AuditDamagedFlow(g, damage);
+      EXPECT_TRUE(absl::IsInternal(broken)) << broken;
+      EXPECT_THAT(broken.message(), ::testing::HasSubstr("flow not conserved"));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace covplan
