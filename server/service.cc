@@ -751,17 +751,18 @@ bool CoveragePlannerService::ServeRecalledHit(grpc::ServerUnaryReactor* reactor,
   v1::PlanResponse response;
   response.mutable_stats()->set_planning_ms(stats.planning_ms);
   response.mutable_stats()->set_decomposition_cached(true);
-  RecordPlanSolve(start, stats);
+  RecordPlanSolve(start, stats, /*queued=*/false);
   metrics_->hits_without_worker().Increment();
   const std::string detail = absl::StrCat(served->detail, " cached=1");
   FinishCall(reactor, call, SerializePlanReply(response, std::move(served), response_bytes), detail);
   return true;
 }
 
-void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& stats) {
+void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& stats, bool queued) {
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, stats.tour_cut_short);
   metrics_->RecordPlanSource(PlanOriginName(stats.plan_source));
+  if (!queued) return;
   const auto update = [solve_us](std::atomic<int64_t>& mean_us) {
     const int64_t mean = mean_us.load();
     mean_us.store(mean == 0 ? solve_us : (7 * mean + solve_us) / 8);

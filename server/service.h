@@ -202,8 +202,10 @@ class CoveragePlannerService final
   // bytes) was answered from memory last time, and recording whether it was.
   bool IsHitRequest(uint64_t key);
   void NoteHitRequest(uint64_t key, bool hit);
-  // A Plan's solve metrics and the mean solve time the admission uses.
-  void RecordPlanSolve(absl::Time start, const PlanStats& stats);
+  // A Plan's solve metrics and, for a call that went through the worker
+  // queue (`queued`), the mean solve times the admission prices queued
+  // calls with (a hit answered on the gRPC thread would pull them down).
+  void RecordPlanSolve(absl::Time start, const PlanStats& stats, bool queued = true);
   // Repeated cache hits (issue 12): the reply already sent for `hit`'s
   // remembered entry to this tenant, if that plan is still retained; else
   // null. RememberServedHit records a reply for the next ones.
