@@ -99,11 +99,12 @@ class SharedLruCache {
       }
       if (leader) {
         absl::StatusOr<Value> result = build(stop);
+        std::vector<Value> dropped;  // freed after the lock is released
         absl::MutexLock lock(&mu_);
         flight->result = result;
         flight->done = true;
         flights_.erase(key);
-        if (result.ok() && *result != nullptr && !Fenced(key, flight->epoch)) Insert(key, *result);
+        if (result.ok() && *result != nullptr && !Fenced(key, flight->epoch)) Insert(key, *result, &dropped);
         return result;
       }
       absl::StatusOr<Value> shared = Wait(*flight, stop);
@@ -136,12 +137,14 @@ class SharedLruCache {
   // released first), and evicts from the LRU end to stay within the budget.
   void Put(const std::string& key, Value value) {
     if (value == nullptr) return;
+    std::vector<Value> dropped;  // freed after the lock is released
     absl::MutexLock lock(&mu_);
-    Insert(key, value);
+    Insert(key, value, &dropped);
   }
 
   // Drops every entry whose key starts with `prefix` (e.g. a deleted map).
   void EraseWithPrefix(const std::string& prefix) {
+    std::vector<Value> dropped;  // freed after the lock is released
     absl::MutexLock lock(&mu_);
     ++erase_epoch_;
     erases_.push_back({prefix, erase_epoch_});
@@ -149,6 +152,7 @@ class SharedLruCache {
     for (auto it = entries_.begin(); it != entries_.end();) {
       if (it->first.compare(0, prefix.size(), prefix) == 0) {
         stats_.bytes -= it->second.bytes;
+        dropped.push_back(std::move(it->second.value));
         lru_.erase(it->second.position);
         it = entries_.erase(it);
       } else {
@@ -192,10 +196,15 @@ class SharedLruCache {
     return flight.result;
   }
 
-  void Insert(const std::string& key, const Value& value) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+  // Values it drops go to `*dropped`, for the caller to free once mu_ is
+  // released: freeing a large artifact takes milliseconds, and gRPC threads
+  // take mu_ to answer repeated hits.
+  void Insert(const std::string& key, const Value& value, std::vector<Value>* dropped)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
     const size_t bytes = size_fn_(*value);
     if (auto old = entries_.find(key); old != entries_.end()) {  // a replacement (Put)
       stats_.bytes -= old->second.bytes;
+      dropped->push_back(std::move(old->second.value));
       lru_.erase(old->second.position);
       entries_.erase(old);
     }
@@ -211,6 +220,7 @@ class SharedLruCache {
       const std::string victim = lru_.back();
       auto it = entries_.find(victim);
       stats_.bytes -= it->second.bytes;
+      dropped->push_back(std::move(it->second.value));
       entries_.erase(it);
       lru_.pop_back();
       ++stats_.evictions;

@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "absl/base/thread_annotations.h"
 #include "absl/synchronization/mutex.h"
@@ -34,7 +35,12 @@ class PlanRegistry {
   size_t size() const;
 
  private:
-  void Expire(absl::Time now) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Both move what they remove into `*dropped`, for the caller to free
+  // after releasing mu_ (a large plan takes a while to free).
+  void Expire(absl::Time now, std::vector<std::shared_ptr<const RetainedPlan>>* dropped)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void Drop(const std::string& plan_id, std::vector<std::shared_ptr<const RetainedPlan>>* dropped)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   struct Entry {
     std::string plan_id;
