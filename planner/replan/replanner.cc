@@ -562,13 +562,15 @@ absl::StatusOr<ReplanResult> Resume(const RetainedPlan& old, const RobotProgress
     return absl::InternalError("replan returned no path to resume");
   }
   const Grid& drive = *out.area->drive;
+  const Waypoint stop = out.plan.path.front();
+  // The drive grid is the free area connected to where the robot stopped.
   absl::StatusOr<CellIndex> joined = JoinCell(drive, robot, "pose");
   if (!joined.ok()) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "pose: the robot at (%.3f, %.3f) is neither in nor next to a free cell it can drive from",
-        robot.x, robot.y));
+        "pose: the robot at (%.3f, %.3f) is neither in nor next to a free cell from which it can drive to "
+        "where it stopped (%.3f, %.3f); obstacles reported on the way may cut it off",
+        robot.x, robot.y, stop.x, stop.y));
   }
-  const Waypoint stop = out.plan.path.front();
   std::vector<Waypoint> path = {{robot.x, robot.y, robot.theta, SegmentKind::kStart, -1}};
   ASSIGN_OR_RETURN(bool routed, AppendRoute(drive, {robot.x, robot.y}, Pose2{stop.x, stop.y, stop.theta},
                                             options.stop, &path));

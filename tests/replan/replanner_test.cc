@@ -366,6 +366,69 @@ TEST(Resume, DrivesBackToTheStopPointAndCoversTheRest) {
   EXPECT_THAT(std::string(off.status().message()), ::testing::HasSubstr("pose"));
 }
 
+// Two 6 m x 6 m rooms joined by a one-cell door. The door reported blocked
+// cuts the room the robot did not stop in off: a Resume from there is
+// refused, and the message says why.
+TEST(Resume, APoseCutOffFromWhereTheRobotStoppedIsRefused) {
+  OccupancyMap rooms(260, 120, 0.05, {0.0, 0.0});  // 13 m wide, 6 m high
+  for (int r = 0; r < 120; ++r) {
+    for (int c = 0; c < 260; ++c) {
+      const bool wall = c >= 120 && c < 140 && !(r >= 40 && r < 60);  // x in [6, 7) m, a 1 m door
+      rooms.set(r, c, wall ? CellState::kOccupied : CellState::kFree);
+    }
+  }
+  PlanOptions o;
+  o.robot.tool_width_m = 1.0;
+  o.tour_solver = TourSolver::kGreedy;
+  absl::StatusOr<EngineResult> planned = PlanCoverageWithArea(rooms, o);
+  ASSERT_TRUE(planned.ok()) << planned.status();
+  RetainedPlan old;
+  old.plan = planned->plan;
+  old.area = planned->area;
+  old.request = o.ToRequest();
+  const Grid& drive = *old.area->drive;
+  // The door: the one free cell of the wall's grid column.
+  std::vector<CellIndex> door;
+  for (int r = 0; r < drive.rows(); ++r) {
+    if (drive.IsFree(r, 6)) door.push_back({r, 6});
+  }
+  std::string picture;
+  for (int r = 0; r < drive.rows(); ++r) {
+    for (int c = 0; c < drive.cols(); ++c) picture += drive.IsFree(r, c) ? '.' : '#';
+    picture += '\n';
+  }
+  ASSERT_EQ(door.size(), 1u) << picture;
+  // Stopped inside a room, not in the doorway.
+  RobotProgress stopped;
+  for (int w = static_cast<int>(old.plan.path.size()) / 6; w < static_cast<int>(old.plan.path.size()); ++w) {
+    const Waypoint& a = old.plan.path[w - 1];
+    const Waypoint& b = old.plan.path[w];
+    const Point2 mid{(a.x + b.x) / 2, (a.y + b.y) / 2};
+    if (mid.x < 5.5 || mid.x > 7.5) {
+      stopped.waypoint = w;
+      stopped.position = mid;
+      break;
+    }
+  }
+  ASSERT_TRUE(stopped.position.has_value());
+  const bool left = stopped.position->x < 6.0;
+  const Pose2 same_room{left ? 2.5 : 10.5, 3.0, 0.0};
+  const Pose2 other_room{left ? 10.5 : 2.5, 3.0, 0.0};
+  Observations door_blocked;
+  door_blocked.cells = door;
+  ReplanOptions options;
+  options.stop = StopToken::WithTimeout(absl::Seconds(30));
+  absl::StatusOr<ReplanResult> cut_off = Resume(old, stopped, other_room, door_blocked, options, nullptr);
+  EXPECT_EQ(cut_off.status().code(), absl::StatusCode::kInvalidArgument) << cut_off.status();
+  EXPECT_THAT(std::string(cut_off.status().message()), HasSubstr("can drive to where it stopped"));
+  // The same door open, or a pose in the robot's room: resumed.
+  absl::StatusOr<ReplanResult> open = Resume(old, stopped, other_room, {}, options, nullptr);
+  ASSERT_TRUE(open.ok()) << open.status();
+  absl::StatusOr<ReplanResult> same = Resume(old, stopped, same_room, door_blocked, options, nullptr);
+  ASSERT_TRUE(same.ok()) << same.status();
+  EXPECT_EQ(testing::CheckPathStaysFree(*same->area->drive, same->plan.path), "");
+}
+
 TEST(Estimator, LearnsFromSolvesAndPersists) {
   ReplanEstimator e;
   const int64_t prior = e.Budget(0.5);

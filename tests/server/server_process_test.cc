@@ -7,7 +7,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include <atomic>
-#include <cmath>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -140,8 +140,7 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   const std::string map_id = PutMap(OfficeMap());
   v1::PlanResponse plan;
   ASSERT_TRUE(Plan(Request(map_id, 0.8, 0.5), &plan).ok());
-  const v1::Waypoint dock = plan.path(0);
-  std::string trace = absl::StrFormat("dock (%.3f, %.3f)", dock.x(), dock.y());  // for a failure's message
+  std::string trace = absl::StrFormat("start (%.3f, %.3f)", plan.path(0).x(), plan.path(0).y());  // for a failure's message
   auto replan = [&](const v1::PlanResponse& p, v1::ReplanResponse* out) {
     v1::ReplanRequest r;
     r.set_plan_id(p.plan_id());
@@ -149,11 +148,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     r.mutable_progress()->set_waypoint(k);
     r.mutable_progress()->mutable_position()->set_x(p.path(k - 1).x());
     r.mutable_progress()->mutable_position()->set_y(p.path(k - 1).y());
-    // The obstacle lies on the path ahead, away from the dock the robot
-    // resumes from below (a tour cut by its deadline may pass the dock there,
-    // and a dock whose only free neighbour is blocked cannot join the grid).
-    int j = k + 3;
-    while (j + 1 < p.path_size() && std::hypot(p.path(j).x() - dock.x(), p.path(j).y() - dock.y()) < 2.5) ++j;
+    // The obstacle lies on the path ahead.
+    const int j = std::min(k + 3, p.path_size() - 1);
     v1::Point2* obstacle = r.mutable_obstacles()->add_points();
     obstacle->set_x(p.path(j).x());
     obstacle->set_y(p.path(j).y());
@@ -195,7 +191,10 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   EXPECT_EQ(static_cast<int>(swept.size()), second.replan().remaining_cells());
 
   // The robot reports its progress in a Drive session, is interrupted with
-  // the server (SIGKILL again), and resumes from its dock where it stopped.
+  // the server (SIGKILL again), and resumes where it stopped from where that
+  // plan started. (Not from the first dock: an obstacle reported in a
+  // doorway may cut the dock's room off from the rest, and Resume then
+  // rightly refuses it; which doorway depends on the tour its deadline cut.)
   const v1::PlanResponse& driving = second.plan();
   const int k = driving.path_size() / 2;
   {
@@ -224,8 +223,10 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   StartServer();
   v1::ResumeRequest resume;
   resume.set_plan_id(driving.plan_id());
-  resume.mutable_pose()->set_x(plan.path(0).x());
-  resume.mutable_pose()->set_y(plan.path(0).y());
+  const v1::Waypoint& from = driving.path(0);
+  resume.mutable_pose()->set_x(from.x());
+  resume.mutable_pose()->set_y(from.y());
+  absl::StrAppendFormat(&trace, "; resumed from (%.3f, %.3f)", from.x(), from.y());
   v1::ReplanResponse resumed;
   {
     grpc::ClientContext context;
@@ -237,7 +238,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   EXPECT_GT(resumed.replan().covered_cells_before(), 0);
   EXPECT_EQ(resumed.replan().covered_cells_before() + resumed.replan().remaining_cells(),
             second.replan().remaining_cells());
-  EXPECT_NEAR(resumed.plan().path(0).x(), plan.path(0).x(), 1e-9);
+  EXPECT_NEAR(resumed.plan().path(0).x(), from.x(), 1e-9);
+  EXPECT_NEAR(resumed.plan().path(0).y(), from.y(), 1e-9);
 }
 
 TEST_F(ServerProcessTest, CorruptedMapFileIsReportedNotServed) {
