@@ -68,6 +68,20 @@ RobotProgress Early(const CoveragePlan& plan) {
   return p;
 }
 
+// A plan of `map` at a 1 m tool with the greedy tour, kept as a server keeps it.
+absl::StatusOr<RetainedPlan> GreedyPlanWithMetreTool(const OccupancyMap& map) {
+  PlanOptions o;
+  o.robot.tool_width_m = 1.0;
+  o.tour_solver = TourSolver::kGreedy;
+  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(map, o);
+  if (!r.ok()) return r.status();
+  RetainedPlan old;
+  old.plan = std::move(r->plan);
+  old.area = std::move(r->area);
+  old.request = o.ToRequest();
+  return old;
+}
+
 void ExpectGoodReplan(const ReplanResult& r, const RetainedPlan& old, const RobotProgress& at,
                       const Observations& seen) {
   EXPECT_EQ(testing::CheckPlanConformance(r.plan, *r.area, old.request.common.robot), "");
@@ -300,15 +314,9 @@ TEST(Replan, ACellThatAnOldSegmentOnlyClipsIsAvoided) {
   for (int r = 0; r < 240; ++r) {
     for (int c = 0; c < 240; ++c) open.set(r, c, CellState::kFree);
   }
-  PlanOptions o;
-  o.robot.tool_width_m = 1.0;
-  o.tour_solver = TourSolver::kGreedy;
-  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(open, o);
-  ASSERT_TRUE(r.ok()) << r.status();
-  RetainedPlan old;
-  old.plan = r->plan;
-  old.area = r->area;
-  old.request = o.ToRequest();
+  absl::StatusOr<RetainedPlan> planned = GreedyPlanWithMetreTool(open);
+  ASSERT_TRUE(planned.ok()) << planned.status();
+  RetainedPlan old = *std::move(planned);
   // Replace the path by one long diagonal transition and its return.
   old.plan.path = {{0.5, 0.5, 0, SegmentKind::kStart, -1},
                    {10.5, 7.5, std::atan2(7.0, 10.0), SegmentKind::kTransition, -1},
@@ -377,15 +385,9 @@ TEST(Resume, APoseCutOffFromWhereTheRobotStoppedIsRefused) {
       rooms.set(r, c, wall ? CellState::kOccupied : CellState::kFree);
     }
   }
-  PlanOptions o;
-  o.robot.tool_width_m = 1.0;
-  o.tour_solver = TourSolver::kGreedy;
-  absl::StatusOr<EngineResult> planned = PlanCoverageWithArea(rooms, o);
+  absl::StatusOr<RetainedPlan> planned = GreedyPlanWithMetreTool(rooms);
   ASSERT_TRUE(planned.ok()) << planned.status();
-  RetainedPlan old;
-  old.plan = planned->plan;
-  old.area = planned->area;
-  old.request = o.ToRequest();
+  const RetainedPlan old = *std::move(planned);
   const Grid& drive = *old.area->drive;
   // The door: the one free cell of the wall's grid column.
   std::vector<CellIndex> door;
