@@ -744,14 +744,13 @@ bool CoveragePlannerService::ServeRecalledHit(grpc::ServerUnaryReactor* reactor,
   std::shared_ptr<const ServedBody> served = ServedHitReply(call.tenant_tag, (*recalled)->entry);
   if (served == nullptr) return false;
   // As RunPlan answers a repeated hit: the served bytes, then this call's stats.
-  PlanStats stats = (*recalled)->entry->plan.stats;
-  stats.plan_source = PlanOrigin::kCacheHit;
-  stats.planning_ms = (*recalled)->lookup_ms;
-  stats.decomposition_cached = true;
   v1::PlanResponse response;
-  response.mutable_stats()->set_planning_ms(stats.planning_ms);
+  response.mutable_stats()->set_planning_ms((*recalled)->lookup_ms);
   response.mutable_stats()->set_decomposition_cached(true);
-  RecordPlanSolve(start, stats, /*queued=*/false);
+  PlanStats solve;  // what the solve metrics read
+  solve.plan_source = PlanOrigin::kCacheHit;
+  solve.tour_cut_short = (*recalled)->entry->plan.stats.tour_cut_short;
+  RecordPlanSolve(start, solve, /*queued=*/false);
   metrics_->hits_without_worker().Increment();
   const std::string detail = absl::StrCat(served->detail, " cached=1");
   FinishCall(reactor, call, SerializePlanReply(response, std::move(served), response_bytes), detail);

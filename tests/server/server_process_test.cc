@@ -6,8 +6,8 @@
 // SIGTERM drains in-flight work.
 #include <grpcpp/grpcpp.h>
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <thread>
