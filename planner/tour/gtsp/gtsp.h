@@ -5,8 +5,10 @@
 // Large-neighbourhood search in the style of GLNS (Smith & Imeson 2017):
 // several removal and insertion heuristics with adaptive weights, simulated-
 // annealing acceptance, restarts/trials, and a local step that re-picks the
-// vertex of each set. Anytime: it always holds a valid tour and returns the
-// best one found when the StopToken fires.
+// vertex of each set. A thorough solve with a deadline instead evolves one
+// population of local optima per thread until the deadline (the memetic
+// search of gtsp_memetic.h, after Gutin & Karapetyan 2010). Anytime: it always
+// holds a valid tour and returns the best one found when the StopToken fires.
 //
 //   GtspInstance inst = ...;               // costs + sets
 //   GtspOptions opt; opt.seed = 7;
@@ -14,7 +16,8 @@
 //   absl::StatusOr<GtspResult> r = SolveGtsp(inst, opt);
 //
 // Deterministic for a given (instance, seed, num_threads) when the run is not
-// cut short by the deadline (i.e. when it stops on its own iteration limits).
+// cut short by the deadline (i.e. when it stops on its own iteration limits);
+// a thorough solve with a deadline is not, since it runs until the clock says.
 // Thread-safety: SolveGtsp is reentrant; it may use opt.num_threads threads.
 #ifndef COVPLAN_PLANNER_TOUR_GTSP_GTSP_H_
 #define COVPLAN_PLANNER_TOUR_GTSP_GTSP_H_
@@ -49,6 +52,7 @@ struct GtspOptions {
   uint64_t seed = 1;
   int num_threads = 1;            // trials run in parallel on this many threads; the
                                   // effort's trials run in whole rounds of this many
+                                  // (thorough with a deadline: one population each)
   GtspEffort effort = GtspEffort::kDefault;
   int max_trials = 0;             // 0 = chosen by effort; kLocalStepOnly: no LNS trial
   static constexpr int kLocalStepOnly = -1;  // the initial (or greedy) tour, locally optimised
@@ -65,8 +69,8 @@ struct GtspResult {
   std::vector<int> tour;     // one vertex per set, visiting order (cycle)
   double cost = 0.0;         // sum of arc costs including the closing arc
   bool stopped_early = false;  // the StopToken cut the search short
-  int64_t iterations = 0;
-  int trials_completed = 0;
+  int64_t iterations = 0;     // LNS iterations, or children evolved (thorough with a deadline)
+  int trials_completed = 0;   // trials (or populations) that ended before the StopToken fired
   double elapsed_s = 0.0;
   double time_to_best_s = 0.0;
 };

@@ -1,0 +1,130 @@
+// The memetic search that fills a thorough solve's deadline: its crossover
+// builds valid children from both parents, a run returns the best tour it
+// reported, and through SolveGtsp it finds the Held-Karp optimum of small
+// instances with one and two threads.
+#include <algorithm>
+#include <numeric>
+#include <vector>
+
+#include "absl/time/clock.h"
+#include "gtest/gtest.h"
+#include "planner/tour/gtsp/gtsp.h"
+#include "planner/tour/gtsp/gtsp_memetic.h"
+#include "planner/tour/gtsp/gtsp_problem.h"
+#include "planner/tour/gtsp/rng.h"
+#include "tests/gtsp/gtsp_test_util.h"
+
+namespace covplan {
+namespace {
+
+using gtsp_internal::MemeticSearch;
+using gtsp_internal::Problem;
+using gtsp_internal::SearchParams;
+using gtsp_internal::SearchTour;
+using gtsp_internal::TrialOutcome;
+using testing_gtsp::HeldKarpOptimum;
+using testing_gtsp::kAsymmetric;
+using testing_gtsp::kEuclidean;
+using testing_gtsp::RandomInstance;
+
+// A random order of the sets with a random vertex of each.
+SearchTour RandomTour(const Problem& p, gtsp_internal::Rng& rng) {
+  std::vector<int> sets(p.m);
+  std::iota(sets.begin(), sets.end(), 0);
+  for (int i = p.m - 1; i > 0; --i) std::swap(sets[i], sets[rng.UniformInt(i + 1)]);
+  SearchTour t;
+  t.Reset(p);
+  for (int s : sets) t.seq.push_back(p.set_begin[s] + rng.UniformInt(p.set_size(s)));
+  t.RebuildPositions(p);
+  t.RecomputeCost(p);
+  return t;
+}
+
+bool IsFullTour(const Problem& p, const SearchTour& t) {
+  if (t.size() != p.m) return false;
+  std::vector<int> seen(p.m, 0);
+  for (int i = 0; i < t.size(); ++i) {
+    const int s = p.set_of[t.seq[i]];
+    if (seen[s]++ > 0 || t.pos[s] != i) return false;
+  }
+  return true;
+}
+
+TEST(MemeticTest, CrossoverKeepsAFragmentOfOneParentAndTheOrderOfTheOther) {
+  const GtspInstance inst = RandomInstance(5, 40, 3, kAsymmetric);
+  const Problem p = Problem::Build(inst);
+  gtsp_internal::Rng rng(17);
+  SearchParams params;
+  for (uint64_t seed = 1; seed <= 200; ++seed) {
+    MemeticSearch search(p, params, seed);
+    const SearchTour a = RandomTour(p, rng), b = RandomTour(p, rng);
+    SearchTour child;
+    search.Crossover(a, b, child);
+    ASSERT_TRUE(IsFullTour(p, child)) << "seed " << seed;
+    double cost = 0.0;
+    for (int i = 0; i < child.size(); ++i) cost += p.c(child.seq[i], child.seq[child.next(i)]);
+    EXPECT_NEAR(child.cost, cost, 1e-6);
+
+    // The child begins with a run of `a` (vertices included) of at least m/10 sets.
+    const int from = a.pos[p.set_of[child.seq[0]]];
+    int run = 0;
+    while (run < p.m && child.seq[run] == a.seq[(from + run) % p.m]) ++run;
+    ASSERT_GE(run, p.m / 10) << "seed " << seed;
+    ASSERT_LE(run, p.m) << "seed " << seed;
+    // After the longest such run, every vertex is b's, in b's cyclic order.
+    int descents = 0;
+    for (int i = run; i < p.m; ++i) {
+      const int s = p.set_of[child.seq[i]];
+      EXPECT_EQ(child.seq[i], b.seq[b.pos[s]]) << "seed " << seed << ", position " << i;
+      if (i > run && b.pos[s] < b.pos[p.set_of[child.seq[i - 1]]]) ++descents;
+    }
+    EXPECT_LE(descents, 1) << "seed " << seed << ": the rest of the child is not in b's cyclic order";
+  }
+}
+
+TEST(MemeticTest, RunReturnsTheLastTourItReportedAndNeverWorseThanItsStart) {
+  const GtspInstance inst = RandomInstance(9, 60, 4, kEuclidean, 2);
+  const Problem p = Problem::Build(inst);
+  gtsp_internal::Rng rng(3);
+  const SearchTour start = RandomTour(p, rng);
+  SearchParams params;
+  params.time_budget_end = absl::Now() + absl::Milliseconds(60);
+  MemeticSearch search(p, params, 11);
+  std::vector<double> reported;
+  const TrialOutcome out = search.Run(&start, StopToken(), [&](const SearchTour& t) {
+    EXPECT_TRUE(IsFullTour(p, t));
+    reported.push_back(t.cost);
+  });
+  ASSERT_TRUE(IsFullTour(p, out.best));
+  ASSERT_FALSE(reported.empty());
+  EXPECT_TRUE(std::is_sorted(reported.rbegin(), reported.rend()));  // each report improves
+  EXPECT_DOUBLE_EQ(out.best.cost, reported.back());
+  EXPECT_LT(out.best.cost, start.cost);  // a random tour of 60 sets is far from locally optimal
+  EXPECT_GT(out.iterations, 0);
+  EXPECT_FALSE(out.stopped);  // its own budget ended it, not the StopToken
+}
+
+TEST(MemeticTest, ThoroughDeadlineSolveFindsTheHeldKarpOptimum) {
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const int num_sets = 6 + static_cast<int>(seed % 5);  // 6..10 sets
+    const GtspInstance inst = RandomInstance(seed, num_sets, 3, seed % 2 ? kAsymmetric : kEuclidean, 2);
+    const double opt = HeldKarpOptimum(inst);
+    for (int threads : {1, 2}) {
+      GtspOptions options;
+      options.seed = seed;
+      options.num_threads = threads;
+      options.effort = GtspEffort::kThorough;
+      options.stop = StopToken::WithTimeout(absl::Milliseconds(100));
+      absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
+      ASSERT_TRUE(r.ok()) << r.status();
+      ASSERT_TRUE(ValidateTour(inst, r->tour).ok());
+      EXPECT_DOUBLE_EQ(r->cost, TourCost(inst, r->tour));
+      EXPECT_NEAR(r->cost, opt, 1e-6) << "seed " << seed << ", " << num_sets << " sets, " << threads
+                                      << " threads";
+      EXPECT_GT(r->iterations, 0);  // children were evolved, not only the greedy step
+    }
+  }
+}
+
+}  // namespace
+}  // namespace covplan
