@@ -387,7 +387,7 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
       cache_->Put(keys->exact, std::move(entry));
     }
   }
-  return EngineResult{std::move(plan), ctx.area};
+  return EngineResult{std::move(plan), ctx.area, nullptr};
 }
 
 PlanStats ComputePathStats(const std::vector<Waypoint>& path, const RobotModel& robot) {

@@ -87,7 +87,9 @@ TEST(OfflineStc, TreesSpanTheCoarseCellsAndTheRingVisitsEachSubCellOnce) {
         EXPECT_EQ(tree.num_edges, tree.num_nodes - static_cast<int>(tree.roots.size()));
         for (int id = 0; id < coarse.size(); ++id) {
           for (int side = 0; side < 4; ++side) {
-            if (tree.HasEdge(id, side)) EXPECT_TRUE(coarse.CanLink(id, side));
+            if (tree.HasEdge(id, side)) {
+              EXPECT_TRUE(coarse.CanLink(id, side));
+            }
           }
         }
         const std::vector<CellIndex> ring = Circumnavigate(coarse, tree);

@@ -237,7 +237,9 @@ TEST(AnyAngleSearch, CellsClosedOnTheWayHaveTheirPaths) {
       }
       EXPECT_NEAR(len, search.DistanceCells(c), 1e-3 * (1.0 + len));
     });
-    if (search.Reached(b)) EXPECT_GE(closed, 1);
+    if (search.Reached(b)) {
+      EXPECT_GE(closed, 1);
+    }
   }
 }
 
