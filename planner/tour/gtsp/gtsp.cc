@@ -220,8 +220,9 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
 
   // kThorough with a deadline (and no trial limit) uses all the time given:
   // one memetic search per thread, each evolving its own population (seeded
-  // with the tour so far) until the deadline. On GTSPLIB it reaches in 1 s
-  // the gaps the LNS trials reach in 5 s (docs/benchmarks.md, section 4).
+  // with the tour so far) until the deadline. On GTSPLIB two threads for
+  // 1 s this way beat one thread of LNS trials for 5 s (docs/benchmarks.md,
+  // section 4, "A memetic search for deadlines").
   const bool until_deadline =
       options.max_trials == 0 && stop.has_deadline() && options.effort == GtspEffort::kThorough;
   if (until_deadline) {
@@ -235,6 +236,8 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
         outcomes[j] = search.Run(&warm, stop, on_best);
       });
       take(outcomes);
+    } else if (problem.m > 1) {
+      result.stopped_early = true;  // stopped before the search began
     }
     return Finish(instance, problem, best, t_start, time_to_best, std::move(result));
   }

@@ -70,7 +70,8 @@ struct GtspResult {
   double cost = 0.0;         // sum of arc costs including the closing arc
   bool stopped_early = false;  // the StopToken cut the search short
   int64_t iterations = 0;     // LNS iterations, or children evolved (thorough with a deadline)
-  int trials_completed = 0;   // trials (or populations) that ended before the StopToken fired
+  int trials_completed = 0;   // trials that ended before the StopToken fired (thorough with a
+                              // deadline: 0, or num_threads when m = 2 and the greedy step is exact)
   double elapsed_s = 0.0;
   double time_to_best_s = 0.0;
 };

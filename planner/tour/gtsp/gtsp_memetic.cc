@@ -9,8 +9,9 @@ namespace covplan::gtsp_internal {
 namespace {
 
 constexpr double kMutationProbability = 0.1;
-// The population stops growing once this share of the budget is spent (a
-// large instance with a short budget evolves a smaller population).
+// Filling the population (at the start and on a restart) stops once this
+// share of the time left is spent (a large instance with a short budget
+// evolves a smaller population).
 constexpr double kInitialShare = 0.25;
 constexpr int kKeptOnRestart = 2;
 constexpr int kRandomOrder = 2;  // LnsTrial::Construct mode
@@ -79,9 +80,7 @@ void MemeticSearch::Select(std::vector<SearchTour>& pop) {
 TrialOutcome MemeticSearch::Run(const SearchTour* start, const StopToken& stop,
                                 const std::function<void(const SearchTour&)>& on_best) {
   TrialOutcome out;
-  const absl::Time t0 = absl::Now();
   const absl::Time end = params_.time_budget_end;
-  const absl::Time grown = end == absl::InfiniteFuture() ? end : t0 + (end - t0) * kInitialShare;
   auto time_left = [&] { return !stop.ShouldStop() && absl::Now() < end; };
 
   std::vector<SearchTour> pop;
@@ -97,10 +96,26 @@ TrialOutcome MemeticSearch::Run(const SearchTour* start, const StopToken& stop,
     out.stopped = stop.ShouldStop();
     return out;
   }
-  while (static_cast<int>(pop.size()) < kPopulation && time_left() && (pop.size() < 2 || absl::Now() < grown)) {
-    AddRandomTour(pop, stop);
-  }
-  Select(pop);
+  // The population is sorted: takes its first tour if it beats the best.
+  auto take_best = [&] {
+    if (pop[0].cost >= out.best.cost - 1e-9 * std::max(1.0, std::abs(out.best.cost))) return false;
+    out.best = pop[0];
+    if (on_best) on_best(out.best);
+    return true;
+  };
+  // Adds fresh local optima up to kPopulation, for at most kInitialShare of
+  // the time left (at least two tours in all).
+  auto fill = [&] {
+    const absl::Time now = absl::Now();
+    const absl::Time until = end == absl::InfiniteFuture() ? end : now + (end - now) * kInitialShare;
+    while (static_cast<int>(pop.size()) < kPopulation && time_left() &&
+           (pop.size() < 2 || absl::Now() < until)) {
+      AddRandomTour(pop, stop);
+    }
+    Select(pop);
+    take_best();
+  };
+  fill();
 
   std::vector<SearchTour> children;
   int stale = 0;
@@ -121,16 +136,13 @@ TrialOutcome MemeticSearch::Run(const SearchTour* start, const StopToken& stop,
     }
     for (int i = 0; i < made; ++i) pop.push_back(std::move(children[i]));
     Select(pop);
-    if (pop[0].cost < out.best.cost - 1e-9 * std::max(1.0, std::abs(out.best.cost))) {
-      out.best = pop[0];
-      if (on_best) on_best(out.best);
+    if (take_best()) {
       stale = 0;
     } else if (++stale >= kStaleGenerations) {
       // Converged: keep the best and refill with fresh local optima.
       stale = 0;
       pop.resize(std::min<size_t>(pop.size(), kKeptOnRestart));
-      while (static_cast<int>(pop.size()) < kPopulation && time_left()) AddRandomTour(pop, stop);
-      Select(pop);
+      fill();
     }
   }
   out.stopped = stop.ShouldStop();

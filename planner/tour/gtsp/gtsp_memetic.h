@@ -35,8 +35,10 @@ class MemeticSearch {
   // replaced by fresh random ones.
   static constexpr int kStaleGenerations = 8;
 
-  // `params.time_budget_end` bounds the run (with the StopToken); the other
-  // fields are used only for the random-insertion tours that seed the population.
+  // `params.time_budget_end` ends the run between children, and the
+  // StopToken also inside a child's local search (SolveGtsp sets both to
+  // the deadline); the other fields are used only to build the
+  // random-insertion tours that seed the population.
   MemeticSearch(const Problem& p, const SearchParams& params, uint64_t seed);
 
   // Evolves a population that contains `start` (if given) until the time
