@@ -214,7 +214,7 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
       } else {
         ++result.trials_completed;
       }
-      if (o.best.cost < best.cost - 1e-9 * std::max(1.0, std::abs(best.cost))) best = std::move(o.best);
+      if (gtsp_internal::Cheaper(o.best.cost, best.cost)) best = std::move(o.best);
     }
   };
 

@@ -98,7 +98,7 @@ TrialOutcome MemeticSearch::Run(const SearchTour* start, const StopToken& stop,
   }
   // The population is sorted: takes its first tour if it beats the best.
   auto take_best = [&] {
-    if (pop[0].cost >= out.best.cost - 1e-9 * std::max(1.0, std::abs(out.best.cost))) return false;
+    if (!Cheaper(pop[0].cost, out.best.cost)) return false;
     out.best = pop[0];
     if (on_best) on_best(out.best);
     return true;

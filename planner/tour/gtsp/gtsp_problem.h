@@ -12,6 +12,8 @@
 #ifndef COVPLAN_PLANNER_TOUR_GTSP_GTSP_PROBLEM_H_
 #define COVPLAN_PLANNER_TOUR_GTSP_GTSP_PROBLEM_H_
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "planner/tour/gtsp/gtsp.h"
@@ -49,6 +51,10 @@ struct Problem {
   }
   int set_size(int s) const { return set_begin[s + 1] - set_begin[s]; }
 };
+
+// True if `cost` beats `than` by more than rounding (relative 1e-9): how
+// trials and populations decide that a tour is a new best.
+inline bool Cheaper(double cost, double than) { return cost < than - 1e-9 * std::max(1.0, std::abs(than)); }
 
 // A (possibly partial) cyclic tour: at most one vertex per set, with O(1)
 // position lookup by set.
