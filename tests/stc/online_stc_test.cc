@@ -64,7 +64,9 @@ TEST(OnlineStc, CoversTheSameSubCellsAsOfflineIncludingPartlyFreeCoarseCells) {
     EXPECT_EQ(robot.trail().back(), *start);  // closed tour
     // The on-line tree is the off-line DFS tree of the start's component.
     EXPECT_LE(online->tree_edges, detail.tree_edges);
-    if (detail.trees == 1) EXPECT_EQ(online->tree_edges, detail.tree_edges);
+    if (detail.trees == 1) {
+      EXPECT_EQ(online->tree_edges, detail.tree_edges);
+    }
   }
 }
 
@@ -87,7 +89,9 @@ TEST(OnlineStc, BothRobotsDriveTheOfflinePathWhenEveryCoarseCellIsWhollyFree) {
     EXPECT_EQ(ant.trail(), offline);
     EXPECT_EQ(stats->max_stored_cells, 0);
     for (int64_t i = 0; i < truth.size(); ++i) {
-      if (truth.free_flags()[i]) EXPECT_TRUE(ant.Marked(truth.FromIndex(i)));
+      if (truth.free_flags()[i]) {
+        EXPECT_TRUE(ant.Marked(truth.FromIndex(i)));
+      }
     }
   }
 }
