@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -288,6 +289,62 @@ class Problem {
 
 thread_local std::vector<CellIndex> Problem::harvest_cells_;
 
+// Internal unless a search's tour is consistent: the start first and the
+// end last, each rank's two endpoints next to each other, positions and
+// mates matching the order, and the cost the sum of its transition costs.
+// Checked on every thread's tour and the shared incumbent before a tour is
+// returned.
+absl::Status AuditTour(int n, const std::vector<int>& t, const std::vector<int>& pos, const std::vector<int>& mate,
+                       const std::vector<double>& lc, double cost) {
+  const int nodes = 2 * n + 2;
+  if (static_cast<int>(t.size()) != nodes || t.front() != 2 * n || t.back() != 2 * n + 1) {
+    return absl::InternalError("sparse tour: the tour does not run from the start to the end");
+  }
+  std::vector<uint8_t> seen(nodes, 0);
+  for (int i = 0; i < nodes; ++i) {
+    const int v = t[i];
+    if (v < 0 || v >= nodes || seen[v]) {
+      return absl::InternalError(absl::StrFormat("sparse tour: node %d visited twice or out of range", v));
+    }
+    seen[v] = 1;
+    if (pos[v] != i) {
+      return absl::InternalError(absl::StrFormat("sparse tour: node %d is at %d, its position says %d", v, i, pos[v]));
+    }
+  }
+  for (int i = 1; i + 1 < nodes; i += 2) {
+    if (t[i + 1] != (t[i] ^ 1)) {
+      return absl::InternalError(absl::StrFormat("sparse tour: rank %d is not driven in one piece", t[i] / 2));
+    }
+  }
+  double sum = 0.0;
+  for (int i = 0; i < nodes; i += 2) {
+    const int a = t[i], b = t[i + 1];
+    if (mate[a] != b || mate[b] != a || lc[a] != lc[b]) {
+      return absl::InternalError(absl::StrFormat("sparse tour: transition %d -> %d is not linked", a, b));
+    }
+    sum += lc[a];
+  }
+  if (!(std::abs(sum - cost) <= 1e-6 * std::max(1.0, std::abs(sum)))) {
+    return absl::InternalError(
+        absl::StrFormat("sparse tour: cost %.6f s is not the sum of its transitions, %.6f s", cost, sum));
+  }
+  return absl::OkStatus();
+}
+
+// The best tour of a kick phase shared by several threads: each kicks its
+// copy of it, publishes a better tour, and copies a newer one before its
+// next kick; `stale` counts the kicks of all threads since the last
+// published gain, so the phase converges after as many kicks without gain
+// as one thread's would, reached about threads times sooner.
+struct Incumbent {
+  std::mutex mu;
+  std::vector<int> t, pos, mate;  // guarded by mu, as is cost
+  std::vector<double> lc;
+  double cost = std::numeric_limits<double>::infinity();
+  std::atomic<uint64_t> version{0};  // bumped (under mu) by every publish
+  std::atomic<int64_t> stale{0};
+};
+
 // One search run: a tour t = [S, entry, exit, entry, exit, ..., E] with
 // positions, the mate of each node across its transition edge, and that
 // edge's cost. Writes can be logged and undone (rejected kicks).
@@ -310,8 +367,27 @@ class Run {
   // Positions, mates and exact costs of the transitions of a complete t_.
   void PriceTour();
   void LocalSearch(const StopToken& stop);
-  // Returns true if it converged (not stopped by the budget).
-  bool Iterate(const StopToken& stop, int64_t converge_after, bool until_limit);
+  // Returns true if it converged (not stopped by the budget). With a
+  // `shared` incumbent the run kicks its latest tour, publishes gains to it
+  // and converges on its global count of kicks without gain.
+  bool Iterate(const StopToken& stop, int64_t converge_after, bool until_limit, Incumbent* shared = nullptr);
+  // Makes this run's tour the incumbent's if it is cheaper; true if it did.
+  bool Publish(Incumbent* shared) {
+    std::lock_guard<std::mutex> lock(shared->mu);
+    if (!(cost_ < shared->cost - kEps)) return false;
+    shared->t = t_, shared->pos = pos_, shared->mate = mate_, shared->lc = lc_, shared->cost = cost_;
+    version_ = shared->version.load(std::memory_order_relaxed) + 1;
+    shared->version.store(version_, std::memory_order_release);
+    return true;
+  }
+  absl::Status Audit() const { return AuditTour(p_.n(), t_, pos_, mate_, lc_, cost_); }
+  // Takes the incumbent's tour when it is newer than the one this run has.
+  void Sync(Incumbent* shared) {
+    if (shared->version.load(std::memory_order_acquire) == version_) return;
+    std::lock_guard<std::mutex> lock(shared->mu);
+    t_ = shared->t, pos_ = shared->pos, mate_ = shared->mate, lc_ = shared->lc, cost_ = shared->cost;
+    version_ = shared->version.load(std::memory_order_relaxed);
+  }
   double cost() const { return cost_; }
   int64_t kicks() const { return kicks_; }
   const std::vector<int>& tour() const { return t_; }
@@ -391,6 +467,7 @@ class Run {
   std::vector<double> lc_;
   double cost_ = 0.0;
   int64_t kicks_ = 0;
+  uint64_t version_ = 0;  // of the incumbent this run's tour came from
   bool logging_ = false;
   std::vector<Undo> log_;
   std::deque<int> queue_;
@@ -709,12 +786,14 @@ void Run::DoubleBridge(int i, int j, int k) {
   for (int v : {a, b1, b2, c1, c2, d}) Push(v);
 }
 
-bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limit) {
+bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limit, Incumbent* shared) {
   const int n = p_.n();
   if (n < 4) return true;
-  int64_t no_improve = 0;
+  std::atomic<int64_t> own_stale{0};
+  std::atomic<int64_t>& no_improve = shared != nullptr ? shared->stale : own_stale;
   while (!stop.ShouldStop()) {
-    if (!until_limit && no_improve >= converge_after) return true;
+    if (!until_limit && no_improve.load(std::memory_order_relaxed) >= converge_after) return true;
+    if (shared != nullptr) Sync(shared);
     // A local double bridge A B C D -> A C B D at the transition edge
     // (t[i], t[i+1]) of a random endpoint: t[j+1] a candidate of t[i] and
     // t[k] a candidate of t[i+1] when the tour order allows, so two of the
@@ -754,7 +833,13 @@ bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limi
     logging_ = false;
     if (cost_ < saved - kEps && std::isfinite(cost_)) {
       log_.clear();
-      no_improve = 0;
+      // Shared: a gain counts once it beats the incumbent (another thread
+      // may have published a better tour meanwhile; the next kick takes it).
+      if (shared == nullptr || Publish(shared)) {
+        no_improve = 0;
+      } else {
+        ++no_improve;
+      }
     } else {
       Rollback();
       cost_ = saved;
@@ -812,17 +897,23 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   const StopToken budget = stop.WithEarlierDeadline(began + absl::Seconds(options.time_limit_s));
   const int threads = options.local_search ? std::max(1, options.num_threads) : 1;
 
+  // Kicks without gain, counted over all threads (they kick one shared
+  // incumbent).
   const int64_t converge_after =
-      std::max<int64_t>(options.min_kicks, static_cast<int64_t>(options.kicks_per_rank * n)) / threads;
+      std::max<int64_t>(options.min_kicks, static_cast<int64_t>(options.kicks_per_rank * n));
+  Incumbent incumbent;
   struct Outcome {
     std::vector<int> tour;
     double cost = std::numeric_limits<double>::infinity();
     bool converged = true;
+    absl::Status audit;
   };
   std::vector<Outcome> outcomes(threads);
   // One construction (deterministic: repeating it per thread would only
-  // duplicate work), then per thread a descent from it and a kick run with
-  // its own seed; the threads share the cost cache.
+  // duplicate work), then per thread a descent from it, and the kick phase:
+  // with one thread a plain iterated local search, with more each thread
+  // kicks the shared incumbent with its own seed. The threads share the
+  // cost cache.
   std::vector<std::unique_ptr<Run>> runs;
   for (int t = 0; t < threads; ++t) {
     runs.push_back(std::make_unique<Run>(&problem, gtsp_internal::SeedFor(options.seed, t)));
@@ -842,12 +933,17 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
       r.LocalSearch(budget);
     }
     if (kicks) {
-      out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit);
+      Incumbent* shared = threads > 1 ? &incumbent : nullptr;
+      // The better descent becomes the incumbent; a thread that finishes
+      // its descent first kicks its own until the other's beats it.
+      if (shared != nullptr) r.Publish(shared);
+      out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit, shared);
     } else if (options.local_search) {
       out.converged = !budget.ShouldStop();  // the descent ran to its end
     }
     out.tour = r.tour();
     out.cost = r.cost();
+    out.audit = r.Audit();
   };
   {
     std::vector<std::thread> pool;
@@ -855,9 +951,16 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     run(0);
     for (auto& t : pool) t.join();
   }
+  for (const Outcome& o : outcomes) RETURN_IF_ERROR(o.audit);
   int best = -1;
   for (int t = 0; t < threads; ++t) {
     if (best < 0 || outcomes[t].cost < outcomes[best].cost - kEps) best = t;
+  }
+  // A thread's last tour may trail the incumbent (its last gain lost to a
+  // better one published meanwhile).
+  if (kicks && threads > 1 && incumbent.cost < outcomes[best].cost - kEps) {
+    RETURN_IF_ERROR(AuditTour(n, incumbent.t, incumbent.pos, incumbent.mate, incumbent.lc, incumbent.cost));
+    outcomes[best].tour = incumbent.t, outcomes[best].cost = incumbent.cost;
   }
   const std::vector<int>& t = outcomes[best].tour;
 
