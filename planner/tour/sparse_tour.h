@@ -20,8 +20,11 @@
 // visited), then 2-opt and Or-opt (1-3 ranks, either direction) restricted
 // to candidate lists, driven by a work queue, then iterated local search
 // with local double-bridge kicks and undo: one construction, then per
-// thread a descent (odd threads with the work queue reversed) and a kick
-// run (different seeds), the threads sharing the cost cache, the best kept.
+// thread a descent (odd threads with the work queue reversed), then the
+// kick phase, in which every thread (its own seed) kicks one shared
+// incumbent tour: a thread publishes a tour that beats it and takes a newer
+// one before its next kick. The threads share the cost cache; the returned
+// tour is audited (order, positions, links, cost).
 // A warm start replaces the construction by a remembered tour.
 // Only the final tour's transitions become paths (in parallel); plan
 // durations come from those paths.
@@ -55,8 +58,8 @@ struct SparseTourOptions {
   int num_threads = 1;
   bool local_search = true;     // false: nearest-neighbour tour only
   bool until_limit = false;     // true: keep kicking until the budget is spent
-  // Kicks without improvement after which a run counts as converged:
-  // max(min_kicks, kicks_per_rank * ranks).
+  // Kicks without improvement, summed over all threads, after which the
+  // kick phase counts as converged: max(min_kicks, kicks_per_rank * ranks).
   int64_t min_kicks = 500;
   double kicks_per_rank = 1.0;
   int64_t max_cached_pairs = 4'000'000;  // on-demand exact lengths kept
