@@ -10,10 +10,12 @@
 #   TOOL=0.1 REF_S=60 RUNS=1 MAPS=../shared/data/maps/ipa/lab_f_scan.png scripts/bench_buildings.sh
 # Environment: AFTER (build/bin/covplan), BEFORE (unset), RUNS (3),
 # BEFORE_RUNS (RUNS; runs of the before binary), REF_S
-# (30; 0 skips the reference), TOOL (0.8), IPA_DIR, MAPS (all), OUT (raw JSON
-# lines; default a temp file). Prints a markdown table with the median wall
-# time and the largest peak RSS of each binary's runs. The IPA maps are read
-# in place, never copied.
+# (30; 0 skips the reference), TOOL (0.8), IPA_DIR, MAPS (all), SEEDS (unset:
+# the default seed; else run k uses --seed SEEDS[k mod count]), OUT (raw JSON
+# lines; default a temp file). The before and after runs alternate. Prints a
+# markdown table with the median and the largest wall time and the largest
+# peak RSS of each binary's runs. The IPA maps are read in place, never
+# copied.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 AFTER=${AFTER:-build/bin/covplan}
@@ -39,11 +41,11 @@ fi
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
 echo "raw results: $OUT" >&2
 : > "$OUT"
-/usr/bin/python3 - "$OUT" "$AFTER" "$BEFORE" "$RUNS" "$REF_S" "$TOOL" "$BEFORE_RUNS" "${maps[@]}" <<'EOF'
+/usr/bin/python3 - "$OUT" "$AFTER" "$BEFORE" "$RUNS" "$REF_S" "$TOOL" "$BEFORE_RUNS" "${SEEDS:-}" "${maps[@]}" <<'EOF'
 import json, os, statistics, subprocess, sys, tempfile, time
 out, after, before, runs, ref_s = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), float(sys.argv[5])
-tool, before_runs = sys.argv[6], int(sys.argv[7])
-maps = sys.argv[8:]
+tool, before_runs, seeds = sys.argv[6], int(sys.argv[7]), sys.argv[8].split()
+maps = sys.argv[9:]
 tmp = tempfile.mkdtemp()
 
 def has_threads(binary):
@@ -73,16 +75,25 @@ with open(out, "w") as f:
     for m in maps:
         name = os.path.basename(m).split(".")[0]
         row = {"map": name}
+        results = {label: [] for label, _ in bins}
+        for k in range(max(runs, before_runs if before else 0)):
+            for label, b in bins:
+                if k >= (runs if label == "after" else before_runs):
+                    continue
+                extra = (["--threads", "2"] if has_threads(b) else []) + (["--seed", seeds[k % len(seeds)]] if seeds else [])
+                r = plan(b, m, extra)
+                r["seed"] = seeds[k % len(seeds)] if seeds else "default"
+                f.write(json.dumps({"map": name, "bin": label, **r}) + "\n")
+                results[label].append(r)
         for label, b in bins:
             thr = ["--threads", "2"] if has_threads(b) else []
-            rs = [plan(b, m, thr) for _ in range(runs if label == "after" else before_runs)]
-            for r in rs:
-                f.write(json.dumps({"map": name, "bin": label, **r}) + "\n")
+            rs = results[label]
             ok = [r for r in rs if "error" not in r]
             if not ok:
                 row[label] = {"error": rs[0]["error"]}
                 continue
-            row[label] = {"wall": statistics.median(r["wall_s"] for r in ok), "ranks": ok[0]["ranks"],
+            row[label] = {"wall": statistics.median(r["wall_s"] for r in ok), "wall_max": max(r["wall_s"] for r in ok),
+                          "ranks": ok[0]["ranks"],
                           "rss": max(r["rss_mib"] for r in ok),
                           "dur": statistics.median(r["duration_s"] for r in ok), "solver": ok[0]["tour_solver"]}
             if ref_s > 0 and label == "after":
@@ -93,25 +104,25 @@ with open(out, "w") as f:
         f.flush()
         print(f"  {name}: {row}", file=sys.stderr)
 
-hdr = "| map | ranks | tour | wall (median of %d) | peak RSS | est. duration | gap to %g s search |" % (runs, ref_s)
-sep = "|---|---:|---|---:|---:|---:|---:|"
+hdr = "| map | ranks | tour | wall (median of %d) | wall (max) | peak RSS | est. duration | gap to %g s search |" % (runs, ref_s)
+sep = "|---|---:|---|---:|---:|---:|---:|---:|"
 if before:
-    hdr += " before: wall | before: peak RSS | before: est. duration |"
-    sep += "---:|---:|---:|"
+    hdr += " before: wall | before: wall (max) | before: peak RSS | before: est. duration |"
+    sep += "---:|---:|---:|---:|"
 print(hdr); print(sep)
 walls, gaps = [], []
 for r in rows:
     a = r.get("after", {})
     if "error" in a:
-        line = f"| {r['map']} | – | – | error: {a['error']} | | | |"
+        line = f"| {r['map']} | – | – | error: {a['error']} | | | | |"
     else:
         gap = 100.0 * (a["dur"] - r["ref"]) / r["ref"] if r.get("ref") else None
         walls.append(a["wall"]); gaps.append(gap)
-        line = (f"| {r['map']} | {a['ranks']} | {a['solver']} | {a['wall']:.2f} s | {a['rss']:.0f} MiB | {a['dur']:.1f} s | "
+        line = (f"| {r['map']} | {a['ranks']} | {a['solver']} | {a['wall']:.2f} s | {a['wall_max']:.2f} s | {a['rss']:.0f} MiB | {a['dur']:.1f} s | "
                 + (f"{gap:+.2f} %" if gap is not None else "–") + " |")
     if before:
         b = r.get("before", {})
-        line += (f" error: {b['error'][:80]} | | |" if "error" in b else f" {b['wall']:.2f} s | {b['rss']:.0f} MiB | {b['dur']:.1f} s |")
+        line += (f" error: {b['error'][:80]} | | | |" if "error" in b else f" {b['wall']:.2f} s | {b['wall_max']:.2f} s | {b['rss']:.0f} MiB | {b['dur']:.1f} s |")
     print(line)
 if walls:
     g = [x for x in gaps if x is not None]
