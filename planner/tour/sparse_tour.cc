@@ -935,8 +935,9 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     if (kicks) {
       Incumbent* shared = threads > 1 ? &incumbent : nullptr;
       // The better descent becomes the incumbent; a thread that finishes
-      // its descent first kicks its own until the other's beats it.
-      if (shared != nullptr) r.Publish(shared);
+      // its descent first kicks its own until the other's beats it, and
+      // kicks without gain count again from the better one.
+      if (shared != nullptr && r.Publish(shared)) shared->stale = 0;
       out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit, shared);
     } else if (options.local_search) {
       out.converged = !budget.ShouldStop();  // the descent ran to its end
