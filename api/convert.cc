@@ -11,15 +11,15 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "planner/common/status_macros.h"
-#include "planner/grid/grid.h"
-#include "planner/grid/map_io.h"
-#include "planner/partition/rank.h"
+#include "api/convert_stc.h"
 #include "api/digest.h"
 #include "api/geojson.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
+#include "planner/common/status_macros.h"
+#include "planner/grid/grid.h"
+#include "planner/grid/map_io.h"
 #include "planner/oarp/oarp_planner.h"
-#include "api/convert_stc.h"
+#include "planner/partition/rank.h"
 
 namespace covplan {
 namespace {
@@ -96,8 +96,8 @@ absl::StatusOr<std::string> ReadFile(const std::string& path, int64_t max_bytes)
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) return absl::InvalidArgumentError(absl::StrCat("cannot read ", path, ": ", ec.message()));
   if (static_cast<int64_t>(size) > max_bytes) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "%s is %d bytes, above the limit of %d bytes", path, static_cast<int64_t>(size), max_bytes));
+    return absl::InvalidArgumentError(absl::StrFormat("%s is %d bytes, above the limit of %d bytes",
+                                                      path, static_cast<int64_t>(size), max_bytes));
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::InvalidArgumentError(absl::StrCat("cannot open ", path));
@@ -137,21 +137,26 @@ std::string ComputeMapId(const v1::Map& map) {
   AppendField(&canonical, "image", r.image());
   AppendField(&canonical, "yaml", r.yaml());
   // %a prints doubles exactly, so equal values give equal ids.
-  if (r.has_resolution()) AppendField(&canonical, "resolution", absl::StrFormat("%a", r.resolution()));
-  if (r.has_origin_x_m()) AppendField(&canonical, "origin_x_m", absl::StrFormat("%a", r.origin_x_m()));
-  if (r.has_origin_y_m()) AppendField(&canonical, "origin_y_m", absl::StrFormat("%a", r.origin_y_m()));
+  if (r.has_resolution())
+    AppendField(&canonical, "resolution", absl::StrFormat("%a", r.resolution()));
+  if (r.has_origin_x_m())
+    AppendField(&canonical, "origin_x_m", absl::StrFormat("%a", r.origin_x_m()));
+  if (r.has_origin_y_m())
+    AppendField(&canonical, "origin_y_m", absl::StrFormat("%a", r.origin_y_m()));
   if (r.has_negate()) AppendField(&canonical, "negate", r.negate() ? "1" : "0");
   if (r.has_occupied_thresh()) {
     AppendField(&canonical, "occupied_thresh", absl::StrFormat("%a", r.occupied_thresh()));
   }
-  if (r.has_free_thresh()) AppendField(&canonical, "free_thresh", absl::StrFormat("%a", r.free_thresh()));
+  if (r.has_free_thresh())
+    AppendField(&canonical, "free_thresh", absl::StrFormat("%a", r.free_thresh()));
 
   return Sha256Hex(canonical);
 }
 
 absl::Status ValidateMapId(absl::string_view map_id) {
   bool ok = map_id.size() == 64;
-  for (char c : map_id) ok = ok && (std::isdigit(static_cast<unsigned char>(c)) || (c >= 'a' && c <= 'f'));
+  for (char c : map_id)
+    ok = ok && (std::isdigit(static_cast<unsigned char>(c)) || (c >= 'a' && c <= 'f'));
   if (ok) return absl::OkStatus();
   return absl::InvalidArgumentError(absl::StrCat(
       "map_id '", map_id.substr(0, 80), "' is malformed: expected 64 lowercase hex digits"));
@@ -215,9 +220,9 @@ absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits&
     }
   }
   if (options.free_thresh >= options.occupied_thresh) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "map free_thresh (%g) must be below occupied_thresh (%g)", options.free_thresh,
-        options.occupied_thresh));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("map free_thresh (%g) must be below occupied_thresh (%g)",
+                        options.free_thresh, options.occupied_thresh));
   }
 
   absl::StatusOr<OccupancyMap> decoded = DecodeMapImage(r.image(), options);
@@ -234,7 +239,8 @@ absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits&
 
 absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request) {
   PlanRequest out;
-  out.planner = request.planner().empty() ? std::string(PlannerRegistry::kDefault) : request.planner();
+  out.planner =
+      request.planner().empty() ? std::string(PlannerRegistry::kDefault) : request.planner();
   if (out.planner.size() > 64) {
     return absl::InvalidArgumentError("planner: name longer than 64 characters");
   }
@@ -246,8 +252,10 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
   if (robot.has_max_speed_mps()) options.robot.max_speed_mps = robot.max_speed_mps();
   if (robot.has_acceleration_mps2()) options.robot.acceleration_mps2 = robot.acceleration_mps2();
   if (robot.has_turn_rate_deg_s()) options.robot.turn_rate_deg_s = robot.turn_rate_deg_s();
-  if (robot.has_start()) options.robot.start = Pose2{robot.start().x(), robot.start().y(), robot.start().theta()};
-  if (robot.has_end()) options.robot.end = Pose2{robot.end().x(), robot.end().y(), robot.end().theta()};
+  if (robot.has_start())
+    options.robot.start = Pose2{robot.start().x(), robot.start().y(), robot.start().theta()};
+  if (robot.has_end())
+    options.robot.end = Pose2{robot.end().x(), robot.end().y(), robot.end().theta()};
 
   if (request.planner_options_case() == v1::PlanRequest::kOarp || out.planner == "oarp") {
     if (request.planner_options_case() != v1::PlanRequest::kOarp &&
@@ -292,29 +300,41 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
             absl::StrCat(prefix, "tour_solver: unknown value ", static_cast<int>(tour)));
     }
     out.options = std::move(oarp);
-  } else if (request.planner_options_case() == v1::PlanRequest::kBoustrophedon || out.planner == "boustrophedon") {
+  } else if (request.planner_options_case() == v1::PlanRequest::kBoustrophedon ||
+             out.planner == "boustrophedon") {
     if (request.planner_options_case() != v1::PlanRequest::kBoustrophedon &&
         request.planner_options_case() != v1::PlanRequest::PLANNER_OPTIONS_NOT_SET) {
-      return absl::InvalidArgumentError("planner_options: planner 'boustrophedon' takes the boustrophedon options");
+      return absl::InvalidArgumentError(
+          "planner_options: planner 'boustrophedon' takes the boustrophedon options");
     }
     const v1::BoustrophedonOptions& b = request.boustrophedon();
     auto options_b = std::make_shared<BoustrophedonOptions>();
     switch (b.sweep_axis()) {
       case v1::SWEEP_AXIS_UNSPECIFIED:
-      case v1::SWEEP_AXIS_AUTO: options_b->sweep_axis = BoustrophedonAxis::kAuto; break;
-      case v1::SWEEP_AXIS_VERTICAL: options_b->sweep_axis = BoustrophedonAxis::kVertical; break;
-      case v1::SWEEP_AXIS_HORIZONTAL: options_b->sweep_axis = BoustrophedonAxis::kHorizontal; break;
+      case v1::SWEEP_AXIS_AUTO:
+        options_b->sweep_axis = BoustrophedonAxis::kAuto;
+        break;
+      case v1::SWEEP_AXIS_VERTICAL:
+        options_b->sweep_axis = BoustrophedonAxis::kVertical;
+        break;
+      case v1::SWEEP_AXIS_HORIZONTAL:
+        options_b->sweep_axis = BoustrophedonAxis::kHorizontal;
+        break;
       default:
-        return absl::InvalidArgumentError(
-            absl::StrCat("boustrophedon.sweep_axis: unknown value ", static_cast<int>(b.sweep_axis())));
+        return absl::InvalidArgumentError(absl::StrCat("boustrophedon.sweep_axis: unknown value ",
+                                                       static_cast<int>(b.sweep_axis())));
     }
     switch (b.tour_solver()) {
       case v1::TOUR_SOLVER_UNSPECIFIED:
-      case v1::GTSP: options_b->tour_solver = TourSolver::kGtsp; break;
-      case v1::GREEDY: options_b->tour_solver = TourSolver::kGreedy; break;
+      case v1::GTSP:
+        options_b->tour_solver = TourSolver::kGtsp;
+        break;
+      case v1::GREEDY:
+        options_b->tour_solver = TourSolver::kGreedy;
+        break;
       default:
-        return absl::InvalidArgumentError(
-            absl::StrCat("boustrophedon.tour_solver: unknown value ", static_cast<int>(b.tour_solver())));
+        return absl::InvalidArgumentError(absl::StrCat("boustrophedon.tour_solver: unknown value ",
+                                                       static_cast<int>(b.tour_solver())));
     }
     out.options = std::move(options_b);
   }
@@ -335,8 +355,8 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
   }
   if (request.planner_options_case() == v1::PlanRequest::kStc) {
     if (out.planner != "stc") {
-      return absl::InvalidArgumentError(
-          absl::StrCat("planner_options: the stc options are for planner 'stc', not '", out.planner, "'"));
+      return absl::InvalidArgumentError(absl::StrCat(
+          "planner_options: the stc options are for planner 'stc', not '", out.planner, "'"));
     }
     ASSIGN_OR_RETURN(out.options, StcOptionsFromProto(request.stc()));
   }
@@ -369,8 +389,8 @@ absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const InputLimits& lim
     }
     AreaLimits area_limits;
     area_limits.max_vertices = limits.max_area_vertices;
-    ASSIGN_OR_RETURN(Area area, Area::Create(PolygonsFromProto(pm.polygons()), "map.polygons",
-                                             area_limits));
+    ASSIGN_OR_RETURN(Area area,
+                     Area::Create(PolygonsFromProto(pm.polygons()), "map.polygons", area_limits));
     double resolution = pm.resolution();
     if (resolution == 0.0) resolution = 0.05;
     if (!std::isfinite(resolution) || resolution < 1e-3 || resolution > 10.0) {
@@ -404,8 +424,7 @@ v1::MapInfo MapInfoFor(const SiteMap& site, const std::string& map_id) {
   return info;
 }
 
-absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path,
-                                         const MapFileOverrides& overrides,
+absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path, const MapFileOverrides& overrides,
                                          const InputLimits& limits) {
   v1::Map map;
   std::filesystem::path file(path);

@@ -27,10 +27,10 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "covplan/v1/covplan.pb.h"
-#include "planner/grid/occupancy_map.h"
 #include "planner/engine/engine.h"
 #include "planner/engine/site.h"
 #include "planner/geometry/area.h"
+#include "planner/grid/occupancy_map.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"
 
@@ -38,13 +38,14 @@ namespace covplan {
 
 // Size limits on untrusted input.
 struct InputLimits {
-  int64_t max_image_bytes = 64ll << 20;   // encoded image size
-  int64_t max_map_pixels = 64'000'000;    // decoded width * height
-  int64_t max_grid_cells = 4'000'000;     // tool-width cells
-  int64_t max_ranks = 100'000;            // coverage ranks (hard cap)
-  int64_t max_transition_bytes = int64_t{1} << 30;   // transition memory per plan
-  int64_t dense_transition_bytes = int64_t{4} << 20;  // all-pairs table up to this (~100 ranks), sparse above
-  int64_t max_area_vertices = 100'000;    // per polygon map, regions or no_go
+  int64_t max_image_bytes = 64ll << 20;             // encoded image size
+  int64_t max_map_pixels = 64'000'000;              // decoded width * height
+  int64_t max_grid_cells = 4'000'000;               // tool-width cells
+  int64_t max_ranks = 100'000;                      // coverage ranks (hard cap)
+  int64_t max_transition_bytes = int64_t{1} << 30;  // transition memory per plan
+  int64_t dense_transition_bytes = int64_t{4}
+                                   << 20;  // all-pairs table up to this (~100 ranks), sparse above
+  int64_t max_area_vertices = 100'000;     // per polygon map, regions or no_go
 
   absl::Status Validate() const;
 };
@@ -92,7 +93,8 @@ absl::StatusOr<ReplanMethod> ReplanMethodFromProto(v1::ReplanMethod method);
 absl::StatusOr<RobotProgress> ProgressFromProto(const v1::RobotProgress& progress);
 Observations ObstaclesFromProto(const v1::Obstacles& obstacles);
 // `retained` is the new plan as the server keeps it (plan_id set).
-void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1::ReplanResponse* out);
+void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained,
+                   v1::ReplanResponse* out);
 // A plan the server did not retain, rebuilt on the map it was planned on.
 absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& plan,
                                                     const PlanningEngine& engine,
@@ -115,8 +117,7 @@ struct MapFileOverrides {
   std::optional<double> occupied_thresh;
   std::optional<double> free_thresh;
 };
-absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path,
-                                         const MapFileOverrides& overrides,
+absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path, const MapFileOverrides& overrides,
                                          const InputLimits& limits);
 
 }  // namespace covplan

@@ -10,12 +10,12 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "api/convert_stc.h"
 #include "google/protobuf/util/json_util.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
-#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
-#include "api/convert_stc.h"
 #include "planner/partition/rank.h"
 
 namespace covplan {
@@ -24,23 +24,34 @@ namespace {
 
 v1::SegmentKind KindToProto(SegmentKind k) {
   switch (k) {
-    case SegmentKind::kStart: return v1::START;
-    case SegmentKind::kCoverage: return v1::COVERAGE;
-    case SegmentKind::kTransition: return v1::TRANSITION;
-    case SegmentKind::kToStation: return v1::TO_STATION;
-    case SegmentKind::kFromStation: return v1::FROM_STATION;
+    case SegmentKind::kStart:
+      return v1::START;
+    case SegmentKind::kCoverage:
+      return v1::COVERAGE;
+    case SegmentKind::kTransition:
+      return v1::TRANSITION;
+    case SegmentKind::kToStation:
+      return v1::TO_STATION;
+    case SegmentKind::kFromStation:
+      return v1::FROM_STATION;
   }
   return v1::SEGMENT_KIND_UNSPECIFIED;
 }
 
 absl::StatusOr<SegmentKind> KindFromProto(v1::SegmentKind k) {
   switch (k) {
-    case v1::START: return SegmentKind::kStart;
-    case v1::COVERAGE: return SegmentKind::kCoverage;
-    case v1::TRANSITION: return SegmentKind::kTransition;
-    case v1::TO_STATION: return SegmentKind::kToStation;
-    case v1::FROM_STATION: return SegmentKind::kFromStation;
-    default: return absl::InvalidArgumentError("plan waypoint has no segment kind");
+    case v1::START:
+      return SegmentKind::kStart;
+    case v1::COVERAGE:
+      return SegmentKind::kCoverage;
+    case v1::TRANSITION:
+      return SegmentKind::kTransition;
+    case v1::TO_STATION:
+      return SegmentKind::kToStation;
+    case v1::FROM_STATION:
+      return SegmentKind::kFromStation;
+    default:
+      return absl::InvalidArgumentError("plan waypoint has no segment kind");
   }
 }
 
@@ -54,30 +65,42 @@ void RankToProto(const Rank& rank, v1::Rank* r) {
 
 v1::TerminationLimit LimitToProto(TerminationLimit l) {
   switch (l) {
-    case TerminationLimit::kNone: return v1::LIMIT_NONE;
-    case TerminationLimit::kTime: return v1::LIMIT_TIME;
-    case TerminationLimit::kDeadline: return v1::LIMIT_DEADLINE;
-    case TerminationLimit::kCancelled: return v1::LIMIT_CANCELLED;
+    case TerminationLimit::kNone:
+      return v1::LIMIT_NONE;
+    case TerminationLimit::kTime:
+      return v1::LIMIT_TIME;
+    case TerminationLimit::kDeadline:
+      return v1::LIMIT_DEADLINE;
+    case TerminationLimit::kCancelled:
+      return v1::LIMIT_CANCELLED;
   }
   return v1::TERMINATION_LIMIT_UNSPECIFIED;
 }
 
 v1::PlanSource PlanOriginToProto(PlanOrigin s) {
   switch (s) {
-    case PlanOrigin::kCold: return v1::PLAN_SOURCE_COLD;
-    case PlanOrigin::kCacheHit: return v1::PLAN_SOURCE_CACHE_HIT;
-    case PlanOrigin::kImproved: return v1::PLAN_SOURCE_IMPROVED;
-    case PlanOrigin::kWarmStart: return v1::PLAN_SOURCE_WARM_START;
+    case PlanOrigin::kCold:
+      return v1::PLAN_SOURCE_COLD;
+    case PlanOrigin::kCacheHit:
+      return v1::PLAN_SOURCE_CACHE_HIT;
+    case PlanOrigin::kImproved:
+      return v1::PLAN_SOURCE_IMPROVED;
+    case PlanOrigin::kWarmStart:
+      return v1::PLAN_SOURCE_WARM_START;
   }
   return v1::PLAN_SOURCE_UNSPECIFIED;
 }
 
 PlanOrigin PlanOriginFromProto(v1::PlanSource s) {
   switch (s) {
-    case v1::PLAN_SOURCE_CACHE_HIT: return PlanOrigin::kCacheHit;
-    case v1::PLAN_SOURCE_IMPROVED: return PlanOrigin::kImproved;
-    case v1::PLAN_SOURCE_WARM_START: return PlanOrigin::kWarmStart;
-    default: return PlanOrigin::kCold;
+    case v1::PLAN_SOURCE_CACHE_HIT:
+      return PlanOrigin::kCacheHit;
+    case v1::PLAN_SOURCE_IMPROVED:
+      return PlanOrigin::kImproved;
+    case v1::PLAN_SOURCE_WARM_START:
+      return PlanOrigin::kWarmStart;
+    default:
+      return PlanOrigin::kCold;
   }
 }
 
@@ -103,7 +126,8 @@ void PolygonsToProto(const std::vector<PolygonInput>& polygons,
   }
 }
 
-std::vector<PolygonInput> PolygonsFromProto(const google::protobuf::RepeatedPtrField<v1::Polygon>& in) {
+std::vector<PolygonInput> PolygonsFromProto(
+    const google::protobuf::RepeatedPtrField<v1::Polygon>& in) {
   std::vector<PolygonInput> out;
   out.reserve(in.size());
   for (const v1::Polygon& p : in) {
@@ -148,7 +172,8 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
       v1::BoustrophedonCell* c = d->add_cells();
       c->set_first_col(info.cell.first_col);
       for (const RowInterval& iv : info.cell.columns) c->add_row_lo(iv.lo), c->add_row_hi(iv.hi);
-      c->set_axis(info.axis == SweepAxis::kHorizontal ? v1::SWEEP_AXIS_HORIZONTAL : v1::SWEEP_AXIS_VERTICAL);
+      c->set_axis(info.axis == SweepAxis::kHorizontal ? v1::SWEEP_AXIS_HORIZONTAL
+                                                      : v1::SWEEP_AXIS_VERTICAL);
       c->set_num_lines(info.num_lines);
     }
     for (int index : bd->cell_order) d->add_cell_order(index);
@@ -172,7 +197,8 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
     o->set_resume_unit(c.resume_unit);
     o->set_resumes_mid_unit(c.resumes_mid_unit);
   }
-  if (const StcDetail* stc = plan.detail_as<StcDetail>()) StcDetailToProto(*stc, out->mutable_stc());
+  if (const StcDetail* stc = plan.detail_as<StcDetail>())
+    StcDetailToProto(*stc, out->mutable_stc());
   for (const Waypoint& w : plan.path) {
     v1::Waypoint* p = out->add_path();
     p->set_x(w.x);
@@ -188,8 +214,9 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
     for (const CellIndex& c : sweep.cells) s->add_cells(c.row * cols + c.col);
   }
   v1::Termination* t = out->mutable_termination();
-  t->set_reason(plan.termination.reason == TerminationReason::kConverged ? v1::CONVERGED
-                                                                          : v1::FEASIBLE_LIMIT_REACHED);
+  t->set_reason(plan.termination.reason == TerminationReason::kConverged
+                    ? v1::CONVERGED
+                    : v1::FEASIBLE_LIMIT_REACHED);
   t->set_limit(LimitToProto(plan.termination.limit));
   t->set_detail(plan.termination.detail);
   const PlanStats& s = plan.stats;
@@ -238,9 +265,9 @@ void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
 absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   const v1::Grid& g = response.grid();
   if (g.rows() <= 0 || g.cols() <= 0 || g.free_cells_size() != g.rows()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "plan grid is inconsistent: %d rows x %d cols with %d row strings", g.rows(), g.cols(),
-        g.free_cells_size()));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("plan grid is inconsistent: %d rows x %d cols with %d row strings",
+                        g.rows(), g.cols(), g.free_cells_size()));
   }
   if (!std::isfinite(g.cell_size_m()) || g.cell_size_m() <= 0.0) {
     return absl::InvalidArgumentError("plan grid cell_size_m must be positive");
@@ -272,8 +299,8 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
       if (r.orientation() != v1::HORIZONTAL && r.orientation() != v1::VERTICAL) {
         return absl::InvalidArgumentError("plan rank has no orientation");
       }
-      rank.orientation = r.orientation() == v1::HORIZONTAL ? Orientation::kHorizontal
-                                                           : Orientation::kVertical;
+      rank.orientation =
+          r.orientation() == v1::HORIZONTAL ? Orientation::kHorizontal : Orientation::kVertical;
       rank.first = {r.first_cell().row(), r.first_cell().col()};
       rank.last = {r.last_cell().row(), r.last_cell().col()};
       if (!plan.grid->InBounds(rank.first.row, rank.first.col) ||
@@ -307,7 +334,8 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
         }
         info.cell.columns.push_back({c.row_lo(k), c.row_hi(k)});
       }
-      info.axis = c.axis() == v1::SWEEP_AXIS_HORIZONTAL ? SweepAxis::kHorizontal : SweepAxis::kVertical;
+      info.axis =
+          c.axis() == v1::SWEEP_AXIS_HORIZONTAL ? SweepAxis::kHorizontal : SweepAxis::kVertical;
       info.num_lines = c.num_lines();
       detail->cells.push_back(std::move(info));
     }
@@ -354,10 +382,18 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
                                 ? TerminationReason::kFeasibleLimitReached
                                 : TerminationReason::kConverged;
   switch (t.limit()) {
-    case v1::LIMIT_TIME: plan.termination.limit = TerminationLimit::kTime; break;
-    case v1::LIMIT_DEADLINE: plan.termination.limit = TerminationLimit::kDeadline; break;
-    case v1::LIMIT_CANCELLED: plan.termination.limit = TerminationLimit::kCancelled; break;
-    default: plan.termination.limit = TerminationLimit::kNone; break;
+    case v1::LIMIT_TIME:
+      plan.termination.limit = TerminationLimit::kTime;
+      break;
+    case v1::LIMIT_DEADLINE:
+      plan.termination.limit = TerminationLimit::kDeadline;
+      break;
+    case v1::LIMIT_CANCELLED:
+      plan.termination.limit = TerminationLimit::kCancelled;
+      break;
+    default:
+      plan.termination.limit = TerminationLimit::kNone;
+      break;
   }
   plan.termination.detail = t.detail();
   const v1::PlanStats& s = response.stats();
@@ -396,10 +432,12 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
   for (const v1::ChargeCycle& c : response.cycles()) {
     const int n = static_cast<int>(plan.path.size());
     for (int w : {c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint()}) {
-      if (w < 0 || w >= n) return absl::InvalidArgumentError("plan charge cycle refers to a missing waypoint");
+      if (w < 0 || w >= n)
+        return absl::InvalidArgumentError("plan charge cycle refers to a missing waypoint");
     }
-    plan.cycles.push_back({c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint(),
-                           c.energy(), c.energy_at_leave(), c.resume_unit(), c.resumes_mid_unit()});
+    plan.cycles.push_back({c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(),
+                           c.leave_waypoint(), c.energy(), c.energy_at_leave(), c.resume_unit(),
+                           c.resumes_mid_unit()});
   }
   return plan;
 }

@@ -12,21 +12,27 @@ namespace covplan {
 absl::StatusOr<ReplanMethod> ReplanMethodFromProto(v1::ReplanMethod m) {
   switch (m) {
     case v1::REPLAN_METHOD_UNSPECIFIED:
-    case v1::AUTO: return ReplanMethod::kAuto;
-    case v1::ILP1: return ReplanMethod::kIlp1;
-    case v1::ILP2: return ReplanMethod::kIlp2;
-    case v1::GREEDY_DETOUR: return ReplanMethod::kGreedyDetour;
-    case v1::FULL: return ReplanMethod::kFull;
+    case v1::AUTO:
+      return ReplanMethod::kAuto;
+    case v1::ILP1:
+      return ReplanMethod::kIlp1;
+    case v1::ILP2:
+      return ReplanMethod::kIlp2;
+    case v1::GREEDY_DETOUR:
+      return ReplanMethod::kGreedyDetour;
+    case v1::FULL:
+      return ReplanMethod::kFull;
     default:
-      return absl::InvalidArgumentError(absl::StrFormat("method: unknown value %d", static_cast<int>(m)));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("method: unknown value %d", static_cast<int>(m)));
   }
 }
 
 absl::StatusOr<RobotProgress> ProgressFromProto(const v1::RobotProgress& p) {
   RobotProgress out;
   if (p.waypoint() < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("progress.waypoint must be >= 1 (or 0 with distance_m), got %d", p.waypoint()));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "progress.waypoint must be >= 1 (or 0 with distance_m), got %d", p.waypoint()));
   }
   if (p.waypoint() > 0) {
     out.waypoint = p.waypoint();
@@ -48,7 +54,8 @@ Observations ObstaclesFromProto(const v1::Obstacles& o) {
   return out;
 }
 
-void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1::ReplanResponse* out) {
+void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained,
+                   v1::ReplanResponse* out) {
   RetainedPlanToProto(retained, out->mutable_plan());
   const ReplanStats& s = result.stats;
   v1::ReplanStats* o = out->mutable_replan();
@@ -85,7 +92,8 @@ void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained, v1:
 
 absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& inline_plan,
                                                     const PlanningEngine& engine,
-                                                    const MapSource& source, const StopToken& stop) {
+                                                    const MapSource& source,
+                                                    const StopToken& stop) {
   ASSIGN_OR_RETURN(PlanRequest request, PlanRequestFromProto(inline_plan.request()));
   request.common.stop = stop;  // a cold grid build on a restarted server is bounded too
   ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area, engine.AreaFor(source, request));
@@ -118,7 +126,8 @@ absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& inline
   derived->cover = std::make_shared<const Grid>(drive.WithFreeFlags(std::move(cover)));
   derived->cover_cells = cover_cells;
   // Cells earlier replans cut off stay counted (the plan says how many).
-  derived->unreachable_cells = std::max<int64_t>(area->unreachable_cells, plan.stats.unreachable_free_cells);
+  derived->unreachable_cells =
+      std::max<int64_t>(area->unreachable_cells, plan.stats.unreachable_free_cells);
   plan.grid = derived->drive;
   RetainedPlan out;
   out.plan_id = inline_plan.plan().plan_id();

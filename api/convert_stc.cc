@@ -16,8 +16,8 @@ absl::StatusOr<StcTreeMethod> TreeFromProto(v1::StcTree t, const char* field) {
     case v1::STC_TREE_PRIM:
       return StcTreeMethod::kPrim;
     default:
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ": unknown value ", static_cast<int>(t), " (STC_TREE_DFS or STC_TREE_PRIM)"));
+      return absl::InvalidArgumentError(absl::StrCat(field, ": unknown value ", static_cast<int>(t),
+                                                     " (STC_TREE_DFS or STC_TREE_PRIM)"));
   }
 }
 
@@ -29,8 +29,9 @@ absl::StatusOr<SweepDirection> DirectionFromProto(v1::StcSweepDirection d, const
     case v1::STC_SWEEP_VERTICAL:
       return SweepDirection::kVertical;
     default:
-      return absl::InvalidArgumentError(absl::StrCat(
-          field, ": unknown value ", static_cast<int>(d), " (STC_SWEEP_HORIZONTAL or STC_SWEEP_VERTICAL)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ": unknown value ", static_cast<int>(d),
+                       " (STC_SWEEP_HORIZONTAL or STC_SWEEP_VERTICAL)"));
   }
 }
 
@@ -42,8 +43,9 @@ absl::StatusOr<PartialCells> PartialFromProto(v1::StcPartialCells p, const char*
     case v1::STC_PARTIAL_DISCARD:
       return PartialCells::kDiscard;
     default:
-      return absl::InvalidArgumentError(absl::StrCat(
-          field, ": unknown value ", static_cast<int>(p), " (STC_PARTIAL_COVER or STC_PARTIAL_DISCARD)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ": unknown value ", static_cast<int>(p),
+                       " (STC_PARTIAL_COVER or STC_PARTIAL_DISCARD)"));
   }
 }
 
@@ -59,11 +61,14 @@ v1::StcPartialCells PartialToProto(PartialCells p) {
 
 }  // namespace
 
-absl::StatusOr<std::shared_ptr<const StcOptions>> StcOptionsFromProto(const v1::StcOptions& options) {
+absl::StatusOr<std::shared_ptr<const StcOptions>> StcOptionsFromProto(
+    const v1::StcOptions& options) {
   auto out = std::make_shared<StcOptions>();
   ASSIGN_OR_RETURN(out->tree, TreeFromProto(options.tree(), "stc.tree"));
-  ASSIGN_OR_RETURN(out->sweep_direction, DirectionFromProto(options.sweep_direction(), "stc.sweep_direction"));
-  ASSIGN_OR_RETURN(out->partial_cells, PartialFromProto(options.partial_cells(), "stc.partial_cells"));
+  ASSIGN_OR_RETURN(out->sweep_direction,
+                   DirectionFromProto(options.sweep_direction(), "stc.sweep_direction"));
+  ASSIGN_OR_RETURN(out->partial_cells,
+                   PartialFromProto(options.partial_cells(), "stc.partial_cells"));
   RETURN_IF_ERROR(out->Validate());
   return std::shared_ptr<const StcOptions>(std::move(out));
 }
@@ -88,7 +93,8 @@ void StcDetailToProto(const StcDetail& d, v1::StcDetail* out) {
 absl::StatusOr<std::shared_ptr<const StcDetail>> StcDetailFromProto(const v1::StcDetail& p) {
   auto d = std::make_shared<StcDetail>();
   ASSIGN_OR_RETURN(d->tree, TreeFromProto(p.tree(), "stc.tree"));
-  ASSIGN_OR_RETURN(d->sweep_direction, DirectionFromProto(p.sweep_direction(), "stc.sweep_direction"));
+  ASSIGN_OR_RETURN(d->sweep_direction,
+                   DirectionFromProto(p.sweep_direction(), "stc.sweep_direction"));
   ASSIGN_OR_RETURN(d->partial_cells, PartialFromProto(p.partial_cells(), "stc.partial_cells"));
   if (p.offset_row() < 0 || p.offset_row() > 1 || p.offset_col() < 0 || p.offset_col() > 1) {
     return absl::InvalidArgumentError("stc.offset_row / stc.offset_col must be 0 or 1");

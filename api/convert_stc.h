@@ -17,7 +17,8 @@
 
 namespace covplan {
 
-absl::StatusOr<std::shared_ptr<const StcOptions>> StcOptionsFromProto(const v1::StcOptions& options);
+absl::StatusOr<std::shared_ptr<const StcOptions>> StcOptionsFromProto(
+    const v1::StcOptions& options);
 void StcDetailToProto(const StcDetail& detail, v1::StcDetail* out);
 absl::StatusOr<std::shared_ptr<const StcDetail>> StcDetailFromProto(const v1::StcDetail& detail);
 

@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
 #include "absl/strings/str_format.h"
+#include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
-#include "planner/engine/plan_coverage.h"
 #include "planner/plan/svg.h"
-#include <fstream>
 
 namespace covplan {
 namespace {
@@ -48,11 +48,13 @@ std::string Base(const std::string& p) {
 
 int Run(const Args& a) {
   std::string partition_table =
-      "| map | grid (rows x cols) | free cells | unreachable cells | ranks (min-cut) | ranks (LP) | "
+      "| map | grid (rows x cols) | free cells | unreachable cells | ranks (min-cut) | ranks (LP) "
+      "| "
       "ranks without thin-wall barriers | min-cut ms | LP ms | covered free-area ratio |\n"
       "|---|---|---|---|---|---|---|---|---|---|\n";
   std::string plan_table =
-      "| map | tour | ranks | turns | coverage m | transition m | duration s | grid ms | partition ms | "
+      "| map | tour | ranks | turns | coverage m | transition m | duration s | grid ms | partition "
+      "ms | "
       "transitions ms | tour ms | total ms (median) | gap to long search |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const std::string& path : a.maps) {
@@ -99,13 +101,13 @@ int Run(const Args& a) {
     plain.min_free_fraction = po.min_free_fraction;
     plain.thin_wall_barriers = false;
     auto plain_grid = BuildGrid(*map, plain);
-    const size_t plain_ranks = MinCutPartitioner().Partition(*plain_grid, StopToken())->ranks.size();
-    absl::StrAppendFormat(&partition_table, "| %s | %d x %d | %d | %d | %d | %s | %d | %.2f | %s | %.4f |\n",
-                          Base(path), grid.rows(), grid.cols(), grid.CountFree(),
-                          area.unreachable_cells, cut_ranks,
-                          a.lp ? absl::StrCat(lp_ranks) : "-", plain_ranks, Median(cut_ms),
-                          a.lp ? absl::StrFormat("%.1f", Median(lp_ms)) : "-",
-                          area.covered_free_area_ratio);
+    const size_t plain_ranks =
+        MinCutPartitioner().Partition(*plain_grid, StopToken())->ranks.size();
+    absl::StrAppendFormat(
+        &partition_table, "| %s | %d x %d | %d | %d | %d | %s | %d | %.2f | %s | %.4f |\n",
+        Base(path), grid.rows(), grid.cols(), grid.CountFree(), area.unreachable_cells, cut_ranks,
+        a.lp ? absl::StrCat(lp_ranks) : "-", plain_ranks, Median(cut_ms),
+        a.lp ? absl::StrFormat("%.1f", Median(lp_ms)) : "-", area.covered_free_area_ratio);
     std::fflush(stdout);
     // Long reference search for the tour gap.
     double reference = 0.0;
@@ -131,20 +133,24 @@ int Run(const Args& a) {
         total.push_back(last->stats.planning_ms);
       }
       if (!last.ok()) {
-        std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(last.status().message()).c_str());
+        std::fprintf(stderr, "%s: %s\n", path.c_str(),
+                     std::string(last.status().message()).c_str());
         return 1;
       }
       if (!a.svg_dir.empty() && ts == TourSolver::kGtsp) {
         std::ofstream(a.svg_dir + "/" + Base(path) + ".svg") << RenderPlanSvg(*last, &*map);
       }
       const PlanStats& s = last->stats;
-      const std::string gap = reference > 0
-          ? absl::StrFormat("%+.2f %%", 100.0 * (s.estimated_duration_s - reference) / reference)
-          : "-";
-      absl::StrAppendFormat(&plan_table, "| %s | %s | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s |\n",
-                            Base(path), s.tour_solver, s.num_ranks, s.num_turns, s.coverage_length_m,
-                            s.transition_length_m, s.estimated_duration_s, s.grid_ms, s.partition_ms,
-                            s.transitions_ms, s.tour_ms, Median(total), gap);
+      const std::string gap =
+          reference > 0 ? absl::StrFormat("%+.2f %%",
+                                          100.0 * (s.estimated_duration_s - reference) / reference)
+                        : "-";
+      absl::StrAppendFormat(
+          &plan_table,
+          "| %s | %s | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s |\n",
+          Base(path), s.tour_solver, s.num_ranks, s.num_turns, s.coverage_length_m,
+          s.transition_length_m, s.estimated_duration_s, s.grid_ms, s.partition_ms,
+          s.transitions_ms, s.tour_ms, Median(total), gap);
     }
     std::fprintf(stderr, "done %s\n", path.c_str());
   }
@@ -166,24 +172,34 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (k == "--resolution") a.resolution = std::atof(next().c_str());
-    else if (k == "--free-thresh") a.free_thresh = std::atof(next().c_str());
-    else if (k == "--tool-width") a.tool_width = std::atof(next().c_str());
-    else if (k == "--time-limit") a.time_limit = std::atof(next().c_str());
-    else if (k == "--reference-s") a.reference_s = std::atof(next().c_str());
-    else if (k == "--runs") a.runs = std::atoi(next().c_str());
-    else if (k == "--threads") a.threads = std::atoi(next().c_str());
-    else if (k == "--no-lp") a.lp = false;
+    if (k == "--resolution")
+      a.resolution = std::atof(next().c_str());
+    else if (k == "--free-thresh")
+      a.free_thresh = std::atof(next().c_str());
+    else if (k == "--tool-width")
+      a.tool_width = std::atof(next().c_str());
+    else if (k == "--time-limit")
+      a.time_limit = std::atof(next().c_str());
+    else if (k == "--reference-s")
+      a.reference_s = std::atof(next().c_str());
+    else if (k == "--runs")
+      a.runs = std::atoi(next().c_str());
+    else if (k == "--threads")
+      a.threads = std::atoi(next().c_str());
+    else if (k == "--no-lp")
+      a.lp = false;
     else if (k == "--effort") {
       const std::string e = next();
-      a.effort = e == "fast" ? covplan::GtspEffort::kFast
-               : e == "thorough" ? covplan::GtspEffort::kThorough : covplan::GtspEffort::kDefault;
-    }
-    else if (k == "--svg-dir") a.svg_dir = next();
+      a.effort = e == "fast"       ? covplan::GtspEffort::kFast
+                 : e == "thorough" ? covplan::GtspEffort::kThorough
+                                   : covplan::GtspEffort::kDefault;
+    } else if (k == "--svg-dir")
+      a.svg_dir = next();
     else if (k.rfind("--", 0) == 0) {
       std::fprintf(stderr, "unknown flag %s\n", k.c_str());
       return 2;
-    } else a.maps.push_back(k);
+    } else
+      a.maps.push_back(k);
   }
   if (a.maps.empty()) {
     std::fprintf(stderr, "usage: map_bench [flags] MAP...\n");

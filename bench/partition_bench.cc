@@ -44,7 +44,8 @@ Grid BuildingGrid(int64_t cells, uint32_t seed) {
   }
   const int64_t furniture = cells / 60;
   for (int64_t k = 0; k < furniture; ++k) {
-    block(static_cast<int>(rng() % rows), static_cast<int>(rng() % cols), 1 + rng() % 3, 1 + rng() % 4);
+    block(static_cast<int>(rng() % rows), static_cast<int>(rng() % cols), 1 + rng() % 3,
+          1 + rng() % 4);
   }
   return Grid(rows, cols, 0.8, {0, 0}, std::move(free));
 }
@@ -69,7 +70,10 @@ void TimePartition(benchmark::State& state, const Grid& grid, const RankPartitio
 void BM_MinCut(benchmark::State& state) {
   TimePartition(state, BuildingGrid(state.range(0), 42), MinCutPartitioner(state.range(1) != 0));
 }
-BENCHMARK(BM_MinCut)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_MinCut)
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 // An open field (a lawn) of `cells` cells with a scattered 1 % of blocked
 // cells (trees, posts).
@@ -85,7 +89,10 @@ Grid FieldGrid(int64_t cells, uint32_t seed) {
 void BM_MinCutField(benchmark::State& state) {
   TimePartition(state, FieldGrid(state.range(0), 42), MinCutPartitioner(state.range(1) != 0));
 }
-BENCHMARK(BM_MinCutField)->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_MinCutField)
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 // Matching: /0 = multi-source BFS with grafting, /1 = Hopcroft-Karp, /2 =
 // multi-source BFS without the greedy initial matching, /3 = Pothen-Fan (PF+).
@@ -98,26 +105,47 @@ void BM_Matching(benchmark::State& state) {
                                         variant != 2);
   TimePartition(state, MakeGrid(state.range(0), 42), partitioner);
 }
-BENCHMARK_TEMPLATE(BM_Matching, BuildingGrid)->Name("BM_MatchingBuilding")
-    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK_TEMPLATE(BM_Matching, FieldGrid)->Name("BM_MatchingField")
-    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_TEMPLATE(BM_Matching, BuildingGrid)
+    ->Name("BM_MatchingBuilding")
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_TEMPLATE(BM_Matching, FieldGrid)
+    ->Name("BM_MatchingField")
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1, 2, 3}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 // The same cut graph as BM_MinCut*, by push-relabel on the implicit grid.
 template <Grid (*MakeGrid)(int64_t, uint32_t)>
 void BM_PushRelabel(benchmark::State& state) {
   TimePartition(state, MakeGrid(state.range(0), 42), PushRelabelPartitioner());
 }
-BENCHMARK_TEMPLATE(BM_PushRelabel, BuildingGrid)->Name("BM_PushRelabelBuilding")
-    ->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK_TEMPLATE(BM_PushRelabel, FieldGrid)->Name("BM_PushRelabelField")
-    ->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_TEMPLATE(BM_PushRelabel, BuildingGrid)
+    ->Name("BM_PushRelabelBuilding")
+    ->Arg(10'000)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_TEMPLATE(BM_PushRelabel, FieldGrid)
+    ->Name("BM_PushRelabelField")
+    ->Arg(10'000)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 void BM_Lp(benchmark::State& state) {
   // GLPK cannot be interrupted: cap at 5 minutes.
   TimePartition(state, BuildingGrid(state.range(0), 42), LpPartitioner(300.0));
 }
-BENCHMARK(BM_Lp)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_Lp)
+    ->Arg(10'000)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 }  // namespace
 }  // namespace covplan

@@ -21,8 +21,8 @@
 namespace covplan {
 
 struct ParsedArgs {
-  std::map<std::string, std::string> values;  // flag name (without --) -> value
-  std::set<std::string> switches;             // boolean flags that are on
+  std::map<std::string, std::string> values;                 // flag name (without --) -> value
+  std::set<std::string> switches;                            // boolean flags that are on
   std::map<std::string, std::vector<std::string>> repeated;  // repeatable flags, in order
 
   std::optional<std::string> Get(const std::string& name) const;

@@ -42,8 +42,8 @@ std::string TerminationText(const Termination& t) {
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(ParsedArgs a,
                    ParseArgs(args,
-                             {"map", "algorithms", "tool-width", "json", "resolution", "free-thresh",
-                              "occupied-thresh", "time-limit", "seed", "name"},
+                             {"map", "algorithms", "tool-width", "json", "resolution",
+                              "free-thresh", "occupied-thresh", "time-limit", "seed", "name"},
                              {"markdown", "no-header", "negate"}));
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   const std::string map_path = *a.Get("map");
@@ -123,8 +123,8 @@ absl::StatusOr<std::vector<ComparisonRow>> ComparePlanners(const PlannerRegistry
                                                            const EngineLimits& limits) {
   for (const std::string& name : planners) {
     if (registry.Find(name) == nullptr) {
-      return absl::InvalidArgumentError(absl::StrFormat("unknown algorithm '%s'; registered: %s", name,
-                                                        absl::StrJoin(registry.Names(), ", ")));
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "unknown algorithm '%s'; registered: %s", name, absl::StrJoin(registry.Names(), ", ")));
     }
   }
   std::vector<ComparisonRow> rows;
@@ -138,7 +138,8 @@ absl::StatusOr<std::vector<ComparisonRow>> ComparePlanners(const PlannerRegistry
     absl::StatusOr<EngineResult> result = engine.Plan(source, r);
     const double ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
     if (!result.ok()) {
-      return absl::Status(result.status().code(), absl::StrCat(name, ": ", result.status().message()));
+      return absl::Status(result.status().code(),
+                          absl::StrCat(name, ": ", result.status().message()));
     }
     const PlanStats& s = result->plan.stats;
     ComparisonRow row;
@@ -151,8 +152,9 @@ absl::StatusOr<std::vector<ComparisonRow>> ComparePlanners(const PlannerRegistry
     // The area's ratio assumes every cell to cover is swept; scale it by the
     // share actually swept (equal for planners that cover everything).
     row.covered_free_area_ratio =
-        s.free_cells > 0 ? s.covered_free_area_ratio * std::min<double>(1.0, static_cast<double>(s.covered_cells) /
-                                                                                 static_cast<double>(s.free_cells))
+        s.free_cells > 0 ? s.covered_free_area_ratio *
+                               std::min<double>(1.0, static_cast<double>(s.covered_cells) /
+                                                         static_cast<double>(s.free_cells))
                          : 0.0;
     row.redundant_cells = CountRedundantCells(*result->area, result->plan.path);
     row.planning_ms = ms;
@@ -163,13 +165,15 @@ absl::StatusOr<std::vector<ComparisonRow>> ComparePlanners(const PlannerRegistry
 }
 
 std::string ComparisonTable(const std::vector<ComparisonRow>& rows) {
-  std::string out = absl::StrFormat("%-14s %7s %11s %12s %9s %16s %12s  %s\n", "planner", "turns", "length_m",
-                                    "duration_s", "covered", "redundant_cells", "planning_ms", "search");
+  std::string out =
+      absl::StrFormat("%-14s %7s %11s %12s %9s %16s %12s  %s\n", "planner", "turns", "length_m",
+                      "duration_s", "covered", "redundant_cells", "planning_ms", "search");
   for (const ComparisonRow& r : rows) {
-    out += absl::StrFormat("%-14s %7d %11.1f %12.1f %8.1f%% %9d (%4.1f%%) %12.1f  %s\n", r.planner, r.turns,
-                           r.length_m, r.duration_s, 100.0 * r.covered_free_area_ratio, r.redundant_cells,
-                           r.cells_to_cover > 0 ? 100.0 * r.redundant_cells / r.cells_to_cover : 0.0,
-                           r.planning_ms, r.termination);
+    out += absl::StrFormat(
+        "%-14s %7d %11.1f %12.1f %8.1f%% %9d (%4.1f%%) %12.1f  %s\n", r.planner, r.turns,
+        r.length_m, r.duration_s, 100.0 * r.covered_free_area_ratio, r.redundant_cells,
+        r.cells_to_cover > 0 ? 100.0 * r.redundant_cells / r.cells_to_cover : 0.0, r.planning_ms,
+        r.termination);
   }
   return out;
 }
@@ -179,15 +183,17 @@ std::string ComparisonMarkdown(const std::vector<ComparisonRow>& rows, const std
   std::string out;
   const std::string lead = map_name.empty() ? "" : "| map ";
   if (header) {
-    out += lead + "| planner | turns | length (m) | duration (s) | covered free area | redundant cells | planning (ms) |\n";
+    out += lead +
+           "| planner | turns | length (m) | duration (s) | covered free area | redundant cells | "
+           "planning (ms) |\n";
     out += std::string(map_name.empty() ? "" : "|---") + "|---|---:|---:|---:|---:|---:|---:|\n";
   }
   for (const ComparisonRow& r : rows) {
     if (!map_name.empty()) out += absl::StrCat("| ", map_name, " ");
-    out += absl::StrFormat("| %s | %d | %.1f | %.1f | %.1f %% | %d (%.1f %%) | %.1f |\n", r.planner, r.turns,
-                           r.length_m, r.duration_s, 100.0 * r.covered_free_area_ratio, r.redundant_cells,
-                           r.cells_to_cover > 0 ? 100.0 * r.redundant_cells / r.cells_to_cover : 0.0,
-                           r.planning_ms);
+    out += absl::StrFormat(
+        "| %s | %d | %.1f | %.1f | %.1f %% | %d (%.1f %%) | %.1f |\n", r.planner, r.turns,
+        r.length_m, r.duration_s, 100.0 * r.covered_free_area_ratio, r.redundant_cells,
+        r.cells_to_cover > 0 ? 100.0 * r.redundant_cells / r.cells_to_cover : 0.0, r.planning_ms);
   }
   return out;
 }
@@ -212,11 +218,12 @@ std::string ComparisonJson(const std::vector<ComparisonRow>& rows, const std::st
         "    {\"planner\": %s, \"turns\": %d, \"length_m\": %.6g, \"duration_s\": %.6g, "
         "\"covered_free_area_ratio\": %.6g, \"cells_to_cover\": %d, \"covered_cells\": %d, "
         "\"redundant_cells\": %d, \"planning_ms\": %.6g, \"termination\": %s}",
-        quote(r.planner), r.turns, r.length_m, r.duration_s, r.covered_free_area_ratio, r.cells_to_cover,
-        r.covered_cells, r.redundant_cells, r.planning_ms, quote(r.termination)));
+        quote(r.planner), r.turns, r.length_m, r.duration_s, r.covered_free_area_ratio,
+        r.cells_to_cover, r.covered_cells, r.redundant_cells, r.planning_ms, quote(r.termination)));
   }
-  return absl::StrFormat("{\n  \"map\": %s,\n  \"tool_width_m\": %.6g,\n  \"planners\": [\n%s\n  ]\n}\n",
-                         quote(map_path), tool_width_m, absl::StrJoin(items, ",\n"));
+  return absl::StrFormat(
+      "{\n  \"map\": %s,\n  \"tool_width_m\": %.6g,\n  \"planners\": [\n%s\n  ]\n}\n",
+      quote(map_path), tool_width_m, absl::StrJoin(items, ",\n"));
 }
 
 int RunCompareCommand(const std::vector<std::string>& args) {

@@ -14,7 +14,8 @@ absl::StatusOr<std::string> ReadFlagFile(const std::string& flag, const std::str
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
-  if (!in) return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", path, ": cannot read it"));
+  if (!in)
+    return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", path, ": cannot read it"));
   return text.str();
 }
 

@@ -2,8 +2,9 @@
 // bearer token, parsed the same way by every command that talks to one.
 //
 //   ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, WithConnectionFlags({"server", "map"}), {}));
-//   ASSIGN_OR_RETURN(Connection server, ConnectionFromArgs(a, a.Get("server").value_or(kDefaultServer)));
-//   std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(server);
+//   ASSIGN_OR_RETURN(Connection server, ConnectionFromArgs(a,
+//   a.Get("server").value_or(kDefaultServer))); std::unique_ptr<RemotePlanner> remote =
+//   RemotePlanner::Connect(server);
 //
 // --tls-ca / --tls-cert / --tls-key are PEM files (the CA to trust; a client
 // certificate and its key for mutual TLS); any of them turns TLS on (without
@@ -31,7 +32,7 @@ struct Connection {
   std::string ca_pem;    // empty with TLS: the system's roots
   std::string cert_pem;  // client certificate (mutual TLS), with key_pem
   std::string key_pem;
-  std::string token;     // empty: no authorization metadata
+  std::string token;  // empty: no authorization metadata
 };
 
 // The value flags above added to a command's own.

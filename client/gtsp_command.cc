@@ -32,11 +32,21 @@ std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -87,7 +97,8 @@ std::string ParseArgs(const std::vector<std::string>& args, Args& out, bool& hel
       }
       out.time_limit_s = s;
     } else if (arg == "--seed") {
-      if (!absl::SimpleAtoi(value, &out.seed)) return absl::StrCat("--seed must be a non-negative integer, got '", value, "'");
+      if (!absl::SimpleAtoi(value, &out.seed))
+        return absl::StrCat("--seed must be a non-negative integer, got '", value, "'");
     } else if (arg == "--threads") {
       if (!absl::SimpleAtoi(value, &out.threads) || out.threads < 1 || out.threads > 256) {
         return absl::StrCat("--threads must be an integer in [1, 256], got '", value, "'");

@@ -19,7 +19,8 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: covplan health --server HOST:PORT [--service NAME] [--timeout-ms T]\n"
-    "                     [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
+    "                     [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file "
+    "F]\n"
     "Prints the grpc.health.v1 status (SERVING, NOT_SERVING, ...); exit 0 only for SERVING.\n";
 
 // grpc.health.v1.HealthCheckRequest { string service = 1; } by hand: the
@@ -53,15 +54,20 @@ int DecodeStatus(const std::string& bytes) {
 
 const char* StatusName(int status) {
   switch (status) {
-    case 1: return "SERVING";
-    case 2: return "NOT_SERVING";
-    case 3: return "SERVICE_UNKNOWN";
-    default: return "UNKNOWN";
+    case 1:
+      return "SERVING";
+    case 2:
+      return "NOT_SERVING";
+    case 3:
+      return "SERVICE_UNKNOWN";
+    default:
+      return "UNKNOWN";
   }
 }
 
 absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, WithConnectionFlags({"server", "service", "timeout-ms"}), {}));
+  ASSIGN_OR_RETURN(ParsedArgs a,
+                   ParseArgs(args, WithConnectionFlags({"server", "service", "timeout-ms"}), {}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   ASSIGN_OR_RETURN(std::optional<int64_t> timeout_ms, a.GetInt("timeout-ms"));
   const int64_t timeout = timeout_ms.value_or(2000);
@@ -96,11 +102,13 @@ absl::Status Run(const std::vector<std::string>& args) {
   std::vector<grpc::Slice> slices;
   std::string bytes;
   if (reply.Dump(&slices).ok()) {
-    for (const grpc::Slice& s : slices) bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+    for (const grpc::Slice& s : slices)
+      bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
   }
   const int serving = DecodeStatus(bytes);
   std::printf("%s\n", StatusName(serving));
-  if (serving != 1) return absl::UnavailableError(absl::StrCat("server reports ", StatusName(serving)));
+  if (serving != 1)
+    return absl::UnavailableError(absl::StrCat("server reports ", StatusName(serving)));
   return absl::OkStatus();
 }
 

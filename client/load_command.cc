@@ -13,10 +13,10 @@
 #include "absl/strings/str_split.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
+#include "api/convert.h"
 #include "client/args.h"
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
-#include "api/convert.h"
 #include "planner/engine/engine.h"
 
 namespace covplan {
@@ -24,7 +24,8 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: covplan load --server HOST:PORT (--map FILE | --maps DIR|F1,F2,...)\n"
-    "                   [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
+    "                   [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file "
+    "F]\n"
     "                    [--concurrency N] [--duration S] [--requests N]\n"
     "                    [--deadline-ms D] [--resolution M] [--tool-width M]\n"
     "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n"
@@ -60,17 +61,23 @@ absl::StatusOr<std::vector<Point2>> ReachableCellCentres(const v1::Map& map, dou
       if (drive.IsFree(r, c)) centres.push_back(drive.CellCenter(r, c));
     }
   }
-  if (centres.empty()) return absl::InvalidArgumentError("--random-start: the map has no reachable cell");
+  if (centres.empty())
+    return absl::InvalidArgumentError("--random-start: the map has no reachable cell");
   return centres;
 }
 
 std::string SourceName(v1::PlanSource s) {
   switch (s) {
-    case v1::PLAN_SOURCE_COLD: return "cold";
-    case v1::PLAN_SOURCE_CACHE_HIT: return "cache_hit";
-    case v1::PLAN_SOURCE_IMPROVED: return "improved";
-    case v1::PLAN_SOURCE_WARM_START: return "warm_start";
-    default: return "unspecified";
+    case v1::PLAN_SOURCE_COLD:
+      return "cold";
+    case v1::PLAN_SOURCE_CACHE_HIT:
+      return "cache_hit";
+    case v1::PLAN_SOURCE_IMPROVED:
+      return "improved";
+    case v1::PLAN_SOURCE_WARM_START:
+      return "warm_start";
+    default:
+      return "unspecified";
   }
 }
 
@@ -87,7 +94,8 @@ absl::StatusOr<std::vector<std::string>> MapFiles(const std::string& spec) {
   } else {
     for (absl::string_view f : absl::StrSplit(spec, ',', absl::SkipEmpty())) files.emplace_back(f);
   }
-  if (files.empty()) return absl::InvalidArgumentError(absl::StrCat("--maps ", spec, ": no map files"));
+  if (files.empty())
+    return absl::InvalidArgumentError(absl::StrCat("--maps ", spec, ": no map files"));
   return files;
 }
 
@@ -98,12 +106,13 @@ double Percentile(std::vector<double> sorted, double q) {
 }
 
 absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(ParsedArgs a,
-                   ParseArgs(args,
-                             WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
-                                                  "deadline-ms", "resolution", "tool-width", "time-limit",
-                                                  "tour", "backoff-ms", "zipf", "seed", "requests"}),
-                             {"inline", "random-start", "full-replies"}));
+  ASSIGN_OR_RETURN(
+      ParsedArgs a,
+      ParseArgs(args,
+                WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
+                                     "deadline-ms", "resolution", "tool-width", "time-limit",
+                                     "tour", "backoff-ms", "zipf", "seed", "requests"}),
+                {"inline", "random-start", "full-replies"}));
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   if (!a.Get("map") == !a.Get("maps")) {
     return absl::InvalidArgumentError("exactly one of --map FILE or --maps DIR|LIST is required");
@@ -111,8 +120,10 @@ absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(std::optional<double> zipf, a.GetDouble("zipf"));
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
   ASSIGN_OR_RETURN(std::optional<int64_t> max_requests, a.GetInt("requests"));
-  if (zipf && !(*zipf >= 0 && *zipf <= 10)) return absl::InvalidArgumentError("--zipf must be in [0, 10]");
-  if (max_requests && *max_requests <= 0) return absl::InvalidArgumentError("--requests must be positive");
+  if (zipf && !(*zipf >= 0 && *zipf <= 10))
+    return absl::InvalidArgumentError("--zipf must be in [0, 10]");
+  if (max_requests && *max_requests <= 0)
+    return absl::InvalidArgumentError("--requests must be positive");
   ASSIGN_OR_RETURN(std::optional<int64_t> concurrency, a.GetInt("concurrency"));
   ASSIGN_OR_RETURN(std::optional<double> duration, a.GetDouble("duration"));
   ASSIGN_OR_RETURN(std::optional<int64_t> deadline_ms, a.GetInt("deadline-ms"));
@@ -122,9 +133,11 @@ absl::Status Run(const std::vector<std::string>& args) {
   MapFileOverrides overrides;
   ASSIGN_OR_RETURN(overrides.resolution, a.GetDouble("resolution"));
   const int threads = static_cast<int>(concurrency.value_or(4));
-  if (threads < 1 || threads > 1024) return absl::InvalidArgumentError("--concurrency must be in [1, 1024]");
+  if (threads < 1 || threads > 1024)
+    return absl::InvalidArgumentError("--concurrency must be in [1, 1024]");
   const double seconds = duration.value_or(10.0);
-  if (!(seconds > 0 && seconds <= 24 * 3600)) return absl::InvalidArgumentError("--duration must be in (0, 86400]");
+  if (!(seconds > 0 && seconds <= 24 * 3600))
+    return absl::InvalidArgumentError("--duration must be in (0, 86400]");
   const int64_t deadline = deadline_ms.value_or(1000);
   if (deadline <= 0) return absl::InvalidArgumentError("--deadline-ms must be positive");
 
@@ -211,7 +224,8 @@ absl::Status Run(const std::vector<std::string>& args) {
         const absl::Time sent = absl::Now();
         absl::StatusOr<v1::PlanStats> reply;
         if (full_replies) {
-          absl::StatusOr<v1::PlanResponse> whole = remote->Plan(request, absl::Milliseconds(deadline));
+          absl::StatusOr<v1::PlanResponse> whole =
+              remote->Plan(request, absl::Milliseconds(deadline));
           reply = whole.ok() ? absl::StatusOr<v1::PlanStats>(whole->stats()) : whole.status();
         } else {
           reply = remote->PlanStatsOnly(request, absl::Milliseconds(deadline));
@@ -258,7 +272,8 @@ std::string LoadReport::ToJson() const {
     absl::StrAppend(&sources_json, sources_json.empty() ? "" : ", ", "\"", source, "\": ", count);
   }
   std::string ids_json;
-  if (!map_ids.empty()) ids_json = absl::StrCat(", \"map_ids\": [\"", absl::StrJoin(map_ids, "\", \""), "\"]");
+  if (!map_ids.empty())
+    ids_json = absl::StrCat(", \"map_ids\": [\"", absl::StrJoin(map_ids, "\", \""), "\"]");
   return absl::StrFormat(
       "{\"requests\": %d, \"ok\": %d, \"codes\": {%s}, \"p50_ms\": %.2f, \"p95_ms\": %.2f, "
       "\"p99_ms\": %.2f, \"max_ms\": %.2f, \"late\": %d, \"cut_short\": %d, "
@@ -266,9 +281,10 @@ std::string LoadReport::ToJson() const {
       "\"throughput_rps\": %.2f, \"random_start\": %s, \"plan_sources\": {%s}, "
       "\"mean_estimated_duration_s\": %.3f%s}",
       requests, ok, codes_json, Percentile(sorted, 0.50), Percentile(sorted, 0.95),
-      Percentile(sorted, 0.99), sorted.empty() ? 0.0 : sorted.back(), late, cut_short,
-      concurrency, maps, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0,
-      random_start ? "true" : "false", sources_json, ok > 0 ? estimated_duration_sum_s / ok : 0.0, ids_json);
+      Percentile(sorted, 0.99), sorted.empty() ? 0.0 : sorted.back(), late, cut_short, concurrency,
+      maps, deadline_ms, duration_s, duration_s > 0 ? requests / duration_s : 0.0,
+      random_start ? "true" : "false", sources_json, ok > 0 ? estimated_duration_sum_s / ok : 0.0,
+      ids_json);
 }
 
 int RunLoadCommand(const std::vector<std::string>& args) {

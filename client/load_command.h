@@ -35,7 +35,7 @@ struct LoadReport {
   std::vector<double> latencies_ms;      // every reply
   double duration_s = 0;
   int concurrency = 0;
-  int maps = 1;  // distinct maps the requests were spread over
+  int maps = 1;                      // distinct maps the requests were spread over
   std::vector<std::string> map_ids;  // acknowledged by PutMap (empty with --inline)
   int64_t deadline_ms = 0;
   bool random_start = false;

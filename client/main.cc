@@ -6,9 +6,9 @@
 //   covplan resume --server HOST:PORT --plan-id P --at X,Y[,THETA] [--distance D]
 //   covplan load --server HOST:PORT --map FILE [--concurrency N] [--duration S] [--deadline-ms D]
 //   covplan gtsp ...
-//   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local | --server H:P]
-//   covplan compare --map FILE [--algorithms oarp,stc] [--tool-width M] [--json out.json]
-//   covplan partition --map FILE [--resolution M] [--tool-width M] [--solver NAME]
+//   covplan simulate --map KNOWN (--true-map TRUE | --clutter PCT) [--method auto] [--local |
+//   --server H:P] covplan compare --map FILE [--algorithms oarp,stc] [--tool-width M] [--json
+//   out.json] covplan partition --map FILE [--resolution M] [--tool-width M] [--solver NAME]
 //
 // Subcommands parse their own flags (client/args.h); no global flags.
 #include <cstdio>
@@ -17,10 +17,10 @@
 
 #include "absl/synchronization/mutex.h"
 #include "client/compare_command.h"
-#include "client/partition_command.h"
 #include "client/gtsp_command.h"
 #include "client/health_command.h"
 #include "client/load_command.h"
+#include "client/partition_command.h"
 #include "client/plan_command.h"
 #include "client/replan_command.h"
 #include "client/simulate_command.h"
@@ -59,7 +59,8 @@ int main(int argc, char** argv) {
   if (command == "resume") return covplan::RunResumeCommand(args);
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
-  if (command == "simulate") return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
+  if (command == "simulate")
+    return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
   if (command == "compare") return covplan::RunCompareCommand(args);
   if (command == "partition") return covplan::RunPartitionCommand(args);
   if (command == "health") return covplan::RunHealthCommand(args);

@@ -43,15 +43,19 @@ constexpr char kUsage[] =
 
 absl::StatusOr<std::unique_ptr<RankPartitioner>> SolverNamed(const std::string& name) {
   if (name == "pushrelabel") return std::make_unique<PushRelabelPartitioner>();
-  if (name == "matching") return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kMultiSourceBfs);
-  if (name == "matching-hk") return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kHopcroftKarp);
-  if (name == "matching-pf") return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kPothenFan);
+  if (name == "matching")
+    return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kMultiSourceBfs);
+  if (name == "matching-hk")
+    return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kHopcroftKarp);
+  if (name == "matching-pf")
+    return std::make_unique<MatchingPartitioner>(MatchingAlgorithm::kPothenFan);
   if (name == "mincut") return std::make_unique<MinCutPartitioner>(true);
   if (name == "mincut-bk") return std::make_unique<MinCutPartitioner>(false);
   if (name == "lp") return std::make_unique<LpPartitioner>();
-  return absl::InvalidArgumentError(absl::StrCat(
-      "--solver must be one of pushrelabel, matching, matching-hk, matching-pf, mincut, mincut-bk, lp; got '",
-      name.substr(0, 64), "'"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("--solver must be one of pushrelabel, matching, matching-hk, matching-pf, "
+                   "mincut, mincut-bk, lp; got '",
+                   name.substr(0, 64), "'"));
 }
 
 }  // namespace
@@ -67,7 +71,8 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
   ASSIGN_OR_RETURN(std::unique_ptr<RankPartitioner> solver, SolverNamed(solver_name));
   ASSIGN_OR_RETURN(std::optional<int64_t> repeat, a.GetInt("repeat"));
   if (repeat && (*repeat < 1 || *repeat > 1000)) {
-    return absl::InvalidArgumentError(absl::StrFormat("--repeat must be in [1, 1000], got %d", *repeat));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--repeat must be in [1, 1000], got %d", *repeat));
   }
   ASSIGN_OR_RETURN(const MapFileOverrides overrides, MapFileOverridesFromFlags(a));
   InputLimits limits;
@@ -93,7 +98,8 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
     runs.push_back(absl::ToDoubleMilliseconds(absl::Now() - t0));
     const int64_t n = static_cast<int64_t>(p.ranks.size());
     if (num_ranks >= 0 && n != num_ranks) {
-      return absl::InternalError(absl::StrFormat("solver %s gave %d ranks, then %d", solver_name, num_ranks, n));
+      return absl::InternalError(
+          absl::StrFormat("solver %s gave %d ranks, then %d", solver_name, num_ranks, n));
     }
     num_ranks = n;
   }
@@ -105,18 +111,20 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
       "{\"map\": %s, \"solver\": \"%s\", \"tool_width_m\": %g, \"rows\": %d, \"cols\": %d, "
       "\"free_cells\": %d, \"num_ranks\": %d, \"partition_ms\": %.3f, \"partition_ms_runs\": [%s], "
       "\"grid_ms\": %.3f}",
-      JsonString(map_path), solver_name, request.common.robot.tool_width_m, grid.rows(), grid.cols(),
-      grid.CountFree(), num_ranks, median,
-      absl::StrJoin(runs, ", ", [](std::string* out, double v) { absl::StrAppendFormat(out, "%.3f", v); }),
+      JsonString(map_path), solver_name, request.common.robot.tool_width_m, grid.rows(),
+      grid.cols(), grid.CountFree(), num_ranks, median,
+      absl::StrJoin(runs, ", ",
+                    [](std::string* out, double v) { absl::StrAppendFormat(out, "%.3f", v); }),
       grid_ms);
 }
 
 int RunPartitionCommand(const std::vector<std::string>& args) {
-  return RunSubcommand("partition", kUsage, args, [](const std::vector<std::string>& a) -> absl::Status {
-    ASSIGN_OR_RETURN(std::string json, PartitionCommandJson(a));
-    std::printf("%s\n", json.c_str());
-    return absl::OkStatus();
-  });
+  return RunSubcommand("partition", kUsage, args,
+                       [](const std::vector<std::string>& a) -> absl::Status {
+                         ASSIGN_OR_RETURN(std::string json, PartitionCommandJson(a));
+                         std::printf("%s\n", json.c_str());
+                         return absl::OkStatus();
+                       });
 }
 
 }  // namespace covplan

@@ -5,24 +5,24 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <sstream>
 #include <fstream>
 #include <optional>
 #include <random>
+#include <sstream>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "api/geojson.h"
 #include "client/args.h"
 #include "client/map_flags.h"
-#include "api/geojson.h"
 #include "client/remote.h"
+#include "planner/common/status_macros.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/engine/engine.h"
-#include "planner/oarp/oarp_planner.h"
-#include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
+#include "planner/oarp/oarp_planner.h"
 #include "planner/plan/svg.h"
 
 namespace covplan {
@@ -33,23 +33,30 @@ constexpr double kLocalDefaultBudgetS = 2.0;
 
 const char* PlanSourceText(v1::PlanSource s) {
   switch (s) {
-    case v1::PLAN_SOURCE_CACHE_HIT: return "remembered plan";
-    case v1::PLAN_SOURCE_IMPROVED: return "remembered plan, searched further";
-    case v1::PLAN_SOURCE_WARM_START: return "warm-started from a remembered tour";
-    default: return "cold";
+    case v1::PLAN_SOURCE_CACHE_HIT:
+      return "remembered plan";
+    case v1::PLAN_SOURCE_IMPROVED:
+      return "remembered plan, searched further";
+    case v1::PLAN_SOURCE_WARM_START:
+      return "warm-started from a remembered tour";
+    default:
+      return "cold";
   }
 }
 
 constexpr char kUsage[] =
     "usage: covplan plan --map FILE [--resolution M] [--tool-width M]\n"
     "                    [--local | --server HOST:PORT] [--out plan.json] [--svg plan.svg]\n"
-    "                    [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
-    "                    [--time-limit S] [--seed N] [--partition pushrelabel|matching|mincut|lp] [--tour gtsp|greedy]\n"
+    "                    [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file "
+    "F]\n"
+    "                    [--time-limit S] [--seed N] [--partition pushrelabel|matching|mincut|lp] "
+    "[--tour gtsp|greedy]\n"
     "                    [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                    [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                    [--min-free-fraction F] [--deadline-ms D] [--improve-remembered]\n"
     "                    [--threads N] [--tour-effort fast|default|thorough]   (--local)\n"
-    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner oarp|stc|boustrophedon]\n"
+    "                    [--start X,Y[,THETA]] [--end X,Y[,THETA]] [--planner "
+    "oarp|stc|boustrophedon]\n"
     "                    [--stc-tree dfs|prim] [--sweep-direction horizontal|vertical]\n"
     "                    [--stc-partial cover|discard] [--region AREA]... [--no-go AREA]...\n"
     "                    [--sweep-axis auto|vertical|horizontal]   (boustrophedon)\n"
@@ -85,7 +92,8 @@ absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pos
   size_t begin = 0;
   while (true) {
     const size_t comma = text.find(',', begin);
-    const std::string part = text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    const std::string part =
+        text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
     char* end = nullptr;
     const double d = std::strtod(part.c_str(), &end);
     if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(d)) {
@@ -97,8 +105,8 @@ absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pos
     begin = comma + 1;
   }
   if (v.size() < 2 || v.size() > 3) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--", flag, " must be X,Y or X,Y,THETA (metres, radians), got '", text, "'"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", flag, " must be X,Y or X,Y,THETA (metres, radians), got '", text, "'"));
   }
   pose->set_x(v[0]);
   pose->set_y(v[1]);
@@ -107,8 +115,8 @@ absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pos
 }
 
 std::string ServerError(const std::string& target, const absl::Status& status) {
-  return absl::StrCat("server ", target, " replied ", absl::StatusCodeToString(status.code()),
-                      ": ", status.message());
+  return absl::StrCat("server ", target, " replied ", absl::StatusCodeToString(status.code()), ": ",
+                      status.message());
 }
 
 // --region / --no-go: a GeoJSON file, or "x,y x,y x,y ..." (one ring, closed
@@ -120,7 +128,8 @@ absl::Status ParseArea(const std::string& flag, const std::string& text,
     std::ifstream in(text, std::ios::binary);
     std::ostringstream buffer;
     buffer << in.rdbuf();
-    if (!in.good() && !in.eof()) return absl::InvalidArgumentError(absl::StrCat("cannot read ", text));
+    if (!in.good() && !in.eof())
+      return absl::InvalidArgumentError(absl::StrCat("cannot read ", text));
     ASSIGN_OR_RETURN(std::vector<PolygonInput> polygons, ParseGeoJsonPolygons(buffer.str(), text));
     PolygonsToProto(polygons, out);
     return absl::OkStatus();
@@ -130,9 +139,9 @@ absl::Status ParseArea(const std::string& flag, const std::string& text,
     std::vector<absl::string_view> xy = absl::StrSplit(token, ',');
     double x = 0, y = 0;
     if (xy.size() != 2 || !absl::SimpleAtod(xy[0], &x) || !absl::SimpleAtod(xy[1], &y)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "--", flag, " must be a GeoJSON file or a ring \"x,y x,y x,y ...\"; '", token,
-          "' is neither a file nor an x,y point"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("--", flag, " must be a GeoJSON file or a ring \"x,y x,y x,y ...\"; '",
+                       token, "' is neither a file nor an x,y point"));
     }
     polygon.outer.push_back({x, y});
   }
@@ -153,7 +162,7 @@ struct PlanCommand {
   std::optional<std::string> out;
   std::optional<std::string> svg;
   std::optional<int64_t> deadline_ms;
-  int threads = 1;  // --local only
+  int threads = 1;                        // --local only
   std::optional<GtspEffort> tour_effort;  // --local only
 };
 
@@ -161,12 +170,40 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   ASSIGN_OR_RETURN(
       ParsedArgs a,
       ParseArgs(args,
-                WithConnectionFlags({"map", "resolution", "tool-width", "server", "out", "svg", "time-limit", "seed",
-                 "partition", "tour", "max-speed", "acceleration", "turn-rate", "free-thresh",
-                 "occupied-thresh", "min-free-fraction", "deadline-ms", "start", "end", "planner",
-                 "battery-capacity", "station", "reserve", "energy-per-metre", "energy-per-turn",
-                 "energy-per-second", "atomic-units", "sweep-axis",
-                 "algorithm", "stc-tree", "sweep-direction", "stc-partial", "threads", "tour-effort"}),
+                WithConnectionFlags({"map",
+                                     "resolution",
+                                     "tool-width",
+                                     "server",
+                                     "out",
+                                     "svg",
+                                     "time-limit",
+                                     "seed",
+                                     "partition",
+                                     "tour",
+                                     "max-speed",
+                                     "acceleration",
+                                     "turn-rate",
+                                     "free-thresh",
+                                     "occupied-thresh",
+                                     "min-free-fraction",
+                                     "deadline-ms",
+                                     "start",
+                                     "end",
+                                     "planner",
+                                     "battery-capacity",
+                                     "station",
+                                     "reserve",
+                                     "energy-per-metre",
+                                     "energy-per-turn",
+                                     "energy-per-second",
+                                     "atomic-units",
+                                     "sweep-axis",
+                                     "algorithm",
+                                     "stc-tree",
+                                     "sweep-direction",
+                                     "stc-partial",
+                                     "threads",
+                                     "tour-effort"}),
                 {"local", "negate", "interruptible", "improve-remembered"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -185,16 +222,23 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   }
   ASSIGN_OR_RETURN(std::optional<int64_t> threads, a.GetInt("threads"));
   if (threads) {
-    if (!c.local) return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
-    if (*threads < 1 || *threads > 256) return absl::InvalidArgumentError("--threads must be in [1, 256]");
+    if (!c.local)
+      return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
+    if (*threads < 1 || *threads > 256)
+      return absl::InvalidArgumentError("--threads must be in [1, 256]");
     c.threads = static_cast<int>(*threads);
   }
   if (auto effort = a.Get("tour-effort")) {
     if (!c.local) return absl::InvalidArgumentError("--tour-effort needs --local");
-    if (*effort == "fast") c.tour_effort = GtspEffort::kFast;
-    else if (*effort == "default") c.tour_effort = GtspEffort::kDefault;
-    else if (*effort == "thorough") c.tour_effort = GtspEffort::kThorough;
-    else return absl::InvalidArgumentError(absl::StrCat("--tour-effort must be fast, default or thorough, got '", *effort, "'"));
+    if (*effort == "fast")
+      c.tour_effort = GtspEffort::kFast;
+    else if (*effort == "default")
+      c.tour_effort = GtspEffort::kDefault;
+    else if (*effort == "thorough")
+      c.tour_effort = GtspEffort::kThorough;
+    else
+      return absl::InvalidArgumentError(
+          absl::StrCat("--tour-effort must be fast, default or thorough, got '", *effort, "'"));
   }
 
   v1::PlanRequest& r = c.request;
@@ -207,7 +251,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   if (accel) robot->set_acceleration_mps2(*accel);
   ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
   if (turn) robot->set_turn_rate_deg_s(*turn);
-  if (auto start = a.Get("start")) RETURN_IF_ERROR(ParsePose("start", *start, robot->mutable_start()));
+  if (auto start = a.Get("start"))
+    RETURN_IF_ERROR(ParsePose("start", *start, robot->mutable_start()));
   if (auto end = a.Get("end")) RETURN_IF_ERROR(ParsePose("end", *end, robot->mutable_end()));
   ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
   if (limit) r.set_time_limit_s(*limit);
@@ -216,50 +261,67 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   if (fraction) r.set_min_free_fraction(*fraction);
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
   if (seed) {
-    if (*seed < 0 || *seed > UINT32_MAX) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
+    if (*seed < 0 || *seed > UINT32_MAX)
+      return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
     r.set_seed(static_cast<uint32_t>(*seed));
   }
   if (a.Get("planner") && a.Get("algorithm") && *a.Get("planner") != *a.Get("algorithm")) {
-    return absl::InvalidArgumentError("--algorithm is another name for --planner: give one of them");
+    return absl::InvalidArgumentError(
+        "--algorithm is another name for --planner: give one of them");
   }
   if (auto p = a.Get("planner")) r.set_planner(*p);
   if (auto p = a.Get("algorithm")) r.set_planner(*p);
   if (a.Get("stc-tree") || a.Get("sweep-direction") || a.Get("stc-partial")) {
     if (r.planner() != "stc") {
-      return absl::InvalidArgumentError("--stc-tree, --sweep-direction and --stc-partial need --planner stc");
+      return absl::InvalidArgumentError(
+          "--stc-tree, --sweep-direction and --stc-partial need --planner stc");
     }
     v1::StcOptions* stc = r.mutable_stc();
     if (auto t = a.Get("stc-tree")) {
-      if (*t == "dfs") stc->set_tree(v1::STC_TREE_DFS);
-      else if (*t == "prim") stc->set_tree(v1::STC_TREE_PRIM);
-      else return absl::InvalidArgumentError(absl::StrCat("--stc-tree must be dfs or prim, got '", *t, "'"));
+      if (*t == "dfs")
+        stc->set_tree(v1::STC_TREE_DFS);
+      else if (*t == "prim")
+        stc->set_tree(v1::STC_TREE_PRIM);
+      else
+        return absl::InvalidArgumentError(
+            absl::StrCat("--stc-tree must be dfs or prim, got '", *t, "'"));
     }
     if (auto d = a.Get("sweep-direction")) {
-      if (*d == "horizontal") stc->set_sweep_direction(v1::STC_SWEEP_HORIZONTAL);
-      else if (*d == "vertical") stc->set_sweep_direction(v1::STC_SWEEP_VERTICAL);
-      else return absl::InvalidArgumentError(
-          absl::StrCat("--sweep-direction must be horizontal or vertical, got '", *d, "'"));
+      if (*d == "horizontal")
+        stc->set_sweep_direction(v1::STC_SWEEP_HORIZONTAL);
+      else if (*d == "vertical")
+        stc->set_sweep_direction(v1::STC_SWEEP_VERTICAL);
+      else
+        return absl::InvalidArgumentError(
+            absl::StrCat("--sweep-direction must be horizontal or vertical, got '", *d, "'"));
     }
     if (auto m = a.Get("stc-partial")) {
-      if (*m == "cover") stc->set_partial_cells(v1::STC_PARTIAL_COVER);
-      else if (*m == "discard") stc->set_partial_cells(v1::STC_PARTIAL_DISCARD);
-      else return absl::InvalidArgumentError(
-          absl::StrCat("--stc-partial must be cover or discard, got '", *m, "'"));
+      if (*m == "cover")
+        stc->set_partial_cells(v1::STC_PARTIAL_COVER);
+      else if (*m == "discard")
+        stc->set_partial_cells(v1::STC_PARTIAL_DISCARD);
+      else
+        return absl::InvalidArgumentError(
+            absl::StrCat("--stc-partial must be cover or discard, got '", *m, "'"));
     }
   }
   if (auto it = a.repeated.find("region"); it != a.repeated.end()) {
-    for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("region", text, r.mutable_regions()));
+    for (const std::string& text : it->second)
+      RETURN_IF_ERROR(ParseArea("region", text, r.mutable_regions()));
   }
   if (auto it = a.repeated.find("no-go"); it != a.repeated.end()) {
-    for (const std::string& text : it->second) RETURN_IF_ERROR(ParseArea("no-go", text, r.mutable_no_go()));
+    for (const std::string& text : it->second)
+      RETURN_IF_ERROR(ParseArea("no-go", text, r.mutable_no_go()));
   }
   ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
-  const bool battery = capacity || a.Get("station") || a.Get("reserve") || a.Get("energy-per-metre") ||
-                       a.Get("energy-per-turn") || a.Get("energy-per-second") || a.Has("interruptible") ||
+  const bool battery = capacity || a.Get("station") || a.Get("reserve") ||
+                       a.Get("energy-per-metre") || a.Get("energy-per-turn") ||
+                       a.Get("energy-per-second") || a.Has("interruptible") ||
                        a.Get("atomic-units");
   if (battery) {
     if (!capacity || !a.Get("station")) {
-      return absl::InvalidArgumentError("a battery needs --battery-capacity E and --station X,Y[,THETA]");
+      return absl::InvalidArgumentError(
+          "a battery needs --battery-capacity E and --station X,Y[,THETA]");
     }
     v1::Battery* b = r.mutable_battery();
     b->set_capacity(*capacity);
@@ -277,32 +339,48 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
       for (absl::string_view id : absl::StrSplit(*ids, ',')) {
         int value = 0;
         if (!absl::SimpleAtoi(id, &value)) {
-          return absl::InvalidArgumentError(
-              absl::StrCat("--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
+          return absl::InvalidArgumentError(absl::StrCat(
+              "--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
         }
         b->add_atomic_units(value);
       }
     }
   }
   if (auto axis = a.Get("sweep-axis")) {
-    if (r.planner() != "boustrophedon") return absl::InvalidArgumentError("--sweep-axis needs --planner boustrophedon");
+    if (r.planner() != "boustrophedon")
+      return absl::InvalidArgumentError("--sweep-axis needs --planner boustrophedon");
     v1::BoustrophedonOptions* o = r.mutable_boustrophedon();
-    if (*axis == "auto") o->set_sweep_axis(v1::SWEEP_AXIS_AUTO);
-    else if (*axis == "vertical") o->set_sweep_axis(v1::SWEEP_AXIS_VERTICAL);
-    else if (*axis == "horizontal") o->set_sweep_axis(v1::SWEEP_AXIS_HORIZONTAL);
-    else return absl::InvalidArgumentError(absl::StrCat("--sweep-axis must be auto, vertical or horizontal, got '", *axis, "'"));
+    if (*axis == "auto")
+      o->set_sweep_axis(v1::SWEEP_AXIS_AUTO);
+    else if (*axis == "vertical")
+      o->set_sweep_axis(v1::SWEEP_AXIS_VERTICAL);
+    else if (*axis == "horizontal")
+      o->set_sweep_axis(v1::SWEEP_AXIS_HORIZONTAL);
+    else
+      return absl::InvalidArgumentError(
+          absl::StrCat("--sweep-axis must be auto, vertical or horizontal, got '", *axis, "'"));
   }
   if (auto p = a.Get("partition")) {
-    if (*p == "mincut") r.set_partition_solver(v1::MINCUT);
-    else if (*p == "lp") r.set_partition_solver(v1::LP);
-    else if (*p == "matching") r.set_partition_solver(v1::MATCHING);
-    else if (*p == "pushrelabel") r.set_partition_solver(v1::PUSH_RELABEL);
-    else return absl::InvalidArgumentError(absl::StrCat("--partition must be pushrelabel, matching, mincut or lp, got '", *p, "'"));
+    if (*p == "mincut")
+      r.set_partition_solver(v1::MINCUT);
+    else if (*p == "lp")
+      r.set_partition_solver(v1::LP);
+    else if (*p == "matching")
+      r.set_partition_solver(v1::MATCHING);
+    else if (*p == "pushrelabel")
+      r.set_partition_solver(v1::PUSH_RELABEL);
+    else
+      return absl::InvalidArgumentError(
+          absl::StrCat("--partition must be pushrelabel, matching, mincut or lp, got '", *p, "'"));
   }
   if (auto t = a.Get("tour")) {
-    if (*t == "gtsp") r.set_tour_solver(v1::GTSP);
-    else if (*t == "greedy") r.set_tour_solver(v1::GREEDY);
-    else return absl::InvalidArgumentError(absl::StrCat("--tour must be gtsp or greedy, got '", *t, "'"));
+    if (*t == "gtsp")
+      r.set_tour_solver(v1::GTSP);
+    else if (*t == "greedy")
+      r.set_tour_solver(v1::GREEDY);
+    else
+      return absl::InvalidArgumentError(
+          absl::StrCat("--tour must be gtsp or greedy, got '", *t, "'"));
   }
   return c;
 }
@@ -319,13 +397,15 @@ absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& ma
   *put.mutable_map() = map;
   put.set_name(c.map_path);
   absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
-  if (!stored.ok()) return absl::Status(stored.status().code(), ServerError(c.server.target, stored.status()));
+  if (!stored.ok())
+    return absl::Status(stored.status().code(), ServerError(c.server.target, stored.status()));
   v1::PlanRequest request = c.request;
   request.set_map_id(stored->map_id());
   std::optional<absl::Duration> timeout;
   if (c.deadline_ms) timeout = absl::Milliseconds(*c.deadline_ms);
   absl::StatusOr<v1::PlanResponse> plan = remote->Plan(request, timeout);
-  if (!plan.ok()) return absl::Status(plan.status().code(), ServerError(c.server.target, plan.status()));
+  if (!plan.ok())
+    return absl::Status(plan.status().code(), ServerError(c.server.target, plan.status()));
   return plan;
 }
 
@@ -366,7 +446,8 @@ absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
   plan_request.common.num_threads = std::max(1, num_threads);
   if (tour_effort) {
     const auto* oarp = dynamic_cast<const OarpOptions*>(plan_request.options.get());
-    if (plan_request.planner != "oarp") return absl::InvalidArgumentError("--tour-effort needs --planner oarp");
+    if (plan_request.planner != "oarp")
+      return absl::InvalidArgumentError("--tour-effort needs --planner oarp");
     auto options = std::make_shared<OarpOptions>(oarp != nullptr ? *oarp : OarpOptions());
     options->tour_effort = *tour_effort;
     plan_request.options = std::move(options);
@@ -395,37 +476,45 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
   if (r.has_stc()) {
     const v1::StcDetail& d = r.stc();
     stc = absl::StrFormat(
-        "stc        %d coarse cells (%d partly free, %d orphan sub-cells), %d extra moves, %d sub-cells "
+        "stc        %d coarse cells (%d partly free, %d orphan sub-cells), %d extra moves, %d "
+        "sub-cells "
         "covered twice%s\n",
-        d.coarse_cells(), d.partial_coarse_cells(), d.orphan_cells(), d.extra_moves(), d.subcells_covered_twice(),
-        d.discarded_cells() > 0 ? absl::StrFormat(", %d cells discarded", d.discarded_cells()) : "");
+        d.coarse_cells(), d.partial_coarse_cells(), d.orphan_cells(), d.extra_moves(),
+        d.subcells_covered_twice(),
+        d.discarded_cells() > 0 ? absl::StrFormat(", %d cells discarded", d.discarded_cells())
+                                : "");
   }
   return absl::StrFormat(
-      "plan       %s (map %s, planner %s)\n"
-      "grid       %d x %d cells of %.3f m, %d to cover, %d swept (%d unreachable, not planned)%s\n"
-      "ranks      %d (partition %s)\n"
-      "tour       %s, %d turns, %s\n"
-      "length     coverage %.1f m, transitions %.1f m\n"
-      "coverage   %.1f %% of the free area\n"
-      "duration   %.1f s estimated (turning %.1f s)\n"
-      "timings    planning %.1f ms: grid %.1f, partition %.1f, transitions %.1f, tour %.1f ms%s\n",
-      r.plan_id(), r.map_id().substr(0, 12), r.planner(), s.grid_rows(), s.grid_cols(),
-      r.grid().cell_size_m(), s.free_cells(), s.covered_cells(), s.unreachable_free_cells(),
-      s.no_go_cells() > 0 ? absl::StrFormat(", %d closed by no-go zones", s.no_go_cells()) : "",
-      s.num_ranks(), s.partition_solver(), s.tour_solver(), s.num_turns(),
-      r.termination().detail().empty() ? "converged" : r.termination().detail(),
-      s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
-      s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
-      s.partition_ms(), s.transitions_ms(), s.tour_ms(),
-      absl::StrCat(s.decomposition_cached() ? " (decomposition cached)" : "",
-                   s.plan_source() == v1::PLAN_SOURCE_COLD || s.plan_source() == v1::PLAN_SOURCE_UNSPECIFIED
-                       ? ""
-                       : absl::StrCat(" (", PlanSourceText(s.plan_source()), ")"))) +
+             "plan       %s (map %s, planner %s)\n"
+             "grid       %d x %d cells of %.3f m, %d to cover, %d swept (%d unreachable, not "
+             "planned)%s\n"
+             "ranks      %d (partition %s)\n"
+             "tour       %s, %d turns, %s\n"
+             "length     coverage %.1f m, transitions %.1f m\n"
+             "coverage   %.1f %% of the free area\n"
+             "duration   %.1f s estimated (turning %.1f s)\n"
+             "timings    planning %.1f ms: grid %.1f, partition %.1f, transitions %.1f, tour %.1f "
+             "ms%s\n",
+             r.plan_id(), r.map_id().substr(0, 12), r.planner(), s.grid_rows(), s.grid_cols(),
+             r.grid().cell_size_m(), s.free_cells(), s.covered_cells(), s.unreachable_free_cells(),
+             s.no_go_cells() > 0 ? absl::StrFormat(", %d closed by no-go zones", s.no_go_cells())
+                                 : "",
+             s.num_ranks(), s.partition_solver(), s.tour_solver(), s.num_turns(),
+             r.termination().detail().empty() ? "converged" : r.termination().detail(),
+             s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
+             s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
+             s.partition_ms(), s.transitions_ms(), s.tour_ms(),
+             absl::StrCat(s.decomposition_cached() ? " (decomposition cached)" : "",
+                          s.plan_source() == v1::PLAN_SOURCE_COLD ||
+                                  s.plan_source() == v1::PLAN_SOURCE_UNSPECIFIED
+                              ? ""
+                              : absl::StrCat(" (", PlanSourceText(s.plan_source()), ")"))) +
          (r.cycles().empty()
               ? std::string()
-              : absl::StrFormat("battery    %d charge cycles, energy %.1f (unconstrained %.1f, bound %.1f)\n",
-                                s.charge_cycles(), s.energy_total(), s.energy_unconstrained(),
-                                s.energy_lower_bound())) +
+              : absl::StrFormat(
+                    "battery    %d charge cycles, energy %.1f (unconstrained %.1f, bound %.1f)\n",
+                    s.charge_cycles(), s.energy_total(), s.energy_unconstrained(),
+                    s.energy_lower_bound())) +
          stc;
 }
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "covplan/v1/covplan.pb.h"
 #include "api/convert.h"
+#include "covplan/v1/covplan.pb.h"
 #include "planner/tour/gtsp/gtsp.h"
 
 namespace covplan {

@@ -53,7 +53,8 @@ std::shared_ptr<grpc::Channel> ChannelFor(const Connection& connection) {
 void AddCallCredentials(const Connection& connection, grpc::ClientContext* context) {
   // Plain metadata rather than gRPC call credentials, which refuse
   // plaintext channels: a loopback server with tokens is served too.
-  if (!connection.token.empty()) context->AddMetadata("authorization", "Bearer " + connection.token);
+  if (!connection.token.empty())
+    context->AddMetadata("authorization", "Bearer " + connection.token);
 }
 
 struct RemotePlanner::Impl {
@@ -77,7 +78,8 @@ absl::StatusOr<v1::PlanStats> StatsOfPlanReply(grpc::ByteBuffer* reply) {
     if (WireFormatLite::GetTagFieldNumber(tag) == v1::PlanResponse::kStatsFieldNumber &&
         WireFormatLite::GetTagWireType(tag) == WireFormatLite::WIRETYPE_LENGTH_DELIMITED) {
       uint32_t length = 0;
-      ok = in.ReadVarint32(&length) && length <= static_cast<uint32_t>(std::numeric_limits<int>::max());
+      ok = in.ReadVarint32(&length) &&
+           length <= static_cast<uint32_t>(std::numeric_limits<int>::max());
       if (!ok) break;
       const auto limit = in.PushLimit(static_cast<int>(length));
       ok = stats.MergePartialFromCodedStream(&in) && in.ConsumedEntireMessage();
@@ -206,7 +208,8 @@ struct RemotePlanner::DriveSession::Stream {
   std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> rw;
 };
 
-RemotePlanner::DriveSession::DriveSession(std::unique_ptr<Stream> stream) : stream_(std::move(stream)) {}
+RemotePlanner::DriveSession::DriveSession(std::unique_ptr<Stream> stream)
+    : stream_(std::move(stream)) {}
 
 RemotePlanner::DriveSession::~DriveSession() {
   if (!closed_) {
@@ -215,7 +218,8 @@ RemotePlanner::DriveSession::~DriveSession() {
   }
 }
 
-absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(const v1::DriveRequest& first) {
+absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(
+    const v1::DriveRequest& first) {
   auto stream = std::make_unique<DriveSession::Stream>();
   AddCallCredentials(impl_->connection, &stream->context);
   stream->rw = impl_->stub->Drive(&stream->context);
@@ -226,12 +230,14 @@ absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Driv
     const absl::Status s = FromGrpc(session->stream_->rw->Finish());
     return s.ok() ? absl::UnavailableError("the drive session ended before it was ready") : s;
   }
-  if (!event.has_ready()) return absl::InternalError("the drive session's first event is not `ready`");
+  if (!event.has_ready())
+    return absl::InternalError("the drive session's first event is not `ready`");
   session->ready_ = event.ready();
   return session;
 }
 
-absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(const v1::DriveRequest& request) {
+absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(
+    const v1::DriveRequest& request) {
   if (closed_) return absl::FailedPreconditionError("the drive session is closed");
   if (!stream_->rw->Write(request)) {
     const absl::Status s = Close();

@@ -13,9 +13,9 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
-#include "absl/strings/str_format.h"
 #include "client/args.h"
 #include "planner/common/status_macros.h"
 #include "planner/engine/engine.h"
@@ -32,15 +32,18 @@ constexpr char kUsage[] =
     "usage: covplan simulate --map KNOWN [--resolution M] [--tool-width M]\n"
     "                        (--true-map TRUE | --clutter PCT) [--seed N]\n"
     "                        [--method auto|ilp1|ilp2|greedy_detour|full] [--sensor-range M]\n"
-    "                        [--local | --server HOST:PORT] [--svg run.svg] [--time-limit S] [--step S]\n"
-    "                        [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | --token-file F]\n"
+    "                        [--local | --server HOST:PORT] [--svg run.svg] [--time-limit S] "
+    "[--step S]\n"
+    "                        [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | "
+    "--token-file F]\n"
     "                        [--replan-tour-limit S] [--clutter-may-disconnect]\n"
     "                        [--no-offline-bound]\n"
     "                        [--max-speed M/S] [--acceleration M/S2] [--turn-rate DEG/S]\n"
     "                        [--free-thresh P] [--occupied-thresh P] [--negate]\n"
     "                        [--planner oarp|stc|boustrophedon]\n"
     "                        [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
-    "                         [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
+    "                         [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second "
+    "E]\n"
     "                         [--interruptible [--atomic-units ID,ID...]] [--recharge-s S]]\n"
     "Plans OARP on KNOWN, drives the plan through the true map (TRUE, or KNOWN with\n"
     "random rotated rectangles over PCT % of its free area, placed with --seed) with a\n"
@@ -90,8 +93,8 @@ absl::StatusOr<ReplanMethod> ParseMethod(const std::string& name) {
                          ReplanMethod::kGreedyDetour, ReplanMethod::kFull}) {
     if (name == ReplanMethodName(m)) return m;
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "--method must be auto, ilp1, ilp2, greedy_detour or full, got '", name, "'"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("--method must be auto, ilp1, ilp2, greedy_detour or full, got '", name, "'"));
 }
 
 // The true map with the driven path, replan points and found obstacles.
@@ -105,15 +108,18 @@ std::string RenderRunSvg(const OccupancyMap& truth, const Grid& grid, const Simu
   std::string svg = RenderPlanSvg(drawn, &truth);
   const double s = grid.cell_size();
   const double h = std::max(grid.rows() * s, truth.height() * truth.resolution());
-  std::string extra = absl::StrFormat("<g transform=\"matrix(1 0 0 -1 0 %.4f)\">\n", h + 2 * grid.origin().y);
-  absl::StrAppendFormat(&extra, "<g fill=\"none\" stroke=\"#d62728\" stroke-width=\"%.4f\">\n", 0.08 * s);
+  std::string extra =
+      absl::StrFormat("<g transform=\"matrix(1 0 0 -1 0 %.4f)\">\n", h + 2 * grid.origin().y);
+  absl::StrAppendFormat(&extra, "<g fill=\"none\" stroke=\"#d62728\" stroke-width=\"%.4f\">\n",
+                        0.08 * s);
   for (const CellIndex& c : r.obstacles_found) {
     absl::StrAppendFormat(&extra, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\"/>\n",
                           grid.origin().x + c.col * s, grid.origin().y + c.row * s, s, s);
   }
   absl::StrAppendFormat(&extra, "</g>\n<g fill=\"#1f5fa8\" fill-opacity=\"0.8\">\n");
   for (const Point2& p : r.replan_points) {
-    absl::StrAppendFormat(&extra, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\"/>\n", p.x, p.y, 0.25 * s);
+    absl::StrAppendFormat(&extra, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\"/>\n", p.x, p.y,
+                          0.25 * s);
   }
   absl::StrAppend(&extra, "</g>\n</g>\n");
   const size_t end = svg.rfind("</svg>");
@@ -127,8 +133,11 @@ absl::StatusOr<Pose2> ParseStation(const std::string& text) {
   Pose2 p;
   double* fields[] = {&p.x, &p.y, &p.theta};
   bool ok = parts.size() == 2 || parts.size() == 3;
-  for (size_t i = 0; ok && i < parts.size(); ++i) ok = absl::SimpleAtod(parts[i], fields[i]) && std::isfinite(*fields[i]);
-  if (!ok) return absl::InvalidArgumentError(absl::StrCat("--station must be X,Y[,THETA] (numbers), got '", text, "'"));
+  for (size_t i = 0; ok && i < parts.size(); ++i)
+    ok = absl::SimpleAtod(parts[i], fields[i]) && std::isfinite(*fields[i]);
+  if (!ok)
+    return absl::InvalidArgumentError(
+        absl::StrCat("--station must be X,Y[,THETA] (numbers), got '", text, "'"));
   return p;
 }
 
@@ -136,11 +145,12 @@ absl::StatusOr<Pose2> ParseStation(const std::string& text) {
 absl::StatusOr<std::optional<BatteryOptions>> ParseBattery(const ParsedArgs& a) {
   ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
   const bool any = capacity || a.Get("station") || a.Get("reserve") || a.Get("energy-per-metre") ||
-                   a.Get("energy-per-turn") || a.Get("energy-per-second") || a.Has("interruptible") ||
-                   a.Get("atomic-units") || a.Get("recharge-s");
+                   a.Get("energy-per-turn") || a.Get("energy-per-second") ||
+                   a.Has("interruptible") || a.Get("atomic-units") || a.Get("recharge-s");
   if (!any) return std::optional<BatteryOptions>();
   if (!capacity || !a.Get("station")) {
-    return absl::InvalidArgumentError("a battery needs --battery-capacity E and --station X,Y[,THETA]");
+    return absl::InvalidArgumentError(
+        "a battery needs --battery-capacity E and --station X,Y[,THETA]");
   }
   BatteryOptions b;
   b.capacity = *capacity;
@@ -192,16 +202,40 @@ absl::Status WithFlagNames(const absl::Status& status) {
 
 absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
                                                 const RemotePlanSourceFactory& make_remote) {
-  ASSIGN_OR_RETURN(ParsedArgs a,
-                   ParseArgs(args,
-                             WithConnectionFlags({"map", "resolution", "tool-width", "true-map", "clutter", "seed", "method",
-                              "sensor-range", "svg", "time-limit", "step", "max-speed", "acceleration",
-                              "turn-rate", "free-thresh", "occupied-thresh", "server", "replan-tour-limit",
-                              "planner", "battery-capacity", "station", "reserve", "energy-per-metre",
-                              "energy-per-turn", "energy-per-second", "atomic-units", "recharge-s"}),
-                             {"local", "negate", "clutter-may-disconnect", "no-offline-bound", "interruptible"}));
-  if (a.Get("server") && a.Has("local")) return absl::InvalidArgumentError("give --local or --server, not both");
-  if (a.Get("server") && a.Get("server")->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
+  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args,
+                                           WithConnectionFlags({"map",
+                                                                "resolution",
+                                                                "tool-width",
+                                                                "true-map",
+                                                                "clutter",
+                                                                "seed",
+                                                                "method",
+                                                                "sensor-range",
+                                                                "svg",
+                                                                "time-limit",
+                                                                "step",
+                                                                "max-speed",
+                                                                "acceleration",
+                                                                "turn-rate",
+                                                                "free-thresh",
+                                                                "occupied-thresh",
+                                                                "server",
+                                                                "replan-tour-limit",
+                                                                "planner",
+                                                                "battery-capacity",
+                                                                "station",
+                                                                "reserve",
+                                                                "energy-per-metre",
+                                                                "energy-per-turn",
+                                                                "energy-per-second",
+                                                                "atomic-units",
+                                                                "recharge-s"}),
+                                           {"local", "negate", "clutter-may-disconnect",
+                                            "no-offline-bound", "interruptible"}));
+  if (a.Get("server") && a.Has("local"))
+    return absl::InvalidArgumentError("give --local or --server, not both");
+  if (a.Get("server") && a.Get("server")->empty())
+    return absl::InvalidArgumentError("--server needs HOST:PORT");
   if (!a.Get("map")) return absl::InvalidArgumentError("--map KNOWN is required");
   if (a.Get("true-map").has_value() == a.Get("clutter").has_value()) {
     return absl::InvalidArgumentError("give exactly one of --true-map TRUE and --clutter PCT");
@@ -217,7 +251,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
 
   SimulationOptions o;
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
-  if (seed && (*seed < 0 || *seed > UINT32_MAX)) return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
+  if (seed && (*seed < 0 || *seed > UINT32_MAX))
+    return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
   o.seed = seed.value_or(1);
   if (auto m = a.Get("method")) {
     ASSIGN_OR_RETURN(o.method, ParseMethod(*m));
@@ -225,16 +260,20 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   if (auto planner = a.Get("planner")) o.plan.planner = *planner;
   ASSIGN_OR_RETURN(o.plan.battery, ParseBattery(a));
   if (o.plan.battery) {
-    if (a.Get("server")) return absl::InvalidArgumentError("--battery-capacity: battery runs are local only, not with --server");
+    if (a.Get("server"))
+      return absl::InvalidArgumentError(
+          "--battery-capacity: battery runs are local only, not with --server");
     if (a.Get("method") && o.method != ReplanMethod::kGreedyDetour) {
       return absl::InvalidArgumentError(
-          "--method: battery plans are replanned with greedy_detour only (the other methods drop the station legs)");
+          "--method: battery plans are replanned with greedy_detour only (the other methods drop "
+          "the station legs)");
     }
     o.method = ReplanMethod::kGreedyDetour;
     ASSIGN_OR_RETURN(std::optional<double> recharge, a.GetDouble("recharge-s"));
     o.recharge_s = recharge.value_or(0.0);
     if (!(o.recharge_s >= 0.0)) {
-      return absl::InvalidArgumentError(absl::StrFormat("--recharge-s must be >= 0 s, got %g", o.recharge_s));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("--recharge-s must be >= 0 s, got %g", o.recharge_s));
     }
     RETURN_IF_ERROR(WithFlagNames(o.plan.battery->Validate()));
   }
@@ -289,7 +328,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     ASSIGN_OR_RETURN(remote, make_remote(connection, *a.Get("map"), flags, o));
   }
   absl::StatusOr<SimulationResult> simulated = Simulate(known, truth, o, remote.get());
-  if (!simulated.ok()) return o.plan.battery ? WithFlagNames(simulated.status()) : simulated.status();
+  if (!simulated.ok())
+    return o.plan.battery ? WithFlagNames(simulated.status()) : simulated.status();
   const SimulationResult& r = *simulated;
   // The bounds and the picture use the true map the run drove (nothing on
   // the start and end poses: see SimulationResult::truth_cleared_px).
@@ -319,14 +359,16 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   double max_ms = 0.0;
   for (double ms : r.replan_ms) max_ms = std::max(max_ms, ms);
   std::string problems = "[";
-  for (size_t i = 0; i < r.problems.size(); ++i) absl::StrAppend(&problems, i ? "," : "", JsonString(r.problems[i]));
+  for (size_t i = 0; i < r.problems.size(); ++i)
+    absl::StrAppend(&problems, i ? "," : "", JsonString(r.problems[i]));
   problems += "]";
   std::string json = "{";
   auto field = [&](const char* name, const std::string& value) {
     absl::StrAppend(&json, json.size() > 1 ? ", " : "", "\"", name, "\": ", value);
   };
   field("method", JsonString(ReplanMethodName(o.method)));
-  field("planner_at", JsonString(a.Get("server") ? absl::StrCat("server ", *a.Get("server")) : "local"));
+  field("planner_at",
+        JsonString(a.Get("server") ? absl::StrCat("server ", *a.Get("server")) : "local"));
   field("true_map", JsonString(truth_name));
   field("total_time_s", JsonNumber(r.total_time_s));
   field("drive_time_s", JsonNumber(r.drive_time_s));
@@ -354,7 +396,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   if (r.battery) {
     const BatteryRun& b = *r.battery;
     std::string energies = "[";
-    for (size_t i = 0; i < b.cycle_energy.size(); ++i) absl::StrAppend(&energies, i ? "," : "", JsonNumber(b.cycle_energy[i]));
+    for (size_t i = 0; i < b.cycle_energy.size(); ++i)
+      absl::StrAppend(&energies, i ? "," : "", JsonNumber(b.cycle_energy[i]));
     energies += "]";
     field("battery_capacity", JsonNumber(o.plan.battery->capacity));
     field("battery_reserve", JsonNumber(o.plan.battery->reserve));
@@ -379,14 +422,16 @@ namespace {
 const RemotePlanSourceFactory* g_remote = nullptr;
 
 absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(std::string json, SimulateCommandJson(args, g_remote != nullptr ? *g_remote : nullptr));
+  ASSIGN_OR_RETURN(std::string json,
+                   SimulateCommandJson(args, g_remote != nullptr ? *g_remote : nullptr));
   std::printf("%s\n", json.c_str());
   return absl::OkStatus();
 }
 
 }  // namespace
 
-int RunSimulateCommand(const std::vector<std::string>& args, const RemotePlanSourceFactory& remote) {
+int RunSimulateCommand(const std::vector<std::string>& args,
+                       const RemotePlanSourceFactory& remote) {
   g_remote = &remote;
   const int rc = RunSubcommand("simulate", kUsage, args, &Run);
   g_remote = nullptr;

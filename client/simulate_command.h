@@ -41,7 +41,8 @@ using RemotePlanSourceFactory = std::function<absl::StatusOr<std::unique_ptr<Pla
     const SimulationOptions& options)>;
 
 // Returns the process exit code; the JSON goes to stdout, errors to stderr.
-int RunSimulateCommand(const std::vector<std::string>& args, const RemotePlanSourceFactory& remote = nullptr);
+int RunSimulateCommand(const std::vector<std::string>& args,
+                       const RemotePlanSourceFactory& remote = nullptr);
 
 // Parses the flags, runs the simulation and the offline lower bound, writes
 // --svg if asked, and returns the JSON object RunSimulateCommand prints.

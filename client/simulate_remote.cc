@@ -66,14 +66,18 @@ ReplanStats StatsFromProto(const v1::ReplanStats& s) {
 
 class ServerPlanSource final : public PlanSource {
  public:
-  ServerPlanSource(std::unique_ptr<RemotePlanner> remote, v1::Map map, const SimulationOptions& options)
-      : remote_(std::move(remote)), map_(std::move(map)), method_(MethodToProto(options.method)),
+  ServerPlanSource(std::unique_ptr<RemotePlanner> remote, v1::Map map,
+                   const SimulationOptions& options)
+      : remote_(std::move(remote)),
+        map_(std::move(map)),
+        method_(MethodToProto(options.method)),
         seed_(static_cast<uint32_t>(options.seed)) {}
   ~ServerPlanSource() override {
     if (session_ != nullptr) session_->Close().IgnoreError();
   }
 
-  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& /*known*/, const PlanOptions& options) override {
+  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& /*known*/,
+                                           const PlanOptions& options) override {
     v1::PutMapRequest put;
     *put.mutable_map() = map_;
     ASSIGN_OR_RETURN(v1::PutMapResponse stored, remote_->PutMap(put, absl::Seconds(120)));
@@ -106,7 +110,8 @@ class ServerPlanSource final : public PlanSource {
   }
 
   absl::StatusOr<ReplanResult> Replan(const RetainedPlan& /*plan*/, const RobotProgress& at,
-                                      const Observations& seen, const ReplanOptions& options) override {
+                                      const Observations& seen,
+                                      const ReplanOptions& options) override {
     if (session_ == nullptr) return absl::FailedPreconditionError("no drive session");
     v1::DriveRequest request;
     request.set_sequence(next_sequence_++);
@@ -128,7 +133,8 @@ class ServerPlanSource final : public PlanSource {
     ReplanResult out;
     ASSIGN_OR_RETURN(out.plan, PlanFromProto(event.replan().plan()));
     out.stats = StatsFromProto(event.replan().replan());
-    for (const v1::CellRef& c : event.replan().unreachable()) out.unreachable.push_back({c.row(), c.col()});
+    for (const v1::CellRef& c : event.replan().unreachable())
+      out.unreachable.push_back({c.row(), c.col()});
     current_plan_id_ = event.replan().plan().plan_id();
     return out;
   }
@@ -145,10 +151,9 @@ class ServerPlanSource final : public PlanSource {
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const Connection& server,
-                                                                    const std::string& known_map_path,
-                                                                    const SimulateMapFlags& flags,
-                                                                    const SimulationOptions& options) {
+absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(
+    const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const SimulationOptions& options) {
   MapFileOverrides overrides;
   overrides.resolution = flags.resolution;
   overrides.free_thresh = flags.free_thresh;

@@ -7,7 +7,8 @@
 // session.
 //
 //   ASSIGN_OR_RETURN(std::unique_ptr<PlanSource> src,
-//                    ConnectServerPlanSource("127.0.0.1:50051", "maps/sample_office.yaml", {}, options));
+//                    ConnectServerPlanSource("127.0.0.1:50051", "maps/sample_office.yaml", {},
+//                    options));
 //   ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, options, src.get()));
 //
 // Thread-safety: one simulation at a time.
@@ -24,10 +25,9 @@
 namespace covplan {
 
 // A RemotePlanSourceFactory (client/simulate_command.h).
-absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(const Connection& server,
-                                                                    const std::string& known_map_path,
-                                                                    const SimulateMapFlags& flags,
-                                                                    const SimulationOptions& options);
+absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(
+    const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const SimulationOptions& options);
 
 }  // namespace covplan
 

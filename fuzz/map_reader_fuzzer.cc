@@ -25,8 +25,7 @@ void Check(const absl::Status& s) {
   }
 }
 
-void CheckMap(const absl::StatusOr<covplan::OccupancyMap>& map,
-              const covplan::MapLoadOptions& o) {
+void CheckMap(const absl::StatusOr<covplan::OccupancyMap>& map, const covplan::MapLoadOptions& o) {
   Check(map.status());
   if (!map.ok()) return;
   if (map->width() <= 0 || map->height() <= 0 ||

@@ -30,12 +30,12 @@
 #include <string>
 #include <unordered_map>
 
+#include <vector>
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "planner/common/stop_token.h"
 #include "planner/engine/artifact_cache.h"
-#include <vector>
 
 namespace covplan {
 
@@ -104,7 +104,8 @@ class SharedLruCache {
         flight->result = result;
         flight->done = true;
         flights_.erase(key);
-        if (result.ok() && *result != nullptr && !Fenced(key, flight->epoch)) Insert(key, *result, &dropped);
+        if (result.ok() && *result != nullptr && !Fenced(key, flight->epoch))
+          Insert(key, *result, &dropped);
         return result;
       }
       absl::StatusOr<Value> shared = Wait(*flight, stop);
@@ -115,8 +116,8 @@ class SharedLruCache {
         *hit = true;
         return shared;
       }
-      const bool leader_stopped = absl::IsDeadlineExceeded(shared.status()) ||
-                                  absl::IsCancelled(shared.status());
+      const bool leader_stopped =
+          absl::IsDeadlineExceeded(shared.status()) || absl::IsCancelled(shared.status());
       if (!leader_stopped || stop.ShouldStop()) return shared.status();
       // The leader gave up on its own deadline; try again (maybe as leader).
     }
@@ -185,12 +186,15 @@ class SharedLruCache {
     absl::MutexLock lock(&mu_);
     while (!flight.done) {
       if (stop.ShouldStop()) {
-        return stop.cancelled() ? absl::CancelledError("request cancelled")
-                                : absl::DeadlineExceededError(
-                                      "deadline reached while waiting for a per-map artifact (grid, partition or transitions) that another call is building");
+        return stop.cancelled()
+                   ? absl::CancelledError("request cancelled")
+                   : absl::DeadlineExceededError(
+                         "deadline reached while waiting for a per-map artifact (grid, partition "
+                         "or transitions) that another call is building");
       }
       absl::Duration wait = absl::Milliseconds(20);
-      if (stop.has_deadline()) wait = std::max(absl::ZeroDuration(), std::min(wait, stop.remaining()));
+      if (stop.has_deadline())
+        wait = std::max(absl::ZeroDuration(), std::min(wait, stop.remaining()));
       mu_.AwaitWithTimeout(absl::Condition(&flight.done), wait);
     }
     return flight.result;
@@ -267,7 +271,8 @@ class SharedLruCache {
 class ArtifactLru final : public ArtifactCache {
  public:
   explicit ArtifactLru(size_t budget_bytes, CacheObserver* observer = nullptr)
-      : lru_(budget_bytes, [](const Artifact& a) { return a.MemoryBytes(); }, observer) {}
+      : lru_(
+            budget_bytes, [](const Artifact& a) { return a.MemoryBytes(); }, observer) {}
 
   absl::StatusOr<Value> GetOrBuild(const std::string& key, const StopToken& stop,
                                    const Builder& build, bool* hit) override {

@@ -39,7 +39,8 @@ absl::StatusOr<std::string> ReadPem(const std::string& path, const char* flag) {
   return text.str();
 }
 
-absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(const ServerConfig& config) {
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(
+    const ServerConfig& config) {
   if (config.tls_cert_file.empty() != config.tls_key_file.empty()) {
     return absl::InvalidArgumentError("--tls_cert and --tls_key go together");
   }
@@ -105,8 +106,10 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
     const bool loopback = config.address == "127.0.0.1" || config.address == "localhost" ||
                           config.address == "::1" || config.address == "[::1]";
     if (config.tls_cert_file.empty() && !loopback) {
-      LogLine("warn", "bearer tokens on a plaintext port beyond loopback travel in the clear; use --tls_cert",
-              {{"address", config.address}});
+      LogLine(
+          "warn",
+          "bearer tokens on a plaintext port beyond loopback travel in the clear; use --tls_cert",
+          {{"address", config.address}});
     }
   }
   server->metrics_ = std::make_unique<ServerMetrics>();
@@ -141,7 +144,8 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   if (!credentials.ok()) return credentials.status();
   builder.AddListeningPort(address, *credentials, &server->port_);
   builder.RegisterService(server->service_.get());
-  builder.experimental().SetInterceptorCreators(MalformedRequestInterceptors(server->metrics_.get()));
+  builder.experimental().SetInterceptorCreators(
+      MalformedRequestInterceptors(server->metrics_.get()));
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || server->port_ == 0) {
     server->server_.reset();
@@ -156,8 +160,8 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   health->SetServingStatus(kStoreHealthService, writable);
   server->metrics_->store_writable().Set(writable ? 1 : 0);
   if (!writable) LogLine("error", "map store is not writable; PutMap and DeleteMap will fail");
-  server->probe_thread_ = std::thread(&CovplanServer::ProbeStoreLoop, server.get(),
-                                      config.store_probe_interval);
+  server->probe_thread_ =
+      std::thread(&CovplanServer::ProbeStoreLoop, server.get(), config.store_probe_interval);
   if (!indexed) {
     server->index_thread_ = std::thread([raw = server.get()] {
       const absl::Time start = absl::Now();
@@ -220,7 +224,8 @@ void CovplanServer::ProbeStoreLoop(absl::Duration interval) {
     // A write that failed since the last probe counts too.
     const bool writable = probe.ok() && store_->writable();
     if (writable != was_writable) {
-      LogLine(writable ? "info" : "error", writable ? "map store writable again" : "map store is not writable",
+      LogLine(writable ? "info" : "error",
+              writable ? "map store writable again" : "map store is not writable",
               {{"detail", probe.ok() ? "" : std::string(probe.message())}});
       server_->GetHealthCheckService()->SetServingStatus(kStoreHealthService, writable);
       metrics_->store_writable().Set(writable ? 1 : 0);
@@ -251,7 +256,8 @@ void CovplanServer::Drain(absl::Duration grace) {
     // Our own calls decide how long the grace lasts, not gRPC's count of
     // open streams: a health Watch stream or an idle connection never ends
     // by itself and would hold Shutdown for the whole deadline.
-    while (service_->active_calls() > 0 && absl::Now() < give_up) absl::SleepFor(absl::Milliseconds(10));
+    while (service_->active_calls() > 0 && absl::Now() < give_up)
+      absl::SleepFor(absl::Milliseconds(10));
     if (service_->active_calls() > 0) {
       // Grace over: running solves stop and answer with their best plan.
       service_->CutShortInFlight();
@@ -277,7 +283,7 @@ void CovplanServer::Drain(absl::Duration grace) {
 
 CovplanServer::~CovplanServer() {
   Drain(absl::ZeroDuration());
-  server_.reset();   // before the service it dispatches to
+  server_.reset();  // before the service it dispatches to
   service_.reset();
 }
 

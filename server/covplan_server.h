@@ -29,15 +29,15 @@ class Server;
 namespace prometheus {
 class Collectable;
 class Exposer;
-}
+}  // namespace prometheus
 
 namespace covplan {
 
 struct ServerConfig {
   std::string address = "127.0.0.1";
-  int port = 50051;                  // 0: pick a free port
+  int port = 50051;  // 0: pick a free port
   std::string metrics_address = "127.0.0.1";
-  int metrics_port = 9464;           // 0: pick a free port; -1: no metrics endpoint
+  int metrics_port = 9464;  // 0: pick a free port; -1: no metrics endpoint
   std::string store_dir = "./covplan-data/maps";
   // "disk" (the embedded store in store_dir, default) or "postgres" (shared
   // by replicas; pg_conninfo is a libpq connection string).

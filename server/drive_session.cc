@@ -18,7 +18,9 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
   return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
 }
 
-int ObstacleItems(const v1::Obstacles& o) { return o.cells_size() + o.points_size() + o.polygons_size(); }
+int ObstacleItems(const v1::Obstacles& o) {
+  return o.cells_size() + o.points_size() + o.polygons_size();
+}
 
 }  // namespace
 
@@ -32,7 +34,8 @@ struct DriveSession::Actions {
 };
 
 DriveSession::DriveSession(CoveragePlannerService* service, grpc::CallbackServerContext* context,
-                           SessionRegistry* registry, std::string session_id, std::string tenant_tag)
+                           SessionRegistry* registry, std::string session_id,
+                           std::string tenant_tag)
     : service_(service),
       context_(context),
       registry_(registry),
@@ -110,8 +113,9 @@ bool DriveSession::ExpireIfIdle(absl::Time idle_before) {
     if (finished_ || ending_ || running_ || last_message_ >= idle_before) return false;
     EndLocked(grpc::Status(
         grpc::StatusCode::DEADLINE_EXCEEDED,
-        absl::StrFormat("drive session idle for more than %g s without a message (--session_idle_s)",
-                        absl::ToDoubleSeconds(registry_->idle_timeout()))));
+        absl::StrFormat(
+            "drive session idle for more than %g s without a message (--session_idle_s)",
+            absl::ToDoubleSeconds(registry_->idle_timeout()))));
     CheckFinish(&a);
   }
   Perform(a);
@@ -199,11 +203,13 @@ void DriveSession::HandleMessage(Actions* a) {
     if (ObstacleItems(in_.obstacles()) == 0) return;
     // Obstacles in the first message: replanned once the plan is adopted.
   } else if (in_.plan_ref_case() == v1::DriveRequest::kPlan) {
-    PushError(seq, absl::InvalidArgumentError("only the first DriveRequest may carry an inline plan"), a);
+    PushError(
+        seq, absl::InvalidArgumentError("only the first DriveRequest may carry an inline plan"), a);
     return;
   }
   std::string plan_id = in_.plan_id();
-  if (!plan_id.empty() && !KnowsPlan(plan_id) && !(adopted_ == false && plan_id == first_.plan_id())) {
+  if (!plan_id.empty() && !KnowsPlan(plan_id) &&
+      !(adopted_ == false && plan_id == first_.plan_id())) {
     PushError(seq,
               absl::InvalidArgumentError(absl::StrCat("plan_id '", plan_id.substr(0, 80),
                                                       "' is not a plan of this session")),
@@ -215,7 +221,8 @@ void DriveSession::HandleMessage(Actions* a) {
     // A progress report: kept for Resume.
     if (in_.has_progress()) {
       if (plan_id.empty() && !plans_.empty()) plan_id = plans_.back();
-      if (plan_id.empty() && first_.plan_ref_case() == v1::DriveRequest::kPlanId) plan_id = first_.plan_id();
+      if (plan_id.empty() && first_.plan_ref_case() == v1::DriveRequest::kPlanId)
+        plan_id = first_.plan_id();
       if (!plan_id.empty()) service_->RecordProgress(plan_id, in_.progress());
     }
     return;
@@ -275,15 +282,17 @@ void DriveSession::StartJob(Actions* a) {
   v1::DriveRequest first = first_;
   v1::Obstacles seen = seen_;
   Ref();  // held by the worker
-  const bool queued = service_->SubmitSolve([this, job, first = std::move(first), seen = std::move(seen), stop] {
-    RunJob(job, first, seen, stop);
-    Unref();
-  });
+  const bool queued =
+      service_->SubmitSolve([this, job, first = std::move(first), seen = std::move(seen), stop] {
+        RunJob(job, first, seen, stop);
+        Unref();
+      });
   if (!queued) {
     running_ = false;
     Unref();  // not the last: gRPC holds one until OnDone
     const absl::Status busy = absl::ResourceExhaustedError(
-        "server busy: no worker free for this session's replan; the obstacles are kept for the next one");
+        "server busy: no worker free for this session's replan; the obstacles are kept for the "
+        "next one");
     if (job.start) {
       EndLocked(ToGrpcStatus(busy));
     } else {
@@ -300,7 +309,8 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
   std::shared_ptr<const Grid> grid;
   std::string adopted;
   if (job.start) {
-    absl::StatusOr<CoveragePlannerService::AdoptedPlan> plan = service_->AdoptPlan(first, stop, tenant_tag_);
+    absl::StatusOr<CoveragePlannerService::AdoptedPlan> plan =
+        service_->AdoptPlan(first, stop, tenant_tag_);
     status = plan.status();
     if (plan.ok()) {
       adopted = plan->plan_id;
@@ -323,8 +333,8 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     call.request_id = absl::StrCat(session_id_, "/", job.sequence);
     call.tenant_tag = tenant_tag_;
     status = service_->RunReplan(call, request, stop, event.mutable_replan());
-    service_->RecordCall(call, status,
-                         status.ok() ? ReplanDetail(event.replan()) : std::string(status.message()));
+    service_->RecordCall(
+        call, status, status.ok() ? ReplanDetail(event.replan()) : std::string(status.message()));
   }
   Actions a;
   {

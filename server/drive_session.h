@@ -76,9 +76,9 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
 
  private:
   struct Job {
-    bool start = false;              // adopt the first message's plan
+    bool start = false;  // adopt the first message's plan
     uint64_t sequence = 0;
-    std::string plan_id;             // the plan the progress refers to ("" = newest)
+    std::string plan_id;  // the plan the progress refers to ("" = newest)
     v1::RobotProgress progress;
     v1::ReplanMethod method = v1::REPLAN_METHOD_UNSPECIFIED;  // unset: the session's
     std::vector<uint64_t> superseded;
@@ -89,12 +89,15 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   void Perform(const Actions& a);
   // Handles in_ (the message just read).
   void HandleMessage(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  absl::Status CheckObservation(const v1::Obstacles& obstacles) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  absl::Status CheckObservation(const v1::Obstacles& obstacles) const
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   bool KnowsPlan(const std::string& plan_id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void StartJob(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  void RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen, const StopToken& stop);
+  void RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen,
+              const StopToken& stop);
   void Push(v1::DriveEvent event, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  void PushError(uint64_t sequence, const absl::Status& status, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void PushError(uint64_t sequence, const absl::Status& status, Actions* a)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Stops taking input and pushing events; the call ends with `status`.
   void EndLocked(const grpc::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Finishes the call once no replan runs and nothing is being written.
@@ -111,13 +114,13 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   v1::DriveRequest in_ ABSL_GUARDED_BY(mu_);
   std::deque<v1::DriveEvent> out_ ABSL_GUARDED_BY(mu_);  // front: being written
   bool writing_ ABSL_GUARDED_BY(mu_) = false;
-  bool started_ ABSL_GUARDED_BY(mu_) = false;    // the first message was read
-  bool adopted_ ABSL_GUARDED_BY(mu_) = false;    // its plan was found
+  bool started_ ABSL_GUARDED_BY(mu_) = false;  // the first message was read
+  bool adopted_ ABSL_GUARDED_BY(mu_) = false;  // its plan was found
   bool reads_done_ ABSL_GUARDED_BY(mu_) = false;
-  bool ending_ ABSL_GUARDED_BY(mu_) = false;     // cancelled, expired or failed: push nothing more
+  bool ending_ ABSL_GUARDED_BY(mu_) = false;  // cancelled, expired or failed: push nothing more
   bool finished_ ABSL_GUARDED_BY(mu_) = false;
   grpc::Status end_status_ ABSL_GUARDED_BY(mu_);
-  v1::DriveRequest first_ ABSL_GUARDED_BY(mu_);  // method, seed, plan_ref
+  v1::DriveRequest first_ ABSL_GUARDED_BY(mu_);            // method, seed, plan_ref
   std::shared_ptr<const Grid> grid_ ABSL_GUARDED_BY(mu_);  // the plans' grid (for checks)
   std::deque<std::string> plans_ ABSL_GUARDED_BY(mu_);     // newest last
   v1::Obstacles seen_ ABSL_GUARDED_BY(mu_);

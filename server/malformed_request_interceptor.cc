@@ -18,7 +18,8 @@ using grpc::experimental::InterceptionHookPoints;
 
 class MalformedRequestInterceptor final : public grpc::experimental::Interceptor {
  public:
-  MalformedRequestInterceptor(const google::protobuf::MethodDescriptor* method, ServerMetrics* metrics)
+  MalformedRequestInterceptor(const google::protobuf::MethodDescriptor* method,
+                              ServerMetrics* metrics)
       : method_(method), metrics_(metrics), start_(absl::Now()) {}
 
   void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
@@ -26,7 +27,8 @@ class MalformedRequestInterceptor final : public grpc::experimental::Interceptor
       const grpc::Status status = methods->GetSendStatus();
       // Our handlers never answer UNIMPLEMENTED: this is gRPC's reply to a
       // request it could not deserialise.
-      if (status.error_code() == grpc::StatusCode::UNIMPLEMENTED && status.error_message().empty()) {
+      if (status.error_code() == grpc::StatusCode::UNIMPLEMENTED &&
+          status.error_message().empty()) {
         const std::string message = absl::StrCat(
             "request is not a valid ", method_->input_type()->full_name(), " protobuf message");
         methods->ModifySendStatus(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, message));
@@ -54,7 +56,8 @@ class Factory final : public grpc::experimental::ServerInterceptorFactoryInterfa
  public:
   explicit Factory(ServerMetrics* metrics) : metrics_(metrics) {}
 
-  grpc::experimental::Interceptor* CreateServerInterceptor(grpc::experimental::ServerRpcInfo* info) override {
+  grpc::experimental::Interceptor* CreateServerInterceptor(
+      grpc::experimental::ServerRpcInfo* info) override {
     // "/covplan.v1.CoveragePlanner/PutMap": only our unary methods.
     const std::string prefix = absl::StrCat("/", v1::CoveragePlanner::service_full_name(), "/");
     const char* name = info->method();
@@ -65,7 +68,8 @@ class Factory final : public grpc::experimental::ServerInterceptorFactoryInterfa
     const google::protobuf::ServiceDescriptor* service =
         v1::PutMapRequest::descriptor()->file()->FindServiceByName("CoveragePlanner");
     const google::protobuf::MethodDescriptor* method =
-        service == nullptr ? nullptr : service->FindMethodByName(std::string(name).substr(prefix.size()));
+        service == nullptr ? nullptr
+                           : service->FindMethodByName(std::string(name).substr(prefix.size()));
     if (method == nullptr) return nullptr;
     return new MalformedRequestInterceptor(method, metrics_);
   }

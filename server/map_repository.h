@@ -60,8 +60,8 @@ class MapRepository {
   // A page of List: at most `limit` maps with ids after `after` ("" = from
   // the start); `more` says whether any follow. Unavailable when the store
   // cannot be reached (rather than an empty page).
-  virtual absl::StatusOr<std::vector<v1::MapInfo>> ListPage(const std::string& after, int limit, bool* more,
-                                                            std::vector<std::string>* corrupted) const;
+  virtual absl::StatusOr<std::vector<v1::MapInfo>> ListPage(
+      const std::string& after, int limit, bool* more, std::vector<std::string>* corrupted) const;
   // A cheap check before serving a map from the cache: OK unless the store
   // knows the map is gone or damaged. Stores without an in-memory index
   // answer OK (their Get verifies every read).
@@ -83,9 +83,8 @@ class MapRepository {
   }
 };
 
-inline absl::StatusOr<std::vector<v1::MapInfo>> MapRepository::ListPage(const std::string& after, int limit,
-                                                                        bool* more,
-                                                                        std::vector<std::string>* corrupted) const {
+inline absl::StatusOr<std::vector<v1::MapInfo>> MapRepository::ListPage(
+    const std::string& after, int limit, bool* more, std::vector<std::string>* corrupted) const {
   if (absl::Status s = Available(); !s.ok()) return s;
   std::vector<v1::MapInfo> all = List(corrupted);
   std::vector<v1::MapInfo> page;

@@ -29,7 +29,8 @@ constexpr char kLockName[] = ".lock";
 constexpr char kProbeName[] = "write_probe.txt";
 
 absl::Status LoadingError() {
-  return absl::UnavailableError("the map store is still being indexed after a restart; retry shortly");
+  return absl::UnavailableError(
+      "the map store is still being indexed after a restart; retry shortly");
 }
 
 // A failed file operation as the client sees it: what failed and why, never
@@ -43,7 +44,8 @@ absl::Status ErrnoError(absl::string_view what, const std::string& path) {
     return absl::ResourceExhaustedError("map store is full (no space left on the server's disk)");
   }
   if (err == EROFS || err == EACCES || err == EPERM) {
-    return absl::UnavailableError(absl::StrCat("map store is not writable (", std::strerror(err), ")"));
+    return absl::UnavailableError(
+        absl::StrCat("map store is not writable (", std::strerror(err), ")"));
   }
   return absl::InternalError(absl::StrCat("map store: ", what, ": ", std::strerror(err)));
 }
@@ -70,7 +72,8 @@ absl::Status FsyncDir(const std::string& dir) {
 }
 
 // Writes `contents` to `path` atomically: temp file, fsync, rename, fsync dir.
-absl::Status AtomicWrite(const std::string& dir, const std::string& path, absl::string_view contents) {
+absl::Status AtomicWrite(const std::string& dir, const std::string& path,
+                         absl::string_view contents) {
   static std::atomic<uint64_t> counter{0};
   const std::string tmp =
       absl::StrCat(path, ".tmp.", ::getpid(), ".", counter.fetch_add(1, std::memory_order_relaxed));
@@ -79,7 +82,8 @@ absl::Status AtomicWrite(const std::string& dir, const std::string& path, absl::
   absl::Status status = WriteAll(fd, contents, tmp);
   if (status.ok() && ::fsync(fd) != 0) status = ErrnoError("cannot fsync", tmp);
   if (::close(fd) != 0 && status.ok()) status = ErrnoError("cannot close", tmp);
-  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0) status = ErrnoError("cannot rename", tmp);
+  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0)
+    status = ErrnoError("cannot rename", tmp);
   if (!status.ok()) {
     ::unlink(tmp.c_str());
     return status;
@@ -89,7 +93,8 @@ absl::Status AtomicWrite(const std::string& dir, const std::string& path, absl::
 
 bool IsMapFileName(const std::string& name, std::string* map_id) {
   const size_t suffix = sizeof(kSuffix) - 1;
-  if (name.size() <= suffix || name.compare(name.size() - suffix, suffix, kSuffix) != 0) return false;
+  if (name.size() <= suffix || name.compare(name.size() - suffix, suffix, kSuffix) != 0)
+    return false;
   *map_id = name.substr(0, name.size() - suffix);
   return ValidateMapId(*map_id).ok();
 }
@@ -99,7 +104,9 @@ bool IsMapFileName(const std::string& name, std::string* map_id) {
 absl::StatusOr<std::unique_ptr<MapStore>> MapStore::OpenLocked(const std::string& dir, bool index) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return absl::InternalError(absl::StrCat("cannot create store directory ", dir, ": ", ec.message()));
+  if (ec)
+    return absl::InternalError(
+        absl::StrCat("cannot create store directory ", dir, ": ", ec.message()));
   // One server per store: a second one would index a different state and
   // the two would disagree about what exists.
   const std::string lock_path = dir + "/" + kLockName;
@@ -112,9 +119,9 @@ absl::StatusOr<std::unique_ptr<MapStore>> MapStore::OpenLocked(const std::string
     const int err = errno;
     ::close(lock_fd);
     if (err == EWOULDBLOCK) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "store directory ", dir, " is in use by another covplan-server (", lock_path,
-          " is locked); stop it or choose another --store_dir"));
+      return absl::FailedPreconditionError(
+          absl::StrCat("store directory ", dir, " is in use by another covplan-server (", lock_path,
+                       " is locked); stop it or choose another --store_dir"));
     }
     return absl::FailedPreconditionError(
         absl::StrCat("cannot lock ", lock_path, ": ", std::strerror(err)));
@@ -183,7 +190,8 @@ absl::Status MapStore::Check(const std::string& map_id) const {
   absl::MutexLock lock(&mu_);
   if (loading_) return LoadingError();
   if (corrupted_.count(map_id) != 0) {
-    return absl::DataLossError(absl::StrCat("map ", map_id, " is corrupted on disk; PutMap it again"));
+    return absl::DataLossError(
+        absl::StrCat("map ", map_id, " is corrupted on disk; PutMap it again"));
   }
   if (index_.count(map_id) == 0) {
     return absl::NotFoundError(absl::StrCat("unknown map_id ", map_id, "; PutMap it first"));
@@ -240,8 +248,8 @@ absl::StatusOr<v1::GetMapResponse> MapStore::ReadVerified(const std::string& pat
   }
   const absl::string_view payload = absl::string_view(contents).substr(pos);
   if (payload.size() != size) {
-    return absl::DataLossError(absl::StrCat("payload is ", payload.size(),
-                                            " bytes, header says ", size, " (truncated?)"));
+    return absl::DataLossError(
+        absl::StrCat("payload is ", payload.size(), " bytes, header says ", size, " (truncated?)"));
   }
   if (Sha256Hex(payload) != lines[1]) {
     return absl::DataLossError("checksum mismatch");
@@ -304,9 +312,9 @@ absl::StatusOr<v1::GetMapResponse> MapStore::Get(const std::string& map_id) cons
   absl::StatusOr<v1::GetMapResponse> stored = ReadVerified(PathFor(map_id));
   if (!stored.ok() || stored->info().map_id() != map_id) {
     MarkCorrupted(map_id);
-    return absl::DataLossError(absl::StrCat(
-        "map ", map_id, " is corrupted on disk (",
-        stored.ok() ? "id mismatch" : stored.status().message(), "); PutMap it again"));
+    return absl::DataLossError(absl::StrCat("map ", map_id, " is corrupted on disk (",
+                                            stored.ok() ? "id mismatch" : stored.status().message(),
+                                            "); PutMap it again"));
   }
   return stored;
 }
@@ -320,13 +328,14 @@ std::vector<v1::MapInfo> MapStore::List(std::vector<std::string>* corrupted) con
   return maps;
 }
 
-absl::StatusOr<std::vector<v1::MapInfo>> MapStore::ListPage(const std::string& after, int limit, bool* more,
-                                                            std::vector<std::string>* corrupted) const {
+absl::StatusOr<std::vector<v1::MapInfo>> MapStore::ListPage(
+    const std::string& after, int limit, bool* more, std::vector<std::string>* corrupted) const {
   absl::MutexLock lock(&mu_);
   if (loading_) return LoadingError();
   std::vector<v1::MapInfo> maps;
   auto it = after.empty() ? index_.begin() : index_.upper_bound(after);
-  for (; it != index_.end() && static_cast<int>(maps.size()) < limit; ++it) maps.push_back(it->second);
+  for (; it != index_.end() && static_cast<int>(maps.size()) < limit; ++it)
+    maps.push_back(it->second);
   *more = it != index_.end();
   if (corrupted != nullptr) corrupted->assign(corrupted_.begin(), corrupted_.end());
   return maps;
@@ -374,13 +383,15 @@ bool IsStateName(const std::string& name) {
 }  // namespace
 
 absl::Status MapStore::PutState(const std::string& name, absl::string_view contents) {
-  if (!IsStateName(name)) return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
+  if (!IsStateName(name))
+    return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
   absl::MutexLock write_lock(&write_mu_);
   return AtomicWrite(dir_, dir_ + "/" + name, contents);
 }
 
 absl::StatusOr<std::string> MapStore::GetState(const std::string& name) const {
-  if (!IsStateName(name)) return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
+  if (!IsStateName(name))
+    return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
   std::ifstream in(dir_ + "/" + name, std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat("no state file ", name));
   std::ostringstream buffer;
@@ -408,7 +419,8 @@ absl::Status MapStore::PutPlan(const std::string& plan_id, absl::string_view con
 }
 
 absl::StatusOr<std::string> MapStore::GetPlan(const std::string& plan_id) const {
-  if (!IsPlanId(plan_id)) return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
+  if (!IsPlanId(plan_id))
+    return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
   std::ifstream in(dir_ + "/plans/" + plan_id + ".plan", std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id));
   std::ostringstream buffer;
@@ -417,11 +429,13 @@ absl::StatusOr<std::string> MapStore::GetPlan(const std::string& plan_id) const 
 }
 
 absl::Status MapStore::PutProgress(const std::string& plan_id, absl::string_view contents) {
-  if (!IsPlanId(plan_id)) return absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id.substr(0, 80)));
+  if (!IsPlanId(plan_id))
+    return absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id.substr(0, 80)));
   const std::string dir = dir_ + "/plans";
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return absl::InternalError(absl::StrCat("cannot create the plans directory: ", ec.message()));
+  if (ec)
+    return absl::InternalError(absl::StrCat("cannot create the plans directory: ", ec.message()));
   return AtomicWrite(dir, dir + "/" + plan_id + ".progress", contents);
 }
 
@@ -448,7 +462,8 @@ int64_t MapStore::TrimPlans(int64_t keep) {
   if (static_cast<int64_t>(files.size()) <= keep) return 0;
   std::sort(files.begin(), files.end());
   int64_t removed = 0;
-  for (size_t i = 0; i + keep < files.size(); ++i) removed += std::filesystem::remove(files[i].second, ec);
+  for (size_t i = 0; i + keep < files.size(); ++i)
+    removed += std::filesystem::remove(files[i].second, ec);
   return removed;
 }
 

@@ -67,8 +67,9 @@ class MapStore : public MapRepository {
   std::vector<v1::MapInfo> List(std::vector<std::string>* corrupted) const override;
   // At most `limit` maps with ids after `after` ("" = from the start);
   // `more` says whether any follow.
-  absl::StatusOr<std::vector<v1::MapInfo>> ListPage(const std::string& after, int limit, bool* more,
-                                                    std::vector<std::string>* corrupted) const override;
+  absl::StatusOr<std::vector<v1::MapInfo>> ListPage(
+      const std::string& after, int limit, bool* more,
+      std::vector<std::string>* corrupted) const override;
 
   // Returns false if there was no such map. The map stays indexed when the
   // file cannot be removed.

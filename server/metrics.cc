@@ -41,33 +41,39 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
   worker_threads_ = NewGauge(r, "covplan_worker_threads", "Size of the worker pool");
   queue_capacity_ = NewGauge(r, "covplan_worker_queue_capacity", "Bound of the worker queue");
   cache_hits_ = NewCounter(r, "covplan_artifact_cache_hits_total",
-                           "Per-map artifact lookups (grid, area, partition, transitions) served from the cache or a concurrent build");
+                           "Per-map artifact lookups (grid, area, partition, transitions) served "
+                           "from the cache or a concurrent build");
   cache_misses_ = NewCounter(r, "covplan_artifact_cache_misses_total",
                              "Per-map artifact lookups that had to build");
   cache_evictions_ = NewCounter(r, "covplan_artifact_cache_evictions_total",
                                 "Artifacts evicted to stay within the byte budget");
   cache_bytes_ = NewGauge(r, "covplan_artifact_cache_bytes", "Bytes held by the cache");
   cache_entries_ = NewGauge(r, "covplan_artifact_cache_entries", "Entries in the cache");
-  cache_budget_bytes_ = NewGauge(r, "covplan_artifact_cache_budget_bytes",
-                                 "Memory budget of the cache");
+  cache_budget_bytes_ =
+      NewGauge(r, "covplan_artifact_cache_budget_bytes", "Memory budget of the cache");
   maps_stored_ = NewGauge(r, "covplan_maps_stored", "Maps in the registry");
   plans_retained_ = NewGauge(r, "covplan_plans_retained", "Plans addressable by plan_id");
-  store_writable_ = NewGauge(r, "covplan_store_writable",
-                             "1 while the map store accepts writes, 0 when it is full or read-only");
+  store_writable_ =
+      NewGauge(r, "covplan_store_writable",
+               "1 while the map store accepts writes, 0 when it is full or read-only");
   store_writable_->Set(1);
   replans_ = &prometheus::BuildCounter()
                   .Name("covplan_replans_total")
                   .Help("Replans answered, by the method that produced the plan")
                   .Register(r);
-  plan_sources_ = &prometheus::BuildCounter()
-                       .Name("covplan_plan_source_total")
-                       .Help("Plans answered, by source: cold search, remembered plan (cache_hit), "
-                             "search on from it (improved), search from a remembered tour (warm_start)")
-                       .Register(r);
-  for (const char* s : {"cold", "cache_hit", "improved", "warm_start"}) plan_sources_->Add({{"source", s}});
-  hits_without_worker_ = NewCounter(r, "covplan_plan_hits_without_worker_total",
-                                    "Repeated cache hits answered on the network thread, without a worker "
-                                    "(also counted as cache_hit in covplan_plan_source_total)");
+  plan_sources_ =
+      &prometheus::BuildCounter()
+           .Name("covplan_plan_source_total")
+           .Help(
+               "Plans answered, by source: cold search, remembered plan (cache_hit), "
+               "search on from it (improved), search from a remembered tour (warm_start)")
+           .Register(r);
+  for (const char* s : {"cold", "cache_hit", "improved", "warm_start"})
+    plan_sources_->Add({{"source", s}});
+  hits_without_worker_ =
+      NewCounter(r, "covplan_plan_hits_without_worker_total",
+                 "Repeated cache hits answered on the network thread, without a worker "
+                 "(also counted as cache_hit in covplan_plan_source_total)");
   replan_duration_ = &prometheus::BuildHistogram()
                           .Name("covplan_replan_duration_seconds")
                           .Help("Compute time of one replan")
@@ -75,10 +81,11 @@ ServerMetrics::ServerMetrics() : registry_(std::make_shared<prometheus::Registry
                           .Add({}, LatencyBuckets());
   greedy_detours_ = NewCounter(r, "covplan_replan_greedy_detours_total",
                                "Encounters handled by greedy detour (too little time to replan)");
-  estimator_ = &prometheus::BuildGauge()
-                    .Name("covplan_replan_estimator")
-                    .Help("Replan runtime model f(m) = a + b m + c m^3 (seconds) and its sample count")
-                    .Register(r);
+  estimator_ =
+      &prometheus::BuildGauge()
+           .Name("covplan_replan_estimator")
+           .Help("Replan runtime model f(m) = a + b m + c m^3 (seconds) and its sample count")
+           .Register(r);
   drive_sessions_ = NewGauge(r, "covplan_drive_sessions", "Open Drive streaming sessions");
   drive_superseded_ = NewCounter(r, "covplan_drive_superseded_total",
                                  "Session replans dropped because a newer observation arrived");

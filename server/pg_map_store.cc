@@ -57,7 +57,8 @@ struct Param {
 };
 
 std::string Reason(PGconn* conn) {
-  return std::string(absl::StripTrailingAsciiWhitespace(conn ? PQerrorMessage(conn) : "out of memory"));
+  return std::string(
+      absl::StripTrailingAsciiWhitespace(conn ? PQerrorMessage(conn) : "out of memory"));
 }
 
 absl::Status Unavailable(const std::string& reason) {
@@ -143,8 +144,7 @@ class PgMapStore::Lease {
  public:
   Lease(const PgMapStore* store, std::unique_ptr<PgConnection> c)
       : store_(store), connection_(std::move(c)) {}
-  Lease(Lease&& other) noexcept
-      : store_(other.store_), connection_(std::move(other.connection_)) {}
+  Lease(Lease&& other) noexcept : store_(other.store_), connection_(std::move(other.connection_)) {}
   ~Lease() {
     if (connection_ != nullptr) store_->Release(std::move(connection_));
   }
@@ -161,11 +161,13 @@ PgMapStore::~PgMapStore() = default;
 
 absl::StatusOr<std::unique_ptr<PgMapStore>> PgMapStore::Open(const std::string& conninfo,
                                                              PgMapStoreOptions options) {
-  if (options.connections < 1) return absl::InvalidArgumentError("PostgreSQL pool needs >= 1 connection");
+  if (options.connections < 1)
+    return absl::InvalidArgumentError("PostgreSQL pool needs >= 1 connection");
   char* error = nullptr;
   PQconninfoOption* parsed = PQconninfoParse(conninfo.c_str(), &error);
   if (parsed == nullptr) {
-    const std::string reason = error ? std::string(absl::StripTrailingAsciiWhitespace(error)) : "out of memory";
+    const std::string reason =
+        error ? std::string(absl::StripTrailingAsciiWhitespace(error)) : "out of memory";
     PQfreemem(error);
     return absl::InvalidArgumentError(absl::StrCat("--pg_conninfo: ", reason));
   }
@@ -234,21 +236,22 @@ absl::StatusOr<bool> PgMapStore::Put(const v1::MapInfo& info, const v1::Map& map
   // Already there: keep an intact copy, replace a damaged one, in one
   // transaction so two replicas repairing at once do not interleave.
   if (auto s = (*c)->Exec("BEGIN", {}, true); !s.ok()) return s.status();
-  absl::StatusOr<Result> existing = (*c)->Exec(
-      "SELECT sha256, payload FROM covplan_maps WHERE map_id = $1 FOR UPDATE", {{info.map_id()}},
-      false);
+  absl::StatusOr<Result> existing =
+      (*c)->Exec("SELECT sha256, payload FROM covplan_maps WHERE map_id = $1 FOR UPDATE",
+                 {{info.map_id()}}, false);
   bool intact = false;
   if (existing.ok() && PQntuples(existing->get()) == 1) {
     intact = Sha256Hex(Field(existing->get(), 0, 1)) == Field(existing->get(), 0, 0);
   }
   absl::Status written = existing.status();
   if (written.ok() && !intact) {
-    written = (*c)->Exec(
-                      "INSERT INTO covplan_maps (map_id, sha256, info, payload) VALUES ($1, $2, $3, $4) "
-                      "ON CONFLICT (map_id) DO UPDATE SET sha256 = EXCLUDED.sha256, "
-                      "info = EXCLUDED.info, payload = EXCLUDED.payload",
-                      row, false)
-                  .status();
+    written =
+        (*c)->Exec(
+                "INSERT INTO covplan_maps (map_id, sha256, info, payload) VALUES ($1, $2, $3, $4) "
+                "ON CONFLICT (map_id) DO UPDATE SET sha256 = EXCLUDED.sha256, "
+                "info = EXCLUDED.info, payload = EXCLUDED.payload",
+                row, false)
+            .status();
     if (written.ok()) LogLine("warn", "replaced a damaged map copy", {{"map_id", info.map_id()}});
   }
   absl::StatusOr<Result> end = (*c)->Exec(written.ok() ? "COMMIT" : "ROLLBACK", {}, false);
@@ -263,7 +266,8 @@ absl::StatusOr<v1::GetMapResponse> PgMapStore::Get(const std::string& map_id) co
   absl::StatusOr<Result> r =
       (*c)->Exec("SELECT sha256, payload FROM covplan_maps WHERE map_id = $1", {{map_id}}, true);
   if (!r.ok()) return r.status();
-  if (PQntuples(r->get()) == 0) return absl::NotFoundError(absl::StrCat("no map ", map_id.substr(0, 80)));
+  if (PQntuples(r->get()) == 0)
+    return absl::NotFoundError(absl::StrCat("no map ", map_id.substr(0, 80)));
   const std::string payload = Field(r->get(), 0, 1);
   v1::GetMapResponse record;
   if (Sha256Hex(payload) != Field(r->get(), 0, 0) || !record.ParseFromString(payload)) {
@@ -316,17 +320,21 @@ int64_t PgMapStore::size() const {
 }
 
 absl::Status PgMapStore::PutState(const std::string& name, absl::string_view contents) {
-  if (!IsStateName(name)) return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
+  if (!IsStateName(name))
+    return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
   absl::StatusOr<Lease> c = Acquire();
   if (!c.ok()) return c.status();
-  return (*c)->Exec("INSERT INTO covplan_state (name, contents) VALUES ($1, $2) "
-                    "ON CONFLICT (name) DO UPDATE SET contents = EXCLUDED.contents",
-                    {{name}, {contents, true}}, true)
+  return (*c)
+      ->Exec(
+          "INSERT INTO covplan_state (name, contents) VALUES ($1, $2) "
+          "ON CONFLICT (name) DO UPDATE SET contents = EXCLUDED.contents",
+          {{name}, {contents, true}}, true)
       .status();
 }
 
 absl::StatusOr<std::string> PgMapStore::GetState(const std::string& name) const {
-  if (!IsStateName(name)) return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
+  if (!IsStateName(name))
+    return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
   absl::StatusOr<Lease> c = Acquire();
   if (!c.ok()) return c.status();
   absl::StatusOr<Result> r =
@@ -340,21 +348,25 @@ absl::Status PgMapStore::PutPlan(const std::string& plan_id, absl::string_view c
   if (!IsPlanId(plan_id)) return absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id));
   absl::StatusOr<Lease> c = Acquire();
   if (!c.ok()) return c.status();
-  return (*c)->Exec("INSERT INTO covplan_plans (plan_id, contents) VALUES ($1, $2) "
-                    "ON CONFLICT (plan_id) DO UPDATE SET contents = EXCLUDED.contents, "
-                    "created = clock_timestamp()",
-                    {{plan_id}, {contents, true}}, true)
+  return (*c)
+      ->Exec(
+          "INSERT INTO covplan_plans (plan_id, contents) VALUES ($1, $2) "
+          "ON CONFLICT (plan_id) DO UPDATE SET contents = EXCLUDED.contents, "
+          "created = clock_timestamp()",
+          {{plan_id}, {contents, true}}, true)
       .status();
 }
 
 absl::StatusOr<std::string> PgMapStore::GetPlan(const std::string& plan_id) const {
-  if (!IsPlanId(plan_id)) return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
+  if (!IsPlanId(plan_id))
+    return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
   absl::StatusOr<Lease> c = Acquire();
   if (!c.ok()) return c.status();
   absl::StatusOr<Result> r =
       (*c)->Exec("SELECT contents FROM covplan_plans WHERE plan_id = $1", {{plan_id}}, true);
   if (!r.ok()) return r.status();
-  if (PQntuples(r->get()) == 0) return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id));
+  if (PQntuples(r->get()) == 0)
+    return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id));
   return Field(r->get(), 0, 0);
 }
 

@@ -44,8 +44,8 @@ namespace covplan {
 class PgConnection;
 
 struct PgMapStoreOptions {
-  int connections = 4;             // pool size
-  int statement_timeout_ms = 5000; // per statement, so a hung database cannot hold a worker
+  int connections = 4;              // pool size
+  int statement_timeout_ms = 5000;  // per statement, so a hung database cannot hold a worker
 };
 
 class PgMapStore : public MapRepository {

@@ -20,8 +20,7 @@ void PlanRegistry::Put(std::shared_ptr<const RetainedPlan> plan, absl::Time now)
   }
 }
 
-std::shared_ptr<const RetainedPlan> PlanRegistry::Get(const std::string& plan_id,
-                                                          absl::Time now) {
+std::shared_ptr<const RetainedPlan> PlanRegistry::Get(const std::string& plan_id, absl::Time now) {
   std::vector<std::shared_ptr<const RetainedPlan>> dropped;  // freed after the lock is released
   absl::MutexLock lock(&mu_);
   Expire(now, &dropped);
@@ -34,14 +33,16 @@ size_t PlanRegistry::size() const {
   return plans_.size();
 }
 
-void PlanRegistry::Expire(absl::Time now, std::vector<std::shared_ptr<const RetainedPlan>>* dropped) {
+void PlanRegistry::Expire(absl::Time now,
+                          std::vector<std::shared_ptr<const RetainedPlan>>* dropped) {
   while (!order_.empty() && order_.front().expires <= now) {
     Drop(order_.front().plan_id, dropped);
     order_.pop_front();
   }
 }
 
-void PlanRegistry::Drop(const std::string& plan_id, std::vector<std::shared_ptr<const RetainedPlan>>* dropped) {
+void PlanRegistry::Drop(const std::string& plan_id,
+                        std::vector<std::shared_ptr<const RetainedPlan>>* dropped) {
   auto it = plans_.find(plan_id);
   if (it == plans_.end()) return;
   dropped->push_back(std::move(it->second));

@@ -30,8 +30,7 @@ class PlanRegistry {
   PlanRegistry(absl::Duration ttl, size_t max_plans) : ttl_(ttl), max_plans_(max_plans) {}
 
   void Put(std::shared_ptr<const RetainedPlan> plan, absl::Time now = absl::Now());
-  std::shared_ptr<const RetainedPlan> Get(const std::string& plan_id,
-                                              absl::Time now = absl::Now());
+  std::shared_ptr<const RetainedPlan> Get(const std::string& plan_id, absl::Time now = absl::Now());
   size_t size() const;
 
  private:
@@ -50,8 +49,7 @@ class PlanRegistry {
   const size_t max_plans_;
   mutable absl::Mutex mu_;
   std::deque<Entry> order_ ABSL_GUARDED_BY(mu_);  // oldest first
-  std::unordered_map<std::string, std::shared_ptr<const RetainedPlan>> plans_
-      ABSL_GUARDED_BY(mu_);
+  std::unordered_map<std::string, std::shared_ptr<const RetainedPlan>> plans_ ABSL_GUARDED_BY(mu_);
 };
 
 }  // namespace covplan

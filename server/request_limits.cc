@@ -14,9 +14,9 @@ using ::google::protobuf::FieldDescriptor;
 using ::google::protobuf::Message;
 using ::google::protobuf::Reflection;
 
-constexpr double kMinResolution = 1e-4;    // metres per pixel
+constexpr double kMinResolution = 1e-4;  // metres per pixel
 constexpr double kMaxResolution = 1000.0;
-constexpr double kMaxCoordinate = 1e7;     // metres from the map frame's origin
+constexpr double kMaxCoordinate = 1e7;  // metres from the map frame's origin
 
 absl::Status TooLong(const std::string& path, size_t size, size_t limit) {
   return absl::InvalidArgumentError(
@@ -41,15 +41,18 @@ absl::Status CheckMessage(const Message& message, const std::string& prefix) {
   std::vector<const FieldDescriptor*> fields;
   reflection->ListFields(message, &fields);  // set fields only
   for (const FieldDescriptor* field : fields) {
-    const std::string path = prefix.empty() ? field->name() : absl::StrCat(prefix, ".", field->name());
+    const std::string path =
+        prefix.empty() ? field->name() : absl::StrCat(prefix, ".", field->name());
     if (field->type() == FieldDescriptor::TYPE_STRING) {
       const size_t limit = StringLimitFor(field->full_name());
       if (field->is_repeated()) {
         const int n = reflection->FieldSize(message, field);
         for (int i = 0; i < n; ++i) {
           std::string scratch;
-          const std::string& value = reflection->GetRepeatedStringReference(message, field, i, &scratch);
-          if (value.size() > limit) return TooLong(absl::StrCat(path, "[", i, "]"), value.size(), limit);
+          const std::string& value =
+              reflection->GetRepeatedStringReference(message, field, i, &scratch);
+          if (value.size() > limit)
+            return TooLong(absl::StrCat(path, "[", i, "]"), value.size(), limit);
         }
       } else {
         std::string scratch;
@@ -69,7 +72,8 @@ absl::Status CheckMessage(const Message& message, const std::string& prefix) {
             return s;
           }
         }
-      } else if (absl::Status s = CheckMessage(reflection->GetMessage(message, field), path); !s.ok()) {
+      } else if (absl::Status s = CheckMessage(reflection->GetMessage(message, field), path);
+                 !s.ok()) {
         return s;
       }
     }
@@ -80,7 +84,8 @@ absl::Status CheckMessage(const Message& message, const std::string& prefix) {
 }  // namespace
 
 size_t StringLimitFor(const std::string& full_field_name) {
-  if (full_field_name == "covplan.v1.PutMapRequest.name" || full_field_name == "covplan.v1.MapInfo.name") {
+  if (full_field_name == "covplan.v1.PutMapRequest.name" ||
+      full_field_name == "covplan.v1.MapInfo.name") {
     return kMapNameLimit;
   }
   if (full_field_name == "covplan.v1.RasterMap.yaml") return kYamlLimit;
@@ -98,16 +103,17 @@ absl::Status CheckSiteGeometry(const SiteMap& site) {
   if (site.raster == nullptr) return absl::InvalidArgumentError("map has no raster");
   const double resolution = site.raster->resolution();
   if (!std::isfinite(resolution) || resolution < kMinResolution || resolution > kMaxResolution) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "map resolution %g m/px is outside [%g, %g] m/px", resolution, kMinResolution, kMaxResolution));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("map resolution %g m/px is outside [%g, %g] m/px", resolution,
+                        kMinResolution, kMaxResolution));
   }
   const Point2 corners[2] = {site.min_corner(), site.max_corner()};
   for (const Point2& p : corners) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || std::abs(p.x) > kMaxCoordinate ||
         std::abs(p.y) > kMaxCoordinate) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "map origin/extent (%g, %g) m is beyond %g m from the map frame's origin",
-          p.x, p.y, kMaxCoordinate));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("map origin/extent (%g, %g) m is beyond %g m from the map frame's origin",
+                          p.x, p.y, kMaxCoordinate));
     }
   }
   return absl::OkStatus();

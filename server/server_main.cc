@@ -39,15 +39,18 @@ ABSL_FLAG(int, metrics_port, 9464, "Prometheus /metrics port (0 picks, -1 disabl
 ABSL_FLAG(std::string, store_dir, "./covplan-data/maps", "Directory of the map registry");
 ABSL_FLAG(std::string, map_store, "disk",
           "Map registry: disk (embedded, in --store_dir) or postgres (shared by replicas)");
-ABSL_FLAG(std::string, pg_conninfo, "",
-          "With --map_store=postgres: libpq connection string, e.g. \"host=/run/pg dbname=covplan\"");
+ABSL_FLAG(
+    std::string, pg_conninfo, "",
+    "With --map_store=postgres: libpq connection string, e.g. \"host=/run/pg dbname=covplan\"");
 ABSL_FLAG(int, threads, 2, "Worker threads for planning");
 ABSL_FLAG(int, max_queue, 16, "Requests that may wait for a worker; beyond: RESOURCE_EXHAUSTED");
-ABSL_FLAG(bool, plan_memory, true,
-          "Remember plans within the --cache_mb budget: an identical Plan request is answered at once, "
-          "one differing only in start/end pose or seed searches from the remembered tour; false: every "
-          "request searches from scratch");
-ABSL_FLAG(int64_t, cache_mb, 256, "Per-map artifact cache budget in MiB (grids, coverage areas, partitions, transitions)");
+ABSL_FLAG(
+    bool, plan_memory, true,
+    "Remember plans within the --cache_mb budget: an identical Plan request is answered at once, "
+    "one differing only in start/end pose or seed searches from the remembered tour; false: every "
+    "request searches from scratch");
+ABSL_FLAG(int64_t, cache_mb, 256,
+          "Per-map artifact cache budget in MiB (grids, coverage areas, partitions, transitions)");
 ABSL_FLAG(double, default_budget_s, 2.0, "Tour search budget for calls without a deadline");
 ABSL_FLAG(int, deadline_margin_ms, 25, "Part of a call's deadline kept for sending the reply");
 ABSL_FLAG(int, plan_ttl_s, 600, "How long plans stay addressable by plan_id");
@@ -60,16 +63,19 @@ ABSL_FLAG(int64_t, max_ranks, 100000,
 ABSL_FLAG(int64_t, max_transition_mb, 1024,
           "Memory budget of one plan's transitions, MiB (OARP all-pairs table or sparse candidate "
           "graph; boustrophedon table); above it: RESOURCE_EXHAUSTED");
-ABSL_FLAG(int64_t, dense_transition_mb, 4,
-          "OARP uses the exact all-pairs transition table and dense GTSP while they fit in this many "
-          "MiB (about 100 ranks at the default), the sparse candidate graph above");
+ABSL_FLAG(
+    int64_t, dense_transition_mb, 4,
+    "OARP uses the exact all-pairs transition table and dense GTSP while they fit in this many "
+    "MiB (about 100 ranks at the default), the sparse candidate graph above");
 ABSL_FLAG(double, max_request_s, 120.0,
           "Calls without a deadline stop after this long with DEADLINE_EXCEEDED");
 ABSL_FLAG(double, drain_grace_s, 10.0, "On SIGTERM, time in-flight calls get to finish");
-ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain for TLS on the gRPC port (with --tls_key); empty = plaintext");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM certificate chain for TLS on the gRPC port (with --tls_key); empty = plaintext");
 ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
-ABSL_FLAG(std::string, tls_client_ca, "",
-          "PEM CA that client certificates must chain to (mutual TLS); empty = no client certificates");
+ABSL_FLAG(
+    std::string, tls_client_ca, "",
+    "PEM CA that client certificates must chain to (mutual TLS); empty = no client certificates");
 ABSL_FLAG(std::string, token_file, "",
           "File of \"<sha256 hex of a bearer token> <tenant>\" lines; every call then needs "
           "\"authorization: Bearer <token>\" and sees only its tenant's maps and plans (health and "
@@ -87,17 +93,20 @@ template <typename T>
 void CheckRange(const char* name, T value, T lo, T hi, std::vector<std::string>* errors) {
   if constexpr (std::is_floating_point_v<T>) {
     if (!std::isfinite(value) || value < lo || value > hi) {
-      errors->push_back(absl::StrCat("--", name, "=", value, ": must be a number in [", lo, ", ", hi, "]"));
+      errors->push_back(
+          absl::StrCat("--", name, "=", value, ": must be a number in [", lo, ", ", hi, "]"));
     }
   } else if (value < lo || value > hi) {
-    errors->push_back(absl::StrCat("--", name, "=", value, ": must be an integer in [", lo, ", ", hi, "]"));
+    errors->push_back(
+        absl::StrCat("--", name, "=", value, ": must be an integer in [", lo, ", ", hi, "]"));
   }
 }
 
 std::vector<std::string> ValidateFlags() {
   std::vector<std::string> errors;
   if (absl::GetFlag(FLAGS_address).empty()) errors.push_back("--address: must not be empty");
-  if (absl::GetFlag(FLAGS_metrics_address).empty()) errors.push_back("--metrics_address: must not be empty");
+  if (absl::GetFlag(FLAGS_metrics_address).empty())
+    errors.push_back("--metrics_address: must not be empty");
   if (absl::GetFlag(FLAGS_store_dir).empty()) errors.push_back("--store_dir: must not be empty");
   CheckRange("port", absl::GetFlag(FLAGS_port), 0, 65535, &errors);
   CheckRange("metrics_port", absl::GetFlag(FLAGS_metrics_port), -1, 65535, &errors);
@@ -110,11 +119,15 @@ std::vector<std::string> ValidateFlags() {
   CheckRange("max_retained_plans", absl::GetFlag(FLAGS_max_retained_plans), 1, 1000000, &errors);
   // The largest gRPC message is the image plus 4 MiB and must fit an int.
   CheckRange<int64_t>("max_image_mb", absl::GetFlag(FLAGS_max_image_mb), 1, 2000, &errors);
-  CheckRange<int64_t>("max_map_pixels", absl::GetFlag(FLAGS_max_map_pixels), 1, int64_t{1} << 36, &errors);
-  CheckRange<int64_t>("max_grid_cells", absl::GetFlag(FLAGS_max_grid_cells), 1, int64_t{1} << 32, &errors);
+  CheckRange<int64_t>("max_map_pixels", absl::GetFlag(FLAGS_max_map_pixels), 1, int64_t{1} << 36,
+                      &errors);
+  CheckRange<int64_t>("max_grid_cells", absl::GetFlag(FLAGS_max_grid_cells), 1, int64_t{1} << 32,
+                      &errors);
   CheckRange<int64_t>("max_ranks", absl::GetFlag(FLAGS_max_ranks), 1, 100000, &errors);
-  CheckRange<int64_t>("max_transition_mb", absl::GetFlag(FLAGS_max_transition_mb), 1, 1 << 20, &errors);
-  CheckRange<int64_t>("dense_transition_mb", absl::GetFlag(FLAGS_dense_transition_mb), 0, 1 << 20, &errors);
+  CheckRange<int64_t>("max_transition_mb", absl::GetFlag(FLAGS_max_transition_mb), 1, 1 << 20,
+                      &errors);
+  CheckRange<int64_t>("dense_transition_mb", absl::GetFlag(FLAGS_dense_transition_mb), 0, 1 << 20,
+                      &errors);
   CheckRange("max_request_s", absl::GetFlag(FLAGS_max_request_s), 1e-3, 24 * 3600.0, &errors);
   CheckRange("drain_grace_s", absl::GetFlag(FLAGS_drain_grace_s), 0.0, 3600.0, &errors);
   CheckRange("drain_notice_s", absl::GetFlag(FLAGS_drain_notice_s), 0.0, 3600.0, &errors);
@@ -232,7 +245,8 @@ int main(int argc, char** argv) {
   config.max_message_bytes =
       static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));
 
-  absl::StatusOr<std::unique_ptr<covplan::CovplanServer>> server = covplan::CovplanServer::Start(config);
+  absl::StatusOr<std::unique_ptr<covplan::CovplanServer>> server =
+      covplan::CovplanServer::Start(config);
   if (!server.ok()) {
     std::fprintf(stderr, "covplan-server: %s\n", std::string(server.status().message()).c_str());
     return 1;
@@ -259,8 +273,9 @@ int main(int argc, char** argv) {
   // teardown (or the /metrics server's) still hang, exit anyway.
   std::thread([grace] {
     absl::SleepFor(grace + kDrainOverrun);
-    covplan::LogLine("warn", "drain overran its bound; exiting",
-                     {{"bound_ms", absl::StrCat(absl::ToInt64Milliseconds(grace + kDrainOverrun))}});
+    covplan::LogLine(
+        "warn", "drain overran its bound; exiting",
+        {{"bound_ms", absl::StrCat(absl::ToInt64Milliseconds(grace + kDrainOverrun))}});
     std::fflush(stderr);
     std::_Exit(0);
   }).detach();

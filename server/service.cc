@@ -37,10 +37,12 @@ EngineLimits EngineLimitsWithMemory(const ServiceOptions& options) {
 // The answers for an id that does not exist, also given for another
 // tenant's id, so a caller cannot tell the two apart.
 absl::Status MapNotFound(const std::string& map_id) {
-  return absl::NotFoundError(absl::StrCat("unknown map_id ", map_id.substr(0, 80), "; PutMap it first"));
+  return absl::NotFoundError(
+      absl::StrCat("unknown map_id ", map_id.substr(0, 80), "; PutMap it first"));
 }
 absl::Status PlanNotFound(const std::string& plan_id) {
-  return absl::NotFoundError(absl::StrCat("unknown or expired plan_id '", plan_id.substr(0, 80), "'"));
+  return absl::NotFoundError(
+      absl::StrCat("unknown or expired plan_id '", plan_id.substr(0, 80), "'"));
 }
 
 // Status messages are bounded (they travel in trailing metadata, whose size
@@ -53,7 +55,8 @@ std::string BoundedMessage(absl::string_view message) {
 
 grpc::Status ToGrpc(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), BoundedMessage(status.message()));
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()),
+                      BoundedMessage(status.message()));
 }
 
 // A Plan stopped by its deadline before a first plan is overload
@@ -86,8 +89,10 @@ bool IsStop(const absl::Status& status) {
 // The status for work that stopped early: the client's cancellation wins,
 // otherwise the deadline was too short for even a first plan.
 absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
-                           const CallInfo& call, absl::Time started, absl::Duration max_request_time) {
-  if (cancel.cancelled()) return absl::CancelledError("call cancelled (by the client, or by the server's drain)");
+                           const CallInfo& call, absl::Time started,
+                           absl::Duration max_request_time) {
+  if (cancel.cancelled())
+    return absl::CancelledError("call cancelled (by the client, or by the server's drain)");
   // A call that spent a real share of its deadline waiting for a worker was
   // refused by overload, not by its own deadline: say so with the code a
   // client retries on (elsewhere).
@@ -97,14 +102,15 @@ absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
       return absl::ResourceExhaustedError(absl::StrFormat(
           "server busy: the call waited %d ms of its %d ms deadline for a worker and had no time "
           "left for a first plan; retry later or elsewhere",
-          absl::ToInt64Milliseconds(waited), absl::ToInt64Milliseconds(call.deadline - call.start)));
+          absl::ToInt64Milliseconds(waited),
+          absl::ToInt64Milliseconds(call.deadline - call.start)));
     }
   }
   if (call.deadline == absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
-    return absl::DeadlineExceededError(absl::StrFormat(
-        "no plan within the server's limit of %g s per call without a deadline "
-        "(--max_request_s) (%s); use a wider tool or a smaller map",
-        absl::ToDoubleSeconds(max_request_time), status.message()));
+    return absl::DeadlineExceededError(
+        absl::StrFormat("no plan within the server's limit of %g s per call without a deadline "
+                        "(--max_request_s) (%s); use a wider tool or a smaller map",
+                        absl::ToDoubleSeconds(max_request_time), status.message()));
   }
   if (absl::IsDeadlineExceeded(status) || call.deadline != absl::InfiniteFuture()) {
     return absl::DeadlineExceededError(
@@ -116,8 +122,8 @@ absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
 
 // A Plan reply's log summary, without the per-call decomposition_cached.
 std::string PlanDetail(const v1::PlanResponse& response) {
-  return absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s source=%s", response.plan_id(),
-                         response.planner(), response.stats().num_ranks(),
+  return absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s source=%s",
+                         response.plan_id(), response.planner(), response.stats().num_ranks(),
                          v1::TerminationReason_Name(response.termination().reason()),
                          v1::TerminationLimit_Name(response.termination().limit()),
                          v1::PlanSource_Name(response.stats().plan_source()));
@@ -137,7 +143,8 @@ class PlanReactor final : public grpc::ServerUnaryReactor {
 
 }  // namespace
 
-std::shared_ptr<const CoveragePlannerService::ServedBody> ServedBodyFor(const v1::PlanResponse& reply) {
+std::shared_ptr<const CoveragePlannerService::ServedBody> ServedBodyFor(
+    const v1::PlanResponse& reply) {
   // The per-call fields are cleared: proto3 does not write a zero, so a
   // zero in the call's appended stats would not override a stored value.
   v1::PlanResponse stored = reply;
@@ -166,8 +173,9 @@ absl::Status SerializePlanReply(const v1::PlanResponse& response,
   using Body = std::shared_ptr<const CoveragePlannerService::ServedBody>;
   const std::string& bytes = served->bytes;
   auto* keep = new Body(std::move(served));  // released with the slice
-  slices.insert(slices.begin(), grpc::Slice(const_cast<char*>(bytes.data()), bytes.size(),
-                                            [](void* p) { delete static_cast<Body*>(p); }, keep));
+  slices.insert(slices.begin(), grpc::Slice(
+                                    const_cast<char*>(bytes.data()), bytes.size(),
+                                    [](void* p) { delete static_cast<Body*>(p); }, keep));
   grpc::ByteBuffer whole(slices.data(), slices.size());
   out->Swap(&whole);
   return absl::OkStatus();
@@ -185,7 +193,8 @@ absl::Status ServiceOptions::Validate() const {
     return absl::InvalidArgumentError("max_request_time must be > 0");
   }
   if (max_sessions < 0) return absl::InvalidArgumentError("max_sessions must be >= 0");
-  if (session_idle <= absl::ZeroDuration()) return absl::InvalidArgumentError("session_idle must be > 0");
+  if (session_idle <= absl::ZeroDuration())
+    return absl::InvalidArgumentError("session_idle must be > 0");
   return absl::OkStatus();
 }
 
@@ -255,7 +264,8 @@ CallInfo CoveragePlannerService::StartCall(grpc::CallbackServerContext* context,
   if (tokens_ != nullptr) {
     auto it = metadata.find("authorization");
     const absl::string_view authorization =
-        it == metadata.end() ? absl::string_view() : absl::string_view(it->second.data(), it->second.size());
+        it == metadata.end() ? absl::string_view()
+                             : absl::string_view(it->second.data(), it->second.size());
     absl::StatusOr<std::string> tenant = tokens_->Authenticate(authorization);
     if (tenant.ok()) {
       call.tenant_tag = TenantTag(*tenant);
@@ -320,7 +330,8 @@ void CoveragePlannerService::CutShortInFlight() {
   drain_cut_.store(true);
   for (const auto& [id, token] : solves_) token.Cancel();
   if (!solves_.empty()) {
-    LogLine("warn", "drain grace over: cutting running solves short", {{"solves", absl::StrCat(solves_.size())}});
+    LogLine("warn", "drain grace over: cutting running solves short",
+            {{"solves", absl::StrCat(solves_.size())}});
   }
 }
 
@@ -328,15 +339,17 @@ bool CoveragePlannerService::SubmitIo(std::function<void()> work) {
   return io_pool_.TrySubmit(std::move(work));
 }
 
-absl::Status CoveragePlannerService::QueuedTooLong(const CallInfo& call, const StopToken& cancel) const {
+absl::Status CoveragePlannerService::QueuedTooLong(const CallInfo& call,
+                                                   const StopToken& cancel) const {
   // gRPC also cancels a call whose deadline passed: say which it was.
   const absl::Time now = absl::Now();
   if (now >= call.deadline) {
-    return absl::DeadlineExceededError(absl::StrFormat(
-        "deadline passed while the call waited %d ms for a worker; not started",
-        absl::ToInt64Milliseconds(now - call.start)));
+    return absl::DeadlineExceededError(
+        absl::StrFormat("deadline passed while the call waited %d ms for a worker; not started",
+                        absl::ToInt64Milliseconds(now - call.start)));
   }
-  if (cancel.cancelled()) return absl::CancelledError("call cancelled while it waited for a worker; not started");
+  if (cancel.cancelled())
+    return absl::CancelledError("call cancelled while it waited for a worker; not started");
   return absl::OkStatus();
 }
 
@@ -482,8 +495,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
   }
   if (request->page_size() < 0) {
     FinishCall(reactor, call,
-               absl::InvalidArgumentError(absl::StrCat("page_size must be >= 0 (got ",
-                                                       request->page_size(), ")")));
+               absl::InvalidArgumentError(
+                   absl::StrCat("page_size must be >= 0 (got ", request->page_size(), ")")));
     return reactor;
   }
   // The token is the last map_id of the previous page (ids are sorted).
@@ -494,8 +507,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ListMaps(grpc::CallbackServerC
                                                        "' is not a next_page_token of ListMaps")));
     return reactor;
   }
-  const int page_size = request->page_size() == 0 ? kDefaultPageSize
-                                                  : std::min(request->page_size(), kMaxPageSize);
+  const int page_size =
+      request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
   std::vector<std::string> corrupted;  // in-memory index only: cheap
   bool more = false;
   absl::StatusOr<std::vector<v1::MapInfo>> page =
@@ -579,7 +592,7 @@ grpc::ServerUnaryReactor* CoveragePlannerService::DeleteMap(grpc::CallbackServer
 // ---------------------------------------------------------------- plans
 
 MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
-                                           std::shared_ptr<const v1::Map> inline_map) {
+                                            std::shared_ptr<const v1::Map> inline_map) {
   MapSource source;
   source.map_id = map_id;
   source.load = [this, map_id, inline_map]() -> absl::StatusOr<SiteMap> {
@@ -590,8 +603,8 @@ MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
       if (!got.ok()) return got.status();
       stored = std::move(*got);
     }
-    ASSIGN_OR_RETURN(SiteMap site,
-                     SiteFromProto(inline_map != nullptr ? *inline_map : stored.map(), options_.limits));
+    ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(inline_map != nullptr ? *inline_map : stored.map(),
+                                                 options_.limits));
     RETURN_IF_ERROR(CheckSiteGeometry(site));
     return site;
   };
@@ -611,7 +624,8 @@ void CoveragePlannerService::WarmInBackground(const MapSource& source, PlanReque
              {"result", built.ok() ? "cached" : std::string(built.message())}});
   });
   if (!queued) {
-    LogLine("warn", "background artifacts dropped: queue full", {{"map", source.map_id.substr(0, 12)}});
+    LogLine("warn", "background artifacts dropped: queue full",
+            {{"map", source.map_id.substr(0, 12)}});
   }
 }
 
@@ -691,14 +705,16 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
       WarmInBackground(source, plan_request);
     }
     if (IsStop(result.status()) && drain_cut_.load()) {
-      return absl::UnavailableError("server shut down before a first plan was found; retry on another");
+      return absl::UnavailableError(
+          "server shut down before a first plan was found; retry on another");
     }
     return IsStop(result.status())
                ? StoppedStatus(result.status(), cancel, call, start, options_.max_request_time)
                : result.status();
   }
   if (result->answered_by != nullptr) {
-    if (std::shared_ptr<const ServedBody> reply = ServedHitReply(call.tenant_tag, result->answered_by)) {
+    if (std::shared_ptr<const ServedBody> reply =
+            ServedHitReply(call.tenant_tag, result->answered_by)) {
       *served = std::move(reply);
       response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
       response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
@@ -715,9 +731,8 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   retained->request.common.stop = StopToken();  // the call's token ends with the call
   RetainedPlanToProto(*retained, response);
   if (drain_cut_.load() && response->termination().limit() == v1::LIMIT_CANCELLED) {
-    response->mutable_termination()->set_detail(
-        absl::StrCat("cut short by the server's drain (shutting down); ",
-                     response->termination().detail()));
+    response->mutable_termination()->set_detail(absl::StrCat(
+        "cut short by the server's drain (shutting down); ", response->termination().detail()));
   }
   if (request.map_ref_case() == v1::PlanRequest::kMapId) PersistPlan(request, *response);
   RecordPlanSolve(start, retained->plan.stats);
@@ -731,8 +746,9 @@ absl::Status CoveragePlannerService::RunPlan(const CallInfo& call, const v1::Pla
   return absl::OkStatus();
 }
 
-bool CoveragePlannerService::ServeRecalledHit(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
-                                              const v1::PlanRequest& request, const StopToken& cancel,
+bool CoveragePlannerService::ServeRecalledHit(grpc::ServerUnaryReactor* reactor,
+                                              const CallInfo& call, const v1::PlanRequest& request,
+                                              const StopToken& cancel,
                                               grpc::ByteBuffer* response_bytes) {
   const absl::Time start = absl::Now();
   absl::StatusOr<PlanRequest> plan_request = EngineRequestFor(call, request, cancel, start);
@@ -753,11 +769,13 @@ bool CoveragePlannerService::ServeRecalledHit(grpc::ServerUnaryReactor* reactor,
   RecordPlanSolve(start, solve, /*queued=*/false);
   metrics_->hits_without_worker().Increment();
   const std::string detail = absl::StrCat(served->detail, " cached=1");
-  FinishCall(reactor, call, SerializePlanReply(response, std::move(served), response_bytes), detail);
+  FinishCall(reactor, call, SerializePlanReply(response, std::move(served), response_bytes),
+             detail);
   return true;
 }
 
-void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& stats, bool queued) {
+void CoveragePlannerService::RecordPlanSolve(absl::Time start, const PlanStats& stats,
+                                             bool queued) {
   const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
   metrics_->RecordSolve(solve_us * 1e-6, stats.tour_cut_short);
   metrics_->RecordPlanSource(PlanOriginName(stats.plan_source));
@@ -810,7 +828,8 @@ std::shared_ptr<const CoveragePlannerService::ServedBody> CoveragePlannerService
   return reply;
 }
 
-void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, const EngineResult& hit,
+void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag,
+                                               const EngineResult& hit,
                                                const v1::PlanResponse& reply) {
   ServedHit served;
   served.entry = hit.answered_by;
@@ -830,7 +849,8 @@ void CoveragePlannerService::RememberServedHit(const std::string& tenant_tag, co
   served_bytes_ += served.bytes;
   it->second = std::move(served);
   // Over a bound: drop the oldest keys (a key replaced in place keeps its place).
-  while ((served_.size() > kMaxServedHits || served_bytes_ > kMaxServedHitBytes) && !served_order_.empty()) {
+  while ((served_.size() > kMaxServedHits || served_bytes_ > kMaxServedHitBytes) &&
+         !served_order_.empty()) {
     auto old = served_.find(served_order_.front());
     served_order_.pop_front();
     if (old == served_.end()) continue;
@@ -873,7 +893,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   // was answered from memory is expected to be answered from memory again
   // (only requests by map id, which are small, are remembered).
   std::optional<uint64_t> hit_key;
-  if (request->map_ref_case() == v1::PlanRequest::kMapId && request_bytes->Length() <= kMaxHitRequestBytes) {
+  if (request->map_ref_case() == v1::PlanRequest::kMapId &&
+      request_bytes->Length() <= kMaxHitRequestBytes) {
     std::vector<grpc::Slice> slices;
     if (request_bytes->Dump(&slices).ok()) {
       std::string bytes = call.tenant_tag;
@@ -910,9 +931,9 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
   // than a DEADLINE_EXCEEDED after waiting.
   if (call.deadline != absl::InfiniteFuture()) {
     const int ahead = admitted_.load() - 1;
-    const absl::Duration wait =
-        ExpectedQueueWait(ahead, hits_ahead, options_.worker_threads,
-                          absl::Microseconds(mean_solve_us_.load()), absl::Microseconds(mean_hit_us_.load()));
+    const absl::Duration wait = ExpectedQueueWait(ahead, hits_ahead, options_.worker_threads,
+                                                  absl::Microseconds(mean_solve_us_.load()),
+                                                  absl::Microseconds(mean_hit_us_.load()));
     const absl::Time reply_by = call.deadline - options_.deadline_margin;
     if (ahead >= std::max(1, options_.worker_threads) && absl::Now() + wait >= reply_by) {
       release();
@@ -924,31 +945,32 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Plan(grpc::CallbackServerConte
       return reactor;
     }
   }
-  const bool queued = pool_.TrySubmit([this, reactor, call, request, response_bytes, release, hit_key] {
-    UpdateQueueGauges();
-    metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
-    const uint64_t solve = TrackSolve(reactor->cancel());
-    v1::PlanResponse response;
-    std::shared_ptr<const ServedBody> served;
-    absl::Status status = RunPlan(call, *request, reactor->cancel(), &response, &served);
-    UntrackSolve(solve);
-    metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
-    release();
-    if (status.ok() && hit_key.has_value()) {
-      // Remembered while it is answered from memory; forgotten once it is
-      // not (the plan or its map was evicted or deleted).
-      NoteHitRequest(*hit_key,
-                     served != nullptr || response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT);
-    }
-    std::string detail;
-    if (status.ok()) {
-      detail = absl::StrCat(served != nullptr ? served->detail : PlanDetail(response),
-                            " cached=", response.stats().decomposition_cached() ? 1 : 0);
-      status = SerializePlanReply(response, std::move(served), response_bytes);
-    }
-    FinishCall(reactor, call, status, detail);
-    MaybeTrimMemory(absl::Now() - call.start);
-  });
+  const bool queued =
+      pool_.TrySubmit([this, reactor, call, request, response_bytes, release, hit_key] {
+        UpdateQueueGauges();
+        metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
+        const uint64_t solve = TrackSolve(reactor->cancel());
+        v1::PlanResponse response;
+        std::shared_ptr<const ServedBody> served;
+        absl::Status status = RunPlan(call, *request, reactor->cancel(), &response, &served);
+        UntrackSolve(solve);
+        metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
+        release();
+        if (status.ok() && hit_key.has_value()) {
+          // Remembered while it is answered from memory; forgotten once it is
+          // not (the plan or its map was evicted or deleted).
+          NoteHitRequest(*hit_key, served != nullptr ||
+                                       response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT);
+        }
+        std::string detail;
+        if (status.ok()) {
+          detail = absl::StrCat(served != nullptr ? served->detail : PlanDetail(response),
+                                " cached=", response.stats().decomposition_cached() ? 1 : 0);
+          status = SerializePlanReply(response, std::move(served), response_bytes);
+        }
+        FinishCall(reactor, call, status, detail);
+        MaybeTrimMemory(absl::Now() - call.start);
+      });
   UpdateQueueGauges();
   if (!queued) {
     release();
@@ -984,7 +1006,8 @@ grpc::ServerUnaryReactor* CoveragePlannerService::GetPlan(grpc::CallbackServerCo
 
 // ---------------------------------------------------------------- replans
 
-void CoveragePlannerService::PersistPlan(const v1::PlanRequest& origin, const v1::PlanResponse& plan) {
+void CoveragePlannerService::PersistPlan(const v1::PlanRequest& origin,
+                                         const v1::PlanResponse& plan) {
   v1::InlinePlan record;
   *record.mutable_request() = origin;
   *record.mutable_plan() = plan;
@@ -1000,7 +1023,8 @@ void CoveragePlannerService::PersistPlan(const v1::PlanRequest& origin, const v1
   // pool after the answer is on its way.
   const bool queued = SubmitIo([this, bytes, plan_id] {
     if (absl::Status s = store_->PutPlan(plan_id, *bytes); !s.ok()) {
-      LogLine("warn", "plan not persisted", {{"plan", plan_id}, {"detail", std::string(s.message())}});
+      LogLine("warn", "plan not persisted",
+              {{"plan", plan_id}, {"detail", std::string(s.message())}});
       return;
     }
     if (persisted_.fetch_add(1) % 256 == 255) store_->TrimPlans(options_.max_stored_plans);
@@ -1040,15 +1064,19 @@ std::shared_ptr<const RetainedPlan> CoveragePlannerService::FindPlan(const std::
   return plan;
 }
 
-absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
-                                               const StopToken& cancel, v1::ReplanResponse* response) {
+absl::Status CoveragePlannerService::RunReplan(const CallInfo& call,
+                                               const v1::ReplanRequest& request,
+                                               const StopToken& cancel,
+                                               v1::ReplanResponse* response) {
   const absl::Time start = absl::Now();
   if (drain_cut_.load()) return absl::UnavailableError("server is shutting down; retry on another");
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
-  if (call.deadline != absl::InfiniteFuture() && call.deadline - options_.deadline_margin <= start) {
-    return absl::DeadlineExceededError(absl::StrFormat(
-        "deadline of %d ms left no time to replan (it waited %d ms for a worker)",
-        absl::ToInt64Milliseconds(call.deadline - call.start), absl::ToInt64Milliseconds(start - call.start)));
+  if (call.deadline != absl::InfiniteFuture() &&
+      call.deadline - options_.deadline_margin <= start) {
+    return absl::DeadlineExceededError(
+        absl::StrFormat("deadline of %d ms left no time to replan (it waited %d ms for a worker)",
+                        absl::ToInt64Milliseconds(call.deadline - call.start),
+                        absl::ToInt64Milliseconds(start - call.start)));
   }
   ASSIGN_OR_RETURN(RobotProgress progress, ProgressFromProto(request.progress()));
   ASSIGN_OR_RETURN(ReplanMethod method, ReplanMethodFromProto(request.method()));
@@ -1061,20 +1089,23 @@ absl::Status CoveragePlannerService::RunReplan(const CallInfo& call, const v1::R
                      ? cancel.WithEarlierDeadline(call.deadline - options_.deadline_margin)
                      : cancel.WithEarlierDeadline(start + options_.max_request_time);
   ResolvedPlan old;
-  RETURN_IF_ERROR(ResolvePlan(call.tenant_tag, request.plan_id(),
-                              request.plan_ref_case() == v1::ReplanRequest::kPlan ? &request.plan() : nullptr,
-                              options.stop, &old));
+  RETURN_IF_ERROR(
+      ResolvePlan(call.tenant_tag, request.plan_id(),
+                  request.plan_ref_case() == v1::ReplanRequest::kPlan ? &request.plan() : nullptr,
+                  options.stop, &old));
   ASSIGN_OR_RETURN(ReplanResult result,
-                   covplan::Replan(*old.plan, progress, ObstaclesFromProto(request.obstacles()), options,
-                                   &estimator_));
-  if (request.plan_ref_case() == v1::ReplanRequest::kPlanId) RecordProgress(request.plan_id(), request.progress());
+                   covplan::Replan(*old.plan, progress, ObstaclesFromProto(request.obstacles()),
+                                   options, &estimator_));
+  if (request.plan_ref_case() == v1::ReplanRequest::kPlanId)
+    RecordProgress(request.plan_id(), request.progress());
   KeepReplan(std::move(result), old, call.tenant_tag, response);
   return absl::OkStatus();
 }
 
-absl::Status CoveragePlannerService::ResolvePlan(const std::string& tenant_tag, const std::string& plan_id,
-                                                 const v1::InlinePlan* inline_plan, const StopToken& stop,
-                                                 ResolvedPlan* out) {
+absl::Status CoveragePlannerService::ResolvePlan(const std::string& tenant_tag,
+                                                 const std::string& plan_id,
+                                                 const v1::InlinePlan* inline_plan,
+                                                 const StopToken& stop, ResolvedPlan* out) {
   if (inline_plan == nullptr) {
     if (plan_id.empty()) return absl::InvalidArgumentError("needs plan_id or an inline plan");
     if (!OwnsPlan(tenant_tag, plan_id)) return PlanNotFound(plan_id);
@@ -1096,8 +1127,9 @@ absl::Status CoveragePlannerService::ResolvePlan(const std::string& tenant_tag, 
   } else {
     return absl::InvalidArgumentError("plan.request needs map_id or an inline map");
   }
-  ASSIGN_OR_RETURN(RetainedPlan rebuilt,
-                   RetainedPlanFromInline(*inline_plan, engine_, SourceFor(map_id, inline_map), stop));
+  ASSIGN_OR_RETURN(
+      RetainedPlan rebuilt,
+      RetainedPlanFromInline(*inline_plan, engine_, SourceFor(map_id, inline_map), stop));
   out->plan = std::make_shared<const RetainedPlan>(std::move(rebuilt));
   out->origin = pr;
   out->has_origin = pr.map_ref_case() == v1::PlanRequest::kMapId;
@@ -1105,7 +1137,8 @@ absl::Status CoveragePlannerService::ResolvePlan(const std::string& tenant_tag, 
 }
 
 void CoveragePlannerService::KeepReplan(ReplanResult result, const ResolvedPlan& old,
-                                        const std::string& tenant_tag, v1::ReplanResponse* response) {
+                                        const std::string& tenant_tag,
+                                        v1::ReplanResponse* response) {
   auto retained = std::make_shared<RetainedPlan>();
   retained->plan_id = NewPlanId(tenant_tag);
   retained->map_id = old.plan->map_id;
@@ -1134,7 +1167,8 @@ void CoveragePlannerService::KeepReplan(ReplanResult result, const ResolvedPlan&
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
-    grpc::CallbackServerContext* context, const char* method, const google::protobuf::Message* request,
+    grpc::CallbackServerContext* context, const char* method,
+    const google::protobuf::Message* request,
     std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work) {
   auto* reactor = new PlanReactor();
   CallInfo call = StartCall(context, method);
@@ -1176,16 +1210,17 @@ grpc::ServerUnaryReactor* CoveragePlannerService::ServeSolve(
 }
 
 std::string ReplanDetail(const v1::ReplanResponse& r) {
-  return absl::StrFormat("plan=%s method=%s encounters=%d detours=%d new_ranks=%d", r.plan().plan_id(),
-                         r.replan().method(), r.replan().num_encounters(), r.replan().greedy_detours_size(),
-                         r.replan().new_ranks());
+  return absl::StrFormat("plan=%s method=%s encounters=%d detours=%d new_ranks=%d",
+                         r.plan().plan_id(), r.replan().method(), r.replan().num_encounters(),
+                         r.replan().greedy_detours_size(), r.replan().new_ranks());
 }
 
 grpc::ServerUnaryReactor* CoveragePlannerService::Replan(grpc::CallbackServerContext* context,
                                                          const v1::ReplanRequest* request,
                                                          v1::ReplanResponse* response) {
   return ServeSolve(context, "Replan", request,
-                    [this, request, response](const CallInfo& call, const StopToken& cancel, std::string* detail) {
+                    [this, request, response](const CallInfo& call, const StopToken& cancel,
+                                              std::string* detail) {
                       absl::Status status = RunReplan(call, *request, cancel, response);
                       if (status.ok()) *detail = ReplanDetail(*response);
                       return status;
@@ -1196,24 +1231,31 @@ grpc::ServerUnaryReactor* CoveragePlannerService::Resume(grpc::CallbackServerCon
                                                          const v1::ResumeRequest* request,
                                                          v1::ReplanResponse* response) {
   return ServeSolve(context, "Resume", request,
-                    [this, request, response](const CallInfo& call, const StopToken& cancel, std::string* detail) {
+                    [this, request, response](const CallInfo& call, const StopToken& cancel,
+                                              std::string* detail) {
                       absl::Status status = RunResume(call, *request, cancel, response);
                       if (status.ok()) {
-                        *detail = absl::StrCat(ReplanDetail(*response), " from=", response->replan().progress_source());
+                        *detail = absl::StrCat(ReplanDetail(*response),
+                                               " from=", response->replan().progress_source());
                       }
                       return status;
                     });
 }
 
-absl::Status CoveragePlannerService::RunResume(const CallInfo& call, const v1::ResumeRequest& request,
-                                               const StopToken& cancel, v1::ReplanResponse* response) {
+absl::Status CoveragePlannerService::RunResume(const CallInfo& call,
+                                               const v1::ResumeRequest& request,
+                                               const StopToken& cancel,
+                                               v1::ReplanResponse* response) {
   const absl::Time start = absl::Now();
   if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
-  if (call.deadline != absl::InfiniteFuture() && call.deadline - options_.deadline_margin <= start) {
+  if (call.deadline != absl::InfiniteFuture() &&
+      call.deadline - options_.deadline_margin <= start) {
     return absl::DeadlineExceededError("the deadline left no time to resume");
   }
-  if (request.plan_id().empty()) return absl::InvalidArgumentError("plan_id: required (the interrupted plan)");
-  if (!request.has_pose()) return absl::InvalidArgumentError("pose: required (where the robot is now)");
+  if (request.plan_id().empty())
+    return absl::InvalidArgumentError("plan_id: required (the interrupted plan)");
+  if (!request.has_pose())
+    return absl::InvalidArgumentError("pose: required (where the robot is now)");
   const Pose2 pose{request.pose().x(), request.pose().y(), request.pose().theta()};
   ASSIGN_OR_RETURN(ReplanMethod method, ReplanMethodFromProto(request.method()));
   ReplanOptions options;
@@ -1238,17 +1280,17 @@ absl::Status CoveragePlannerService::RunResume(const CallInfo& call, const v1::R
   }
   ASSIGN_OR_RETURN(RobotProgress progress, ProgressFromProto(at));
   double rejoin_m = 0.0;
-  absl::StatusOr<ReplanResult> result = covplan::Resume(*old.plan, progress, pose,
-                                                        ObstaclesFromProto(request.obstacles()), options,
-                                                        &estimator_, &rejoin_m);
+  absl::StatusOr<ReplanResult> result =
+      covplan::Resume(*old.plan, progress, pose, ObstaclesFromProto(request.obstacles()), options,
+                      &estimator_, &rejoin_m);
   if (!result.ok()) {
     if (source == "request" || !absl::IsInvalidArgument(result.status()) ||
         absl::StartsWith(result.status().message(), "pose")) {
       return result.status();
     }
     return absl::InvalidArgumentError(
-        absl::StrCat("the progress recorded for this plan (", source, ") no longer fits it: ",
-                     result.status().message()));
+        absl::StrCat("the progress recorded for this plan (", source,
+                     ") no longer fits it: ", result.status().message()));
   }
   RecordProgress(request.plan_id(), at);
   KeepReplan(std::move(*result), old, call.tenant_tag, response);
@@ -1281,15 +1323,17 @@ grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* CoveragePlannerServic
     metrics_->RecordRequest("Drive", "UNAVAILABLE", 0.0);
     return new RefusedDrive(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
   }
-  auto* session =
-      new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id), call.tenant_tag);
+  auto* session = new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id),
+                                   call.tenant_tag);
   if (!sessions_.Add(session)) {
     session->Unref();
     metrics_->RecordRequest("Drive", "RESOURCE_EXHAUSTED", 0.0);
-    LogLine("warn", "drive session refused", {{"request_id", call.request_id}, {"detail", "too many sessions"}});
+    LogLine("warn", "drive session refused",
+            {{"request_id", call.request_id}, {"detail", "too many sessions"}});
     return new RefusedDrive(grpc::Status(
         grpc::StatusCode::RESOURCE_EXHAUSTED,
-        absl::StrFormat("too many drive sessions (%d open, --max_sessions); retry later", options_.max_sessions)));
+        absl::StrFormat("too many drive sessions (%d open, --max_sessions); retry later",
+                        options_.max_sessions)));
   }
   UpdateSessionGauge();
   LogLine("info", "drive session started", {{"request_id", call.request_id}});
@@ -1301,9 +1345,10 @@ absl::StatusOr<CoveragePlannerService::AdoptedPlan> CoveragePlannerService::Adop
     const v1::DriveRequest& first, const StopToken& stop, const std::string& tenant_tag) {
   const StopToken bounded = stop.WithEarlierDeadline(absl::Now() + options_.max_request_time);
   ResolvedPlan resolved;
-  RETURN_IF_ERROR(ResolvePlan(tenant_tag, first.plan_id(),
-                              first.plan_ref_case() == v1::DriveRequest::kPlan ? &first.plan() : nullptr, bounded,
-                              &resolved));
+  RETURN_IF_ERROR(
+      ResolvePlan(tenant_tag, first.plan_id(),
+                  first.plan_ref_case() == v1::DriveRequest::kPlan ? &first.plan() : nullptr,
+                  bounded, &resolved));
   AdoptedPlan out;
   out.grid = resolved.plan->plan.grid;
   if (first.plan_ref_case() == v1::DriveRequest::kPlanId) {
@@ -1335,7 +1380,8 @@ bool CoveragePlannerService::SubmitSolve(std::function<void()> work) {
   return queued;
 }
 
-void CoveragePlannerService::RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) {
+void CoveragePlannerService::RecordProgress(const std::string& plan_id,
+                                            const v1::RobotProgress& progress) {
   if (plan_id.empty() || plan_id.size() > 64) return;
   bool queue = false;
   {
@@ -1375,12 +1421,14 @@ void CoveragePlannerService::FlushProgress() {
   // the next task.
   for (const auto& [id, bytes] : writes) {
     if (absl::Status s = store_->PutProgress(id, bytes); !s.ok()) {
-      LogLine("warn", "progress not persisted", {{"plan", id}, {"detail", std::string(s.message())}});
+      LogLine("warn", "progress not persisted",
+              {{"plan", id}, {"detail", std::string(s.message())}});
     }
   }
 }
 
-std::optional<v1::RobotProgress> CoveragePlannerService::RecordedProgress(const std::string& plan_id) {
+std::optional<v1::RobotProgress> CoveragePlannerService::RecordedProgress(
+    const std::string& plan_id) {
   {
     absl::MutexLock lock(&progress_mu_);
     if (auto it = progress_.find(plan_id); it != progress_.end()) return it->second.second;

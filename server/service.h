@@ -41,8 +41,8 @@
 #include "absl/container/flat_hash_set.h"
 #include "absl/status/status.h"
 #include "absl/time/time.h"
-#include "covplan/v1/covplan.grpc.pb.h"
 #include "api/convert.h"
+#include "covplan/v1/covplan.grpc.pb.h"
 #include "planner/engine/engine.h"
 #include "planner/replan/replanner.h"
 #include "server/artifact_lru.h"
@@ -64,7 +64,7 @@ struct ServiceOptions {
   // Remember plans in that cache (planner/engine/plan_memory.h): identical
   // requests answered at once, new start poses warm-started.
   bool plan_memory = true;
-  double default_budget_s = 2.0;             // tour search budget without a deadline
+  double default_budget_s = 2.0;  // tour search budget without a deadline
   // Without a deadline, the whole call (artifacts included) stops after
   // this long with DEADLINE_EXCEEDED rather than holding a worker forever.
   absl::Duration max_request_time = absl::Seconds(120);
@@ -115,8 +115,8 @@ class CoveragePlannerService final
  public:
   // `tokens` (optional, outlives the service): every call must carry a
   // bearer token of a tenant, and sees only that tenant's maps and plans.
-  CoveragePlannerService(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics,
-                         const TenantTokens* tokens = nullptr);
+  CoveragePlannerService(const ServiceOptions& options, MapRepository* store,
+                         ServerMetrics* metrics, const TenantTokens* tokens = nullptr);
   ~CoveragePlannerService() override;
 
   grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
@@ -180,8 +180,9 @@ class CoveragePlannerService final
   // and puts only this call's stats into `response`: the reply is then the
   // bytes of `*served` followed by those of `response` (protobuf merges
   // concatenated messages).
-  absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request, const StopToken& cancel,
-                       v1::PlanResponse* response, std::shared_ptr<const ServedBody>* served);
+  absl::Status RunPlan(const CallInfo& call, const v1::PlanRequest& request,
+                       const StopToken& cancel, v1::PlanResponse* response,
+                       std::shared_ptr<const ServedBody>* served);
   // RunPlan's first steps. The engine request of a Plan call started at
   // `start`: its time budget is the request's limit (or the default),
   // capped by the call's deadline minus the reply margin.
@@ -209,8 +210,8 @@ class CoveragePlannerService final
   // Repeated cache hits (issue 12): the reply already sent for the
   // remembered `entry` to this tenant, if that plan is still retained; else
   // null. RememberServedHit records a reply for the next ones.
-  std::shared_ptr<const ServedBody> ServedHitReply(const std::string& tenant_tag,
-                                                   const std::shared_ptr<const RememberedPlan>& entry);
+  std::shared_ptr<const ServedBody> ServedHitReply(
+      const std::string& tenant_tag, const std::shared_ptr<const RememberedPlan>& entry);
   void RememberServedHit(const std::string& tenant_tag, const EngineResult& hit,
                          const v1::PlanResponse& reply);
   // The Replan work proper (runs on a worker).
@@ -276,13 +277,15 @@ class CoveragePlannerService final
     bool has_origin = false;  // on a stored map: its replans are persisted
   };
   absl::Status ResolvePlan(const std::string& tenant_tag, const std::string& plan_id,
-                           const v1::InlinePlan* inline_plan, const StopToken& stop, ResolvedPlan* out);
+                           const v1::InlinePlan* inline_plan, const StopToken& stop,
+                           ResolvedPlan* out);
   // Retains (and persists) a replan's result and fills the reply.
   void KeepReplan(ReplanResult result, const ResolvedPlan& old, const std::string& tenant_tag,
                   v1::ReplanResponse* response);
   // A unary solve (Replan, Resume): admission, the pool, the reply.
   grpc::ServerUnaryReactor* ServeSolve(
-      grpc::CallbackServerContext* context, const char* method, const google::protobuf::Message* request,
+      grpc::CallbackServerContext* context, const char* method,
+      const google::protobuf::Message* request,
       std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)> work);
   void FlushProgress();
 
@@ -348,12 +351,13 @@ class CoveragePlannerService final
   // the cold solve's time and partly refused.
   std::atomic<int64_t> mean_hit_us_{0};
   std::atomic<int> admitted_hits_{0};
-  static constexpr size_t kMaxHitRequests = 4096;     // then forgotten at once
+  static constexpr size_t kMaxHitRequests = 4096;      // then forgotten at once
   static constexpr size_t kMaxHitRequestBytes = 4096;  // larger requests are not keyed
   absl::flat_hash_set<uint64_t> hit_requests_ ABSL_GUARDED_BY(served_mu_);
   // Latest progress per plan (bounded), and those not yet written.
   absl::Mutex progress_mu_;
-  std::map<std::string, std::pair<uint64_t, v1::RobotProgress>> progress_ ABSL_GUARDED_BY(progress_mu_);
+  std::map<std::string, std::pair<uint64_t, v1::RobotProgress>> progress_
+      ABSL_GUARDED_BY(progress_mu_);
   std::set<std::string> progress_dirty_ ABSL_GUARDED_BY(progress_mu_);
   bool progress_flush_queued_ ABSL_GUARDED_BY(progress_mu_) = false;
   uint64_t progress_clock_ ABSL_GUARDED_BY(progress_mu_) = 0;
@@ -375,7 +379,8 @@ class CoveragePlannerService final
 // fields (planning_ms, decomposition_cached) cleared, so that the call's own
 // values, written after it by SerializePlanReply, win even when they are
 // zero or false; null if it cannot be serialised.
-std::shared_ptr<const CoveragePlannerService::ServedBody> ServedBodyFor(const v1::PlanResponse& reply);
+std::shared_ptr<const CoveragePlannerService::ServedBody> ServedBodyFor(
+    const v1::PlanResponse& reply);
 // A Plan reply's bytes: `response`'s, after those of `served` if set (a
 // repeated hit, whose stored bytes are shared with the slice, not copied).
 absl::Status SerializePlanReply(const v1::PlanResponse& response,

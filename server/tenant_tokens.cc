@@ -26,7 +26,8 @@ bool IsLowerHex(absl::string_view s) {
 bool IsTenantName(absl::string_view s) {
   if (s.empty() || s.size() > kMaxTenantName) return false;
   for (char c : s) {
-    if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') return false;
+    if (!absl::ascii_isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.')
+      return false;
   }
   return true;
 }
@@ -40,18 +41,20 @@ absl::StatusOr<std::map<std::string, std::string>> TenantTokens::Parse(absl::str
     ++line_number;
     line = absl::StripAsciiWhitespace(line);
     if (line.empty() || line[0] == '#') continue;
-    std::vector<absl::string_view> fields = absl::StrSplit(line, absl::ByAnyChar(" \t"), absl::SkipEmpty());
+    std::vector<absl::string_view> fields =
+        absl::StrSplit(line, absl::ByAnyChar(" \t"), absl::SkipEmpty());
     if (fields.size() != 2 || fields[0].size() != 64 || !IsLowerHex(fields[0])) {
       return absl::InvalidArgumentError(absl::StrCat(
           "line ", line_number, ": expected \"<sha256 of the token, 64 lowercase hex> <tenant>\""));
     }
     if (!IsTenantName(fields[1])) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "line ", line_number, ": tenant must be 1-64 characters of [A-Za-z0-9._-]"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("line ", line_number, ": tenant must be 1-64 characters of [A-Za-z0-9._-]"));
     }
     const std::string hash(fields[0]);
     if (table.count(hash) != 0) {
-      return absl::InvalidArgumentError(absl::StrCat("line ", line_number, ": the same token hash twice"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("line ", line_number, ": the same token hash twice"));
     }
     table.emplace(hash, std::string(fields[1]));
   }
@@ -69,10 +72,12 @@ absl::StatusOr<size_t> TenantTokens::Reload() {
   std::ifstream in(path_, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
-  if (!in) return absl::InvalidArgumentError(absl::StrCat("--token_file ", path_, ": cannot read it"));
+  if (!in)
+    return absl::InvalidArgumentError(absl::StrCat("--token_file ", path_, ": cannot read it"));
   absl::StatusOr<std::map<std::string, std::string>> table = Parse(text.str());
   if (!table.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("--token_file ", path_, ": ", table.status().message()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--token_file ", path_, ": ", table.status().message()));
   }
   absl::MutexLock lock(&mu_);
   tenant_by_hash_ = std::move(*table);
@@ -81,17 +86,20 @@ absl::StatusOr<size_t> TenantTokens::Reload() {
 
 absl::StatusOr<std::string> TenantTokens::Authenticate(absl::string_view authorization) const {
   if (authorization.empty()) {
-    return absl::UnauthenticatedError("missing credentials: send metadata \"authorization: Bearer <token>\"");
+    return absl::UnauthenticatedError(
+        "missing credentials: send metadata \"authorization: Bearer <token>\"");
   }
   constexpr absl::string_view kBearer = "Bearer ";
-  if (!absl::StartsWithIgnoreCase(authorization, kBearer) || authorization.size() > kMaxTokenBytes) {
+  if (!absl::StartsWithIgnoreCase(authorization, kBearer) ||
+      authorization.size() > kMaxTokenBytes) {
     return absl::UnauthenticatedError("authorization metadata is not \"Bearer <token>\"");
   }
   const absl::string_view token = absl::StripAsciiWhitespace(authorization.substr(kBearer.size()));
   const std::string hash = Sha256Hex(token);
   absl::MutexLock lock(&mu_);
   auto it = tenant_by_hash_.find(hash);
-  if (token.empty() || it == tenant_by_hash_.end()) return absl::UnauthenticatedError("invalid bearer token");
+  if (token.empty() || it == tenant_by_hash_.end())
+    return absl::UnauthenticatedError("invalid bearer token");
   return it->second;
 }
 
@@ -107,14 +115,18 @@ std::string TenantTag(absl::string_view tenant) {
 
 std::string ScopedMapId(const std::string& content_id, const std::string& tag) {
   if (tag.empty()) return content_id;
-  return Sha256Hex(absl::StrCat("covplan-tenant-map\n", tag, "\n", content_id)).substr(0, 64 - kTagHex) + tag;
+  return Sha256Hex(absl::StrCat("covplan-tenant-map\n", tag, "\n", content_id))
+             .substr(0, 64 - kTagHex) +
+         tag;
 }
 
 bool OwnsMap(const std::string& tag, absl::string_view map_id) {
   return tag.empty() || (map_id.size() == 64 && absl::EndsWith(map_id, tag));
 }
 
-std::string PlanIdSuffix(const std::string& tag) { return tag.empty() ? "" : absl::StrCat("-", tag); }
+std::string PlanIdSuffix(const std::string& tag) {
+  return tag.empty() ? "" : absl::StrCat("-", tag);
+}
 
 bool OwnsPlan(const std::string& tag, absl::string_view plan_id) {
   return tag.empty() || absl::EndsWith(plan_id, PlanIdSuffix(tag));

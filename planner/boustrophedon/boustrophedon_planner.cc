@@ -6,8 +6,8 @@
 
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
-#include "planner/common/status_macros.h"
 #include "planner/boustrophedon/cell_tour.h"
+#include "planner/common/status_macros.h"
 #include "planner/tour/polyline_tour.h"
 #include "planner/tour/tour_model.h"
 
@@ -39,9 +39,10 @@ std::string BoustrophedonOptions::CacheText() const {
 }
 
 size_t BoustrophedonDetail::MemoryBytes() const {
-  size_t bytes = sizeof(*this) + cell_order.capacity() * sizeof(int) + cell_reversed.capacity() / 8 +
-                 cell_mirrored.capacity() / 8;
-  for (const BoustrophedonCellInfo& c : cells) bytes += sizeof(c) + c.cell.columns.capacity() * sizeof(RowInterval);
+  size_t bytes = sizeof(*this) + cell_order.capacity() * sizeof(int) +
+                 cell_reversed.capacity() / 8 + cell_mirrored.capacity() / 8;
+  for (const BoustrophedonCellInfo& c : cells)
+    bytes += sizeof(c) + c.cell.columns.capacity() * sizeof(RowInterval);
   return bytes;
 }
 
@@ -52,7 +53,8 @@ std::shared_ptr<const PlannerOptions> BoustrophedonPlanner::DefaultOptions() con
 absl::Status BoustrophedonPlanner::CheckOptions(const PlannerOptions& options) const {
   const auto* o = dynamic_cast<const BoustrophedonOptions*>(&options);
   if (o == nullptr) {
-    return absl::InvalidArgumentError("planner 'boustrophedon' needs boustrophedon options (boustrophedon)");
+    return absl::InvalidArgumentError(
+        "planner 'boustrophedon' needs boustrophedon options (boustrophedon)");
   }
   return o->Validate();
 }
@@ -61,26 +63,30 @@ absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> BoustrophedonPlanne
     const PlanContext& ctx) const {
   const auto key = ctx.area_key.Derive<DecompositionArtifact>("bcd", "");
   bool hit = false;
-  ASSIGN_OR_RETURN(std::shared_ptr<const DecompositionArtifact> d,
-                   GetOrBuild(*ctx.cache, key, ctx.common->stop,
-                              [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> {
-                                const absl::Time t = absl::Now();
-                                auto out = std::make_shared<DecompositionArtifact>();
-                                out->decomposition =
-                                    std::make_shared<const BoustrophedonDecomposition>(Decompose(*ctx.area->cover));
-                                out->build_ms = MsSince(t);
-                                return std::shared_ptr<const DecompositionArtifact>(std::move(out));
-                              },
-                              &hit));
+  ASSIGN_OR_RETURN(
+      std::shared_ptr<const DecompositionArtifact> d,
+      GetOrBuild(
+          *ctx.cache, key, ctx.common->stop,
+          [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> {
+            const absl::Time t = absl::Now();
+            auto out = std::make_shared<DecompositionArtifact>();
+            out->decomposition =
+                std::make_shared<const BoustrophedonDecomposition>(Decompose(*ctx.area->cover));
+            out->build_ms = MsSince(t);
+            return std::shared_ptr<const DecompositionArtifact>(std::move(out));
+          },
+          &hit));
   if (!hit && ctx.all_cached != nullptr) *ctx.all_cached = false;
   const int64_t n = static_cast<int64_t>(d->decomposition->cells.size());
   if (n == 0) return absl::InvalidArgumentError("no cells to cover: the coverage area is empty");
   // Four entry corners per cell: the all-pairs transition table has 4n
   // endpoints and must fit the transition memory budget.
-  const int64_t table_bytes = TransitionTable::EstimateBytes(static_cast<int>(std::min<int64_t>(4 * n, 1 << 30)));
+  const int64_t table_bytes =
+      TransitionTable::EstimateBytes(static_cast<int>(std::min<int64_t>(4 * n, 1 << 30)));
   if (table_bytes > ctx.limits.max_transition_bytes) {
     return absl::ResourceExhaustedError(absl::StrFormat(
-        "the map decomposes into %d boustrophedon cells at tool width %g m: the transition table over "
+        "the map decomposes into %d boustrophedon cells at tool width %g m: the transition table "
+        "over "
         "their corners would take about %d MiB, above the transition memory budget of %d MiB "
         "(--max_transition_mb); use a wider tool or split the map",
         n, ctx.area->cover->cell_size(), table_bytes >> 20, ctx.limits.max_transition_bytes >> 20));
@@ -122,9 +128,9 @@ absl::StatusOr<CoveragePlan> BoustrophedonPlanner::Plan(const PlanContext& ctx) 
   }
   const std::optional<Pose2> end_pose = common.robot.end;
   const absl::Time t_model = absl::Now();
-  absl::StatusOr<CellTourModel> model =
-      CellTourModel::Create(drive, std::move(elements), start_pose, end_pose,
-                                std::make_shared<TravelTimeCost>(common.robot), common.stop, common.num_threads);
+  absl::StatusOr<CellTourModel> model = CellTourModel::Create(
+      drive, std::move(elements), start_pose, end_pose,
+      std::make_shared<TravelTimeCost>(common.robot), common.stop, common.num_threads);
   if (!model.ok()) {
     if (absl::IsFailedPrecondition(model.status())) {
       return absl::InternalError(absl::StrCat("boustrophedon: ", model.status().message()));

@@ -3,8 +3,8 @@
 // at connectivity changes (decomposition.h), an ox-plow path per cell with a
 // sweep axis chosen per cell (ox_plow.h), and the cells toured by the anytime
 // GTSP over CellTourModel elements (each cell entered at any of its four
-// corners: either end of the first or of the last line), priced by the robot's time model, transitions on the
-// drive grid. A cell is always swept whole, in one visit. Registered as
+// corners: either end of the first or of the last line), priced by the robot's time model,
+// transitions on the drive grid. A cell is always swept whole, in one visit. Registered as
 // "boustrophedon".
 //
 // Per-map artifact, derived from the request's CoverageArea key:
@@ -72,7 +72,8 @@ class BoustrophedonPlanner final : public Planner {
   absl::StatusOr<CoveragePlan> Plan(const PlanContext& ctx) const override;
 
  private:
-  absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> GetDecomposition(const PlanContext& ctx) const;
+  absl::StatusOr<std::shared_ptr<const DecompositionArtifact>> GetDecomposition(
+      const PlanContext& ctx) const;
 };
 
 }  // namespace covplan

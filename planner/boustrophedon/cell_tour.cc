@@ -30,7 +30,8 @@ std::vector<Point2> Directed(const PolylineElement& e, bool backwards) {
   return pts;
 }
 
-std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose, const std::vector<CellIndex>& cells) {
+std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose,
+                             const std::vector<CellIndex>& cells) {
   std::vector<Point2> pts = {{pose.x, pose.y}};
   for (const CellIndex& c : cells) pts.push_back(grid.CellCenter(c));
   return pts;
@@ -38,11 +39,10 @@ std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose, const std::vec
 
 }  // namespace
 
-absl::StatusOr<CellTourModel> CellTourModel::Create(const Grid& drive,
-                                                    std::vector<std::array<PolylineElement, 2>> cells,
-                                                    const Pose2& start, std::optional<Pose2> end,
-                                                    std::shared_ptr<const MotionCost> motion, const StopToken& stop,
-                                                    int num_threads) {
+absl::StatusOr<CellTourModel> CellTourModel::Create(
+    const Grid& drive, std::vector<std::array<PolylineElement, 2>> cells, const Pose2& start,
+    std::optional<Pose2> end, std::shared_ptr<const MotionCost> motion, const StopToken& stop,
+    int num_threads) {
   if (cells.empty()) return absl::InvalidArgumentError("no cells to tour");
   if (motion == nullptr) return absl::InvalidArgumentError("no motion cost");
   CellTourModel m;
@@ -54,8 +54,8 @@ absl::StatusOr<CellTourModel> CellTourModel::Create(const Grid& drive,
   std::vector<CellIndex> endpoints;
   for (size_t e = 0; e < cells.size(); ++e) {
     for (const PolylineElement& el : cells[e]) {
-      if (el.points.size() < 2 || el.kinds.size() + 1 != el.points.size() || el.sweeps.size() != el.kinds.size() ||
-          el.tags.size() != el.kinds.size()) {
+      if (el.points.size() < 2 || el.kinds.size() + 1 != el.points.size() ||
+          el.sweeps.size() != el.kinds.size() || el.tags.size() != el.kinds.size()) {
         return absl::InvalidArgumentError(absl::StrFormat("cell %d: malformed ox-plow path", e));
       }
       endpoints.push_back(el.first_cell);
@@ -76,7 +76,8 @@ absl::StatusOr<CellTourModel> CellTourModel::Create(const Grid& drive,
     const bool backwards = v % 2 == 1;
     const std::vector<Point2> pts = Directed(el, backwards);
     const std::vector<Point2> rev = Directed(el, !backwards);
-    const double axis = (el.first_cell.row == el.last_cell.row ? 0.0 : M_PI / 2) + (backwards ? M_PI : 0.0);
+    const double axis =
+        (el.first_cell.row == el.last_cell.row ? 0.0 : M_PI / 2) + (backwards ? M_PI : 0.0);
     m.heading_in_[v] = FirstHeading(pts, axis);
     m.heading_out_[v] = std::fmod(FirstHeading(rev, axis + M_PI) + M_PI, 2 * M_PI);
     m.traverse_[v] = m.motion_->Polyline(pts, m.heading_in_[v], std::nullopt);
@@ -86,17 +87,21 @@ absl::StatusOr<CellTourModel> CellTourModel::Create(const Grid& drive,
   absl::StatusOr<CellIndex> end_cell = JoinCell(drive, m.end_, "end");
   if (!end_cell.ok()) return end_cell.status();
   AnyAngleSearch search(drive);
-  if (!search.Run(*start_cell, stop)) return absl::DeadlineExceededError("stopped while routing from the start");
+  if (!search.Run(*start_cell, stop))
+    return absl::DeadlineExceededError("stopped while routing from the start");
   m.start_paths_.resize(n), m.from_start_.resize(n);
   for (int v = 0; v < n; ++v) {
     const CellIndex entry = m.table_->endpoint(v);
     if (!search.Reached(entry)) {
-      return absl::FailedPreconditionError(absl::StrFormat("cell %d cannot be reached from the start", v / 4));
+      return absl::FailedPreconditionError(
+          absl::StrFormat("cell %d cannot be reached from the start", v / 4));
     }
     m.start_paths_[v] = PosePath(drive, m.start_, search.PathTo(entry));
-    m.from_start_[v] = m.motion_->Polyline(m.start_paths_[v], m.start_.theta, m.heading_in_[v]) + m.traverse_[v];
+    m.from_start_[v] =
+        m.motion_->Polyline(m.start_paths_[v], m.start_.theta, m.heading_in_[v]) + m.traverse_[v];
   }
-  if (m.has_end_ && !search.Run(*end_cell, stop)) return absl::DeadlineExceededError("stopped while routing to the end");
+  if (m.has_end_ && !search.Run(*end_cell, stop))
+    return absl::DeadlineExceededError("stopped while routing to the end");
   m.end_paths_.resize(n), m.to_end_.resize(n);
   for (int u = 0; u < n; ++u) {
     const CellIndex exit = m.table_->endpoint(u ^ 1);

@@ -7,7 +7,8 @@
 // (travel time), as PolylineTourModel does for two-variant elements.
 //
 //   std::vector<std::array<PolylineElement, 2>> cells = ...;  // plain, mirrored
-//   ASSIGN_OR_RETURN(CellTourModel model, CellTourModel::Create(drive, std::move(cells), start, end,
+//   ASSIGN_OR_RETURN(CellTourModel model, CellTourModel::Create(drive, std::move(cells), start,
+//   end,
 //                                                               motion, stop, threads));
 //   ASSIGN_OR_RETURN(TourOrder order, GtspOrderer(opts).Order(model, stop));
 //   model.BuildPath(order.vertices, &path, &sweeps);
@@ -34,10 +35,11 @@ class CellTourModel final : public TourModel {
  public:
   // InvalidArgument for malformed elements or a start/end off the drive
   // grid; FailedPrecondition when a cell cannot be reached from the start.
-  static absl::StatusOr<CellTourModel> Create(const Grid& drive, std::vector<std::array<PolylineElement, 2>> cells,
+  static absl::StatusOr<CellTourModel> Create(const Grid& drive,
+                                              std::vector<std::array<PolylineElement, 2>> cells,
                                               const Pose2& start, std::optional<Pose2> end,
-                                              std::shared_ptr<const MotionCost> motion, const StopToken& stop,
-                                              int num_threads);
+                                              std::shared_ptr<const MotionCost> motion,
+                                              const StopToken& stop, int num_threads);
 
   int num_elements() const override { return static_cast<int>(cells_.size()); }
   int num_variants(int) const override { return 4; }

@@ -52,7 +52,8 @@ BoustrophedonDecomposition Decompose(const Grid& grid) {
     std::vector<int> cur_cell(cur.size(), -1);
     if (c > 0 && !prev.empty() && !cur.empty()) {
       // Degrees of the bipartite link graph between the two slices.
-      std::vector<int> right_degree(prev.size(), 0), left_degree(cur.size(), 0), left_of(cur.size(), -1);
+      std::vector<int> right_degree(prev.size(), 0), left_degree(cur.size(), 0),
+          left_of(cur.size(), -1);
       for (size_t i = 0; i < prev.size(); ++i) {
         for (size_t j = 0; j < cur.size(); ++j) {
           if (cur[j].lo > prev[i].hi) break;  // segments are sorted bottom to top
@@ -63,7 +64,8 @@ BoustrophedonDecomposition Decompose(const Grid& grid) {
         }
       }
       for (size_t j = 0; j < cur.size(); ++j) {
-        if (left_degree[j] == 1 && right_degree[left_of[j]] == 1) cur_cell[j] = prev_cell[left_of[j]];
+        if (left_degree[j] == 1 && right_degree[left_of[j]] == 1)
+          cur_cell[j] = prev_cell[left_of[j]];
       }
     }
     for (size_t j = 0; j < cur.size(); ++j) {

@@ -31,7 +31,8 @@ std::optional<SweepLines> BuildSweepLines(const Grid& grid, const BcdCell& cell,
     for (size_t k = 0; k < cell.columns.size(); ++k) {
       if (!cell.columns[k].Contains(r)) continue;
       const int c = cell.first_col + static_cast<int>(k);
-      if (!line.empty() && (line.back().col != c - 1 || !grid.Passable(r, c - 1, 0, 1))) return std::nullopt;
+      if (!line.empty() && (line.back().col != c - 1 || !grid.Passable(r, c - 1, 0, 1)))
+        return std::nullopt;
       line.push_back({r, c});
     }
     if (line.empty()) return std::nullopt;
@@ -50,7 +51,8 @@ std::optional<SweepLines> BuildSweepLines(const Grid& grid, const BcdCell& cell,
   return out;
 }
 
-SweepLines ChooseSweepLines(const Grid& grid, const BcdCell& cell, std::optional<SweepAxis> forced) {
+SweepLines ChooseSweepLines(const Grid& grid, const BcdCell& cell,
+                            std::optional<SweepAxis> forced) {
   std::optional<SweepLines> vertical = BuildSweepLines(grid, cell, SweepAxis::kVertical);
   std::optional<SweepLines> horizontal = BuildSweepLines(grid, cell, SweepAxis::kHorizontal);
   if (!horizontal.has_value()) return *vertical;
@@ -87,9 +89,12 @@ PolylineElement OxPlowElement(const Grid& grid, const SweepLines& sl, int tag, b
     CellIndex link = at;
     for (const CellIndex& x : sl.lines[k]) {
       const CellIndex y{x.row + step.row, x.col + step.col};
-      if (Along(sl.axis, y) < Along(sl.axis, next.front()) || Along(sl.axis, y) > Along(sl.axis, next.back())) continue;
+      if (Along(sl.axis, y) < Along(sl.axis, next.front()) ||
+          Along(sl.axis, y) > Along(sl.axis, next.back()))
+        continue;
       if (!grid.Passable(x.row, x.col, step.row, step.col)) continue;
-      const int d = std::abs(Along(sl.axis, at) - Along(sl.axis, x)) + std::abs(Along(sl.axis, x) - Along(sl.axis, s));
+      const int d = std::abs(Along(sl.axis, at) - Along(sl.axis, x)) +
+                    std::abs(Along(sl.axis, x) - Along(sl.axis, s));
       if (d < best) best = d, link = x;
     }
     move(link, SegmentKind::kTransition, {});

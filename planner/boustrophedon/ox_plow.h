@@ -41,7 +41,8 @@ SweepLines ChooseSweepLines(const Grid& grid, const BcdCell& cell, std::optional
 // The ox-plow polyline over `lines`: coverage segments (one per line) and
 // transition moves inside the cell, tagged `tag`. Forwards starts at the
 // first line's first cell, or its last cell when `mirrored`.
-PolylineElement OxPlowElement(const Grid& grid, const SweepLines& lines, int tag, bool mirrored = false);
+PolylineElement OxPlowElement(const Grid& grid, const SweepLines& lines, int tag,
+                              bool mirrored = false);
 
 }  // namespace covplan
 

@@ -11,7 +11,8 @@ namespace {
 
 absl::Status NonNegative(double v, const char* field) {
   if (!std::isfinite(v) || v < 0.0) {
-    return absl::InvalidArgumentError(absl::StrFormat("%s must be a finite value >= 0, got %g", field, v));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s must be a finite value >= 0, got %g", field, v));
   }
   return absl::OkStatus();
 }
@@ -26,7 +27,8 @@ absl::Status EnergyModel::Validate() const {
     if (!s.ok()) return s;
   }
   if (per_metre == 0.0 && per_turn == 0.0 && per_second == 0.0) {
-    return absl::InvalidArgumentError("battery.energy: every coefficient is 0; the path would cost nothing");
+    return absl::InvalidArgumentError(
+        "battery.energy: every coefficient is 0; the path would cost nothing");
   }
   return absl::OkStatus();
 }
@@ -41,13 +43,15 @@ absl::Status BatteryOptions::Validate() const {
         absl::StrFormat("battery.reserve must be a finite value >= 0, got %g", reserve));
   }
   if (reserve >= capacity) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "battery.reserve (%g) must be below battery.capacity (%g): nothing would be left to drive on",
-        reserve, capacity));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("battery.reserve (%g) must be below battery.capacity (%g): nothing would "
+                        "be left to drive on",
+                        reserve, capacity));
   }
   if (!atomic_units.empty() && !interruptible_units) {
     return absl::InvalidArgumentError(
-        "battery.atomic_units only makes sense with battery.interruptible_units (all units are atomic otherwise)");
+        "battery.atomic_units only makes sense with battery.interruptible_units (all units are "
+        "atomic otherwise)");
   }
   if (!std::isfinite(station.x) || !std::isfinite(station.y) || !std::isfinite(station.theta)) {
     return absl::InvalidArgumentError("battery.station must have finite x, y and theta");

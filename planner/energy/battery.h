@@ -16,7 +16,6 @@
 
 #include <cstddef>
 #include <vector>
-#include <vector>
 
 #include "absl/status/status.h"
 #include "planner/plan/coverage_plan.h"
@@ -25,9 +24,9 @@
 namespace covplan {
 
 struct EnergyModel {
-  double per_metre = 1.0;   // per metre driven
-  double per_turn = 0.0;    // per heading change (> 1e-6 rad), as PlanStats counts turns
-  double per_second = 0.0;  // per second of driving and turning (robot time model)
+  double per_metre = 1.0;         // per metre driven
+  double per_turn = 0.0;          // per heading change (> 1e-6 rad), as PlanStats counts turns
+  double per_second = 0.0;        // per second of driving and turning (robot time model)
   absl::Status Validate() const;  // names "battery.energy.*"
 };
 

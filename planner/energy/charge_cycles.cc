@@ -38,7 +38,8 @@ class StationLegs {
 
   absl::Status Run(const StopToken& stop) {
     ASSIGN_OR_RETURN(station_cell_, JoinCell(drive_, battery_.station, "battery.station"));
-    if (!search_.Run(station_cell_, stop)) return absl::DeadlineExceededError("stopped while routing from the station");
+    if (!search_.Run(station_cell_, stop))
+      return absl::DeadlineExceededError("stopped while routing from the station");
     return absl::OkStatus();
   }
   // Points station -> p; nullopt when p cannot be reached.
@@ -72,7 +73,8 @@ class StationLegs {
     std::reverse(pts.begin(), pts.end());
     std::vector<Waypoint> w;
     Append(pts, SegmentKind::kToStation, &w);
-    w.push_back({battery_.station.x, battery_.station.y, battery_.station.theta, SegmentKind::kToStation, -1});
+    w.push_back({battery_.station.x, battery_.station.y, battery_.station.theta,
+                 SegmentKind::kToStation, -1});
     return w;
   }
   Waypoint StationWaypoint(SegmentKind kind) const {
@@ -106,8 +108,8 @@ absl::Status CheckStation(const Grid& drive, const BatteryOptions& battery) {
   const Point2 hi{lo.x + drive.cols() * drive.cell_size(), lo.y + drive.rows() * drive.cell_size()};
   if (s.x < lo.x || s.y < lo.y || s.x > hi.x || s.y > hi.y) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "battery.station (%.3f, %.3f) lies outside the map (%.3f, %.3f)..(%.3f, %.3f)", s.x, s.y, lo.x, lo.y,
-        hi.x, hi.y));
+        "battery.station (%.3f, %.3f) lies outside the map (%.3f, %.3f)..(%.3f, %.3f)", s.x, s.y,
+        lo.x, lo.y, hi.x, hi.y));
   }
   const Point2 local{(s.x - lo.x) / drive.cell_size(), (s.y - lo.y) / drive.cell_size()};
   const CellIndex cell = drive.CellAt({s.x, s.y});
@@ -124,8 +126,8 @@ absl::Status CheckStation(const Grid& drive, const BatteryOptions& battery) {
 }
 
 absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, const Grid& drive,
-                                                   const BatteryOptions& battery, const RobotModel& robot,
-                                                   const StopToken& stop) {
+                                                   const BatteryOptions& battery,
+                                                   const RobotModel& robot, const StopToken& stop) {
   RETURN_IF_ERROR(battery.Validate());
   RETURN_IF_ERROR(CheckStation(drive, battery));
   const std::vector<Waypoint>& path = plan.path;
@@ -137,7 +139,8 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
   int prev_cov = -1;
   for (int i = 1; i < static_cast<int>(path.size()); ++i) {
     if (path[i].kind != SegmentKind::kCoverage) continue;
-    const bool same_unit = prev_cov >= 0 && path[i].rank >= 0 && path[prev_cov].rank == path[i].rank;
+    const bool same_unit =
+        prev_cov >= 0 && path[i].rank >= 0 && path[prev_cov].rank == path[i].rank;
     if (!same_unit) {
       unit_tag.push_back(path[i].rank);
       pieces.push_back({i - 1, i, static_cast<int>(unit_tag.size()) - 1, 0});
@@ -157,21 +160,25 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
   auto unit_name = [&](int k) {
     const Piece& p = pieces[k];
     const std::string unit = absl::StrFormat("%s %d", UnitWord(plan.planner), unit_tag[p.unit]);
-    return battery.IsAtomic(unit_tag[p.unit]) ? unit : absl::StrFormat("line %d of %s", p.line, unit);
+    return battery.IsAtomic(unit_tag[p.unit]) ? unit
+                                              : absl::StrFormat("line %d of %s", p.line, unit);
   };
   // seg + turn energy of the segment ending at waypoint t, after t - 1.
-  auto step = [&](int t) { return SegmentEnergy(path[t - 1].theta, path[t - 1], path[t], model, robot); };
+  auto step = [&](int t) {
+    return SegmentEnergy(path[t - 1].theta, path[t - 1], path[t], model, robot);
+  };
   SplitProblem sp;
   sp.out.resize(n), sp.work.resize(n), sp.back.resize(n), sp.link.resize(n > 0 ? n - 1 : 0);
   for (int k = 0; k < n; ++k) {
-    if (k % 64 == 0 && stop.ShouldStop()) return absl::DeadlineExceededError("stopped while pricing charge cycles");
+    if (k % 64 == 0 && stop.ShouldStop())
+      return absl::DeadlineExceededError("stopped while pricing charge cycles");
     const Piece& p = pieces[k];
     const Point2 pa{path[p.a].x, path[p.a].y}, pz{path[p.z].x, path[p.z].y};
     std::optional<std::vector<Point2>> to_a = legs.Points(pa), to_z = legs.Points(pz);
     if (!to_a || !to_z) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "battery.station (%.3f, %.3f) cannot reach %s on the drive grid", battery.station.x, battery.station.y,
-          unit_name(k)));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("battery.station (%.3f, %.3f) cannot reach %s on the drive grid",
+                          battery.station.x, battery.station.y, unit_name(k)));
     }
     const std::vector<Waypoint> out = legs.Out(*to_a);
     const Waypoint& arrive = out.empty() ? station : out.back();
@@ -189,15 +196,17 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
     }
     const double solo = CycleEnergy(sp, k, k);
     if (solo > battery.budget()) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "battery: %s needs %.6g to reach from the station, cover and return, above capacity - reserve = %.6g",
-          unit_name(k), solo, battery.budget()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("battery: %s needs %.6g to reach from the station, cover and return, "
+                          "above capacity - reserve = %.6g",
+                          unit_name(k), solo, battery.budget()));
     }
   }
   // Piece k's first segment is priced in out[k] (after a charge) or in
   // link[k - 1] (along the tour); work[k] starts after it.
   absl::StatusOr<SplitResult> split = SplitTour(sp, battery.budget());
-  if (!split.ok()) return absl::InternalError(absl::StrCat("battery split: ", split.status().message()));
+  if (!split.ok())
+    return absl::InternalError(absl::StrCat("battery split: ", split.status().message()));
 
   CoveragePlan out = plan;
   out.path.clear();
@@ -211,7 +220,8 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
     cycle.first_waypoint = static_cast<int>(out.path.size()) - 1;
     const Piece& first = pieces[i];
     const Piece& last = pieces[j];
-    for (const Waypoint& w : legs.Out(*legs.Points({path[first.a].x, path[first.a].y}))) out.path.push_back(w);
+    for (const Waypoint& w : legs.Out(*legs.Points({path[first.a].x, path[first.a].y})))
+      out.path.push_back(w);
     cycle.resume_waypoint = static_cast<int>(out.path.size()) - 1;
     cycle.resume_unit = unit_tag[first.unit];
     cycle.resumes_mid_unit = i > 0 && pieces[i - 1].unit == first.unit;
@@ -220,10 +230,12 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
       out.path.push_back(path[t]);
     }
     cycle.leave_waypoint = static_cast<int>(out.path.size()) - 1;
-    for (const Waypoint& w : legs.Back(*legs.Points({path[last.z].x, path[last.z].y}))) out.path.push_back(w);
+    for (const Waypoint& w : legs.Back(*legs.Points({path[last.z].x, path[last.z].y})))
+      out.path.push_back(w);
     cycle.last_waypoint = static_cast<int>(out.path.size()) - 1;
     cycle.energy = PathEnergy(out.path, cycle.first_waypoint, cycle.last_waypoint, model, robot);
-    cycle.energy_at_leave = PathEnergy(out.path, cycle.first_waypoint, cycle.leave_waypoint, model, robot);
+    cycle.energy_at_leave =
+        PathEnergy(out.path, cycle.first_waypoint, cycle.leave_waypoint, model, robot);
     if (cycle.energy > battery.budget() * (1 + 1e-9) + 1e-9 ||
         std::abs(cycle.energy - split->energy[c]) > 1e-6 * std::max(1.0, cycle.energy)) {
       return absl::InternalError(absl::StrFormat("battery split: cycle %d priced %g, drives %g", c,
@@ -232,7 +244,8 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
     out.cycles.push_back(cycle);
   }
   for (const CoverageSweep& s : plan.sweeps) {
-    if (new_index[s.waypoint] < 0) return absl::InternalError("battery split dropped a coverage segment");
+    if (new_index[s.waypoint] < 0)
+      return absl::InternalError("battery split dropped a coverage segment");
     out.sweeps.push_back({new_index[s.waypoint], s.cells});
   }
   PlanStats& st = out.stats;
@@ -251,10 +264,12 @@ absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, con
   std::sort(delta.begin(), delta.end());
   double floor_energy = st.energy_unconstrained;
   size_t negative = 0;
-  for (; negative < delta.size() && delta[negative] < 0; ++negative) floor_energy += delta[negative];
+  for (; negative < delta.size() && delta[negative] < 0; ++negative)
+    floor_energy += delta[negative];
   const double visits = std::max(0.0, std::ceil(floor_energy / battery.budget() - 1e-12) - 1);
   double bound = floor_energy;
-  for (size_t k = negative; k < delta.size() && static_cast<double>(k) < visits; ++k) bound += delta[k];
+  for (size_t k = negative; k < delta.size() && static_cast<double>(k) < visits; ++k)
+    bound += delta[k];
   st.energy_lower_bound = bound;
   return out;
 }

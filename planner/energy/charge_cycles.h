@@ -9,8 +9,8 @@
 // cycle starts and ends at the station, with kFromStation / kToStation legs
 // driven as any-angle paths on the drive grid.
 //
-//   ASSIGN_OR_RETURN(CoveragePlan split, SplitIntoChargeCycles(plan, *area.drive, battery, robot, stop));
-//   for (const ChargeCycle& c : split.cycles) { split.path[c.leave_waypoint] ... }
+//   ASSIGN_OR_RETURN(CoveragePlan split, SplitIntoChargeCycles(plan, *area.drive, battery, robot,
+//   stop)); for (const ChargeCycle& c : split.cycles) { split.path[c.leave_waypoint] ... }
 //
 // stats.energy_lower_bound bounds every split of this tour order from below:
 // E_u is the unconstrained energy of the tour from the station and back, and
@@ -40,8 +40,8 @@ namespace covplan {
 // budget() (the message names the unit and the energy it needs).
 absl::Status CheckStation(const Grid& drive, const BatteryOptions& battery);
 absl::StatusOr<CoveragePlan> SplitIntoChargeCycles(const CoveragePlan& plan, const Grid& drive,
-                                                   const BatteryOptions& battery, const RobotModel& robot,
-                                                   const StopToken& stop);
+                                                   const BatteryOptions& battery,
+                                                   const RobotModel& robot, const StopToken& stop);
 
 }  // namespace covplan
 

@@ -23,11 +23,13 @@ absl::StatusOr<SplitResult> SplitTour(const SplitProblem& p, double budget) {
   if (static_cast<int>(p.out.size()) != n || static_cast<int>(p.back.size()) != n ||
       static_cast<int>(p.link.size()) != n - 1 ||
       (!p.break_after.empty() && static_cast<int>(p.break_after.size()) != n)) {
-    return absl::InvalidArgumentError("split problem: out, back, link and break_after sizes disagree");
+    return absl::InvalidArgumentError(
+        "split problem: out, back, link and break_after sizes disagree");
   }
   for (const std::vector<double>* v : {&p.out, &p.work, &p.link, &p.back}) {
     for (double x : *v) {
-      if (!std::isfinite(x) || x < 0.0) return absl::InvalidArgumentError("split problem: energies must be finite and >= 0");
+      if (!std::isfinite(x) || x < 0.0)
+        return absl::InvalidArgumentError("split problem: energies must be finite and >= 0");
     }
   }
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -58,7 +60,8 @@ absl::StatusOr<SplitResult> SplitTour(const SplitProblem& p, double budget) {
       if (best[b] < kInf) first_unreached = b;
     }
     return absl::FailedPreconditionError(absl::StrFormat(
-        "no split into charge cycles of at most %g exists: piece %d cannot be reached", budget, first_unreached));
+        "no split into charge cycles of at most %g exists: piece %d cannot be reached", budget,
+        first_unreached));
   }
   SplitResult r;
   r.total = best[n];

@@ -12,7 +12,8 @@
 //   ArtifactKey<GridArtifact> key = ArtifactKey<GridArtifact>::Root(map_id, "grid", "cell=0.8");
 //   bool hit = false;
 //   ASSIGN_OR_RETURN(std::shared_ptr<const GridArtifact> g,
-//                    GetOrBuild(cache, key, stop, [&](const StopToken& s) { return Build(s); }, &hit));
+//                    GetOrBuild(cache, key, stop, [&](const StopToken& s) { return Build(s); },
+//                    &hit));
 //
 // Thread-safety: implementations must be thread-safe (say so in their
 // comments); artifacts are immutable.
@@ -43,7 +44,8 @@ class Artifact {
 template <typename T>
 class ArtifactKey {
  public:
-  static ArtifactKey Root(const std::string& map_id, const std::string& kind, const std::string& params) {
+  static ArtifactKey Root(const std::string& map_id, const std::string& kind,
+                          const std::string& params) {
     return ArtifactKey(absl::StrCat(map_id, "/", kind, "(", params, ")"));
   }
   template <typename U>
@@ -94,7 +96,8 @@ absl::StatusOr<std::shared_ptr<const T>> GetOrBuild(ArtifactCache& cache, const 
   if (!value.ok()) return value.status();
   std::shared_ptr<const T> typed = std::dynamic_pointer_cast<const T>(*value);
   if (typed == nullptr) {
-    return absl::InternalError(absl::StrCat("artifact cache: key ", key.text(), " holds another type"));
+    return absl::InternalError(
+        absl::StrCat("artifact cache: key ", key.text(), " holds another type"));
   }
   return typed;
 }

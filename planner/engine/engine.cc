@@ -17,12 +17,13 @@ namespace covplan {
 namespace {
 
 // InvalidArgument when a zone polygon's outer ring misses the map entirely.
-absl::Status CheckInsideMap(const std::vector<PolygonInput>& polygons, const char* field,
-                            Point2 lo, Point2 hi) {
+absl::Status CheckInsideMap(const std::vector<PolygonInput>& polygons, const char* field, Point2 lo,
+                            Point2 hi) {
   for (size_t i = 0; i < polygons.size(); ++i) {
     double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
     for (const Point2& p : polygons[i].outer) {
-      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x),
+      y1 = std::max(y1, p.y);
     }
     if (x1 <= lo.x || y1 <= lo.y || x0 >= hi.x || y0 >= hi.y) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -79,9 +80,9 @@ absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanReque
   Resolved r;
   r.planner = registry_->Find(request.planner);
   if (r.planner == nullptr) {
-    return absl::InvalidArgumentError(absl::StrFormat("planner: unknown planner '%s'; registered: %s",
-                                                      request.planner,
-                                                      absl::StrJoin(registry_->Names(), ", ")));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("planner: unknown planner '%s'; registered: %s", request.planner,
+                        absl::StrJoin(registry_->Names(), ", ")));
   }
   RETURN_IF_ERROR(request.common.Validate());
   if (request.battery.has_value()) RETURN_IF_ERROR(request.battery->Validate());
@@ -99,22 +100,23 @@ absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanReque
     for (auto [pose, name] : {std::pair{&request.common.robot.start, "robot.start"},
                               std::pair{&request.common.robot.end, "robot.end"}}) {
       if (pose->has_value() && r.zones.no_go->Contains({(*pose)->x, (*pose)->y})) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "%s (%.3f, %.3f) lies in a no-go zone", name, (*pose)->x, (*pose)->y));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s (%.3f, %.3f) lies in a no-go zone", name, (*pose)->x, (*pose)->y));
       }
     }
     if (request.battery.has_value() &&
         r.zones.no_go->Contains({request.battery->station.x, request.battery->station.y})) {
-      return absl::InvalidArgumentError(absl::StrFormat("battery.station (%.3f, %.3f) lies in a no-go zone",
-                                                        request.battery->station.x, request.battery->station.y));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("battery.station (%.3f, %.3f) lies in a no-go zone",
+                          request.battery->station.x, request.battery->station.y));
     }
   }
   return r;
 }
 
 absl::StatusOr<bool> PlanningEngine::Setup(const MapSource& source, const PlanRequest& request,
-                                           const Resolved& resolved, ArtifactUse use, PlanContext* ctx,
-                                           bool* all_cached) const {
+                                           const Resolved& resolved, ArtifactUse use,
+                                           PlanContext* ctx, bool* all_cached) const {
   const CommonOptions& common = request.common;
   GridOptions grid_options;
   grid_options.cell_size = common.robot.tool_width_m;
@@ -122,21 +124,23 @@ absl::StatusOr<bool> PlanningEngine::Setup(const MapSource& source, const PlanRe
   grid_options.max_cells = limits_.max_grid_cells;
   const auto grid_key = ArtifactKey<GridArtifact>::Root(
       source.map_id, "grid",
-      absl::StrFormat("cell=%.9g;minfree=%.9g", grid_options.cell_size, grid_options.min_free_fraction));
+      absl::StrFormat("cell=%.9g;minfree=%.9g", grid_options.cell_size,
+                      grid_options.min_free_fraction));
   bool hit = false;
   std::shared_ptr<const GridArtifact> grid;
   if (use == ArtifactUse::kCachedOnly) {
     grid = std::dynamic_pointer_cast<const GridArtifact>(cache_->Find(grid_key.text()));
     if (grid == nullptr) return false;
   } else {
-    ASSIGN_OR_RETURN(grid,
-                     GetOrBuild(*cache_, grid_key, common.stop,
-                                [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const GridArtifact>> {
-                                  if (!source.load) return absl::InternalError("map source without loader");
-                                  ASSIGN_OR_RETURN(SiteMap site, source.load());
-                                  return BuildGridArtifact(site, grid_options);
-                                },
-                                &hit));
+    ASSIGN_OR_RETURN(
+        grid, GetOrBuild(
+                  *cache_, grid_key, common.stop,
+                  [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const GridArtifact>> {
+                    if (!source.load) return absl::InternalError("map source without loader");
+                    ASSIGN_OR_RETURN(SiteMap site, source.load());
+                    return BuildGridArtifact(site, grid_options);
+                  },
+                  &hit));
     *all_cached = *all_cached && hit;
   }
   const Grid& g = *grid->grid;
@@ -150,11 +154,13 @@ absl::StatusOr<bool> PlanningEngine::Setup(const MapSource& source, const PlanRe
     area = std::dynamic_pointer_cast<const CoverageArea>(cache_->Find(area_key.text()));
     if (area == nullptr) return false;
   } else {
-    ASSIGN_OR_RETURN(area, GetOrBuild(*cache_, area_key, common.stop,
-                                      [&](const StopToken&) {
-                                        return BuildCoverageArea(*grid, resolved.zones, common.min_free_fraction);
-                                      },
-                                      &hit));
+    ASSIGN_OR_RETURN(area, GetOrBuild(
+                               *cache_, area_key, common.stop,
+                               [&](const StopToken&) {
+                                 return BuildCoverageArea(*grid, resolved.zones,
+                                                          common.min_free_fraction);
+                               },
+                               &hit));
     *all_cached = *all_cached && hit;
   }
   ctx->common = &request.common;
@@ -171,7 +177,8 @@ absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest&
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
   PlanContext ctx;
   bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
+  RETURN_IF_ERROR(
+      Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
   return resolved.planner->Prepare(ctx);
 }
 
@@ -180,12 +187,14 @@ absl::StatusOr<std::shared_ptr<const CoverageArea>> PlanningEngine::AreaFor(
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
   PlanContext ctx;
   bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
+  RETURN_IF_ERROR(
+      Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
   return ctx.area;
 }
 
 absl::Status PlanningEngine::Finish(const PlanRequest& request, const Resolved& resolved,
-                                    const CoverageArea& area, bool all_cached, CoveragePlan* plan) const {
+                                    const CoverageArea& area, bool all_cached,
+                                    CoveragePlan* plan) const {
   // The engine's own check: no segment may enter a no-go zone's interior.
   if (resolved.zones.has_no_go()) {
     for (size_t i = 1; i < plan->path.size(); ++i) {
@@ -194,18 +203,20 @@ absl::Status PlanningEngine::Finish(const PlanRequest& request, const Resolved& 
       if (resolved.zones.no_go->SegmentLengthInInterior({a.x, a.y}, {b.x, b.y}) <= 1e-9) continue;
       const bool from_start = i <= 2 && request.common.robot.start.has_value();
       const bool to_end = i + 2 >= plan->path.size() && request.common.robot.end.has_value();
-      const bool station_leg = request.battery.has_value() &&
-                               (b.kind == SegmentKind::kToStation || b.kind == SegmentKind::kFromStation);
+      const bool station_leg = request.battery.has_value() && (b.kind == SegmentKind::kToStation ||
+                                                               b.kind == SegmentKind::kFromStation);
       if (station_leg) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "battery.station: the move between (%.3f, %.3f) and (%.3f, %.3f) near the station would "
-            "cross a no-go zone; move the station away from the zone",
-            a.x, a.y, b.x, b.y));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("battery.station: the move between (%.3f, %.3f) and (%.3f, %.3f) near "
+                            "the station would "
+                            "cross a no-go zone; move the station away from the zone",
+                            a.x, a.y, b.x, b.y));
       }
       if (from_start || to_end) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "%s: the move between (%.3f, %.3f) and the grid at (%.3f, %.3f) would cross a no-go zone",
-            from_start ? "robot.start" : "robot.end", a.x, a.y, b.x, b.y));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("%s: the move between (%.3f, %.3f) and the grid at (%.3f, %.3f) would "
+                            "cross a no-go zone",
+                            from_start ? "robot.start" : "robot.end", a.x, a.y, b.x, b.y));
       }
       return absl::InternalError(absl::StrFormat(
           "planner '%s' produced a segment through a no-go zone at (%.3f, %.3f)-(%.3f, %.3f)",
@@ -267,8 +278,8 @@ bool AnswersAtOnce(const RememberedPlan* remembered, const PlanRequest& request)
 
 PlanMemoryKeys PlanningEngine::MemoryKeys(const PlanRequest& request, const Resolved& resolved,
                                           const PlanContext& ctx) const {
-  return PlanMemoryKeysFor(ctx.area_key, resolved.planner->name(), *resolved.options, request.common,
-                           request.battery);
+  return PlanMemoryKeysFor(ctx.area_key, resolved.planner->name(), *resolved.options,
+                           request.common, request.battery);
 }
 
 absl::StatusOr<std::optional<Recalled>> PlanningEngine::Recall(const MapSource& source,
@@ -282,11 +293,13 @@ absl::StatusOr<std::optional<Recalled>> PlanningEngine::Recall(const MapSource& 
   ASSIGN_OR_RETURN(const bool cached,
                    Setup(source, request, resolved, ArtifactUse::kCachedOnly, &ctx, &all_cached));
   if (!cached) return std::nullopt;
-  if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
+  if (request.battery.has_value())
+    RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
   std::shared_ptr<const RememberedPlan> entry =
       FindRemembered<RememberedPlan>(*cache_, MemoryKeys(request, resolved, ctx).exact);
   if (!AnswersAtOnce(entry.get(), request)) return std::nullopt;
-  return Recalled{std::move(entry), std::move(ctx.area), absl::ToDoubleMilliseconds(absl::Now() - t0)};
+  return Recalled{std::move(entry), std::move(ctx.area),
+                  absl::ToDoubleMilliseconds(absl::Now() - t0)};
 }
 
 absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
@@ -296,8 +309,10 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   PlanRequest request = WithStationPoses(original);
   PlanContext ctx;
   bool all_cached = true;
-  RETURN_IF_ERROR(Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
-  if (request.battery.has_value()) RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
+  RETURN_IF_ERROR(
+      Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
+  if (request.battery.has_value())
+    RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
 
   // Remembered plans (plan_memory.h).
   std::optional<PlanMemoryKeys> keys;
@@ -327,9 +342,11 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
         ctx.warm_trials = OrdererOptions::kEffortTrials;  // all warm
       }
       // Each further improvement run searches with seeds of its own.
-      request.common.seed += 0x9E3779B97F4A7C15ull * static_cast<uint64_t>(remembered->generation + 1);
+      request.common.seed +=
+          0x9E3779B97F4A7C15ull * static_cast<uint64_t>(remembered->generation + 1);
       plan_source = PlanOrigin::kImproved;
-    } else if (warm && (remembered_tour = FindRemembered<RememberedTour>(*cache_, keys->tour)) != nullptr) {
+    } else if (warm &&
+               (remembered_tour = FindRemembered<RememberedTour>(*cache_, keys->tour)) != nullptr) {
       ctx.warm_tour = &remembered_tour->vertices;
       ctx.warm_trials = kWarmStartTrials;
       plan_source = PlanOrigin::kWarmStart;
@@ -342,9 +359,10 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   plan.planner = std::string(resolved.planner->name());
   if (request.battery.has_value()) {
     const absl::Time t = absl::Now();
-    ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *area.drive, *request.battery, request.common.robot,
-                                                 request.common.stop));
-    plan.stats.tour_ms += absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
+    ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *area.drive, *request.battery,
+                                                 request.common.robot, request.common.stop));
+    plan.stats.tour_ms +=
+        absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
   }
   RETURN_IF_ERROR(Finish(request, resolved, area, all_cached, &plan));
   plan.stats.plan_source = plan_source;

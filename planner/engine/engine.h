@@ -29,10 +29,10 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "planner/energy/battery.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/engine/planner.h"
 #include "planner/engine/site.h"
-#include "planner/energy/battery.h"
 #include "planner/geometry/area.h"
 #include "planner/plan/coverage_plan.h"
 
@@ -122,7 +122,8 @@ class PlanningEngine {
   // this time limit. A request Plan would refuse is refused alike (or, when
   // the refusal needs the map, nullopt). Cheap enough for a server's
   // network thread.
-  absl::StatusOr<std::optional<Recalled>> Recall(const MapSource& source, const PlanRequest& request) const;
+  absl::StatusOr<std::optional<Recalled>> Recall(const MapSource& source,
+                                                 const PlanRequest& request) const;
   // Builds every per-map artifact `request` needs, without planning.
   absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
   // The coverage area `request` plans on (validated like Plan), e.g. to
@@ -143,12 +144,14 @@ class PlanningEngine {
   enum class ArtifactUse { kBuild, kCachedOnly };
   // Finds (or with kBuild, builds) the grid and coverage area of `request`
   // and fills `ctx`. False with kCachedOnly when one is not cached.
-  absl::StatusOr<bool> Setup(const MapSource& source, const PlanRequest& request, const Resolved& resolved,
-                             ArtifactUse use, PlanContext* ctx, bool* all_cached) const;
-  PlanMemoryKeys MemoryKeys(const PlanRequest& request, const Resolved& resolved, const PlanContext& ctx) const;
+  absl::StatusOr<bool> Setup(const MapSource& source, const PlanRequest& request,
+                             const Resolved& resolved, ArtifactUse use, PlanContext* ctx,
+                             bool* all_cached) const;
+  PlanMemoryKeys MemoryKeys(const PlanRequest& request, const Resolved& resolved,
+                            const PlanContext& ctx) const;
   // Path checks and path-derived statistics of a planner's result.
-  absl::Status Finish(const PlanRequest& request, const Resolved& resolved, const CoverageArea& area,
-                      bool all_cached, CoveragePlan* plan) const;
+  absl::Status Finish(const PlanRequest& request, const Resolved& resolved,
+                      const CoverageArea& area, bool all_cached, CoveragePlan* plan) const;
 
   const PlannerRegistry* registry_;
   ArtifactCache* cache_;

@@ -29,10 +29,11 @@ PlanRequest PlanOptions::ToRequest() const {
   return r;
 }
 
-absl::StatusOr<EngineResult> PlanCoverageWithArea(const OccupancyMap& map, const PlanOptions& options,
-                                                  ArtifactCache* cache, const std::string& map_id,
-                                                  EngineLimits limits) {
-  static const PlannerRegistry* const registry = new PlannerRegistry(PlannerRegistry::WithBuiltins());
+absl::StatusOr<EngineResult> PlanCoverageWithArea(const OccupancyMap& map,
+                                                  const PlanOptions& options, ArtifactCache* cache,
+                                                  const std::string& map_id, EngineLimits limits) {
+  static const PlannerRegistry* const registry =
+      new PlannerRegistry(PlannerRegistry::WithBuiltins());
   LocalArtifactCache local;
   PlanningEngine engine(registry, cache != nullptr ? cache : &local, limits);
   MapSource source;

@@ -22,7 +22,8 @@
 namespace covplan {
 
 struct PlanOptions {
-  std::string planner = PlannerRegistry::kDefault;  // a registered name; OARP fields apply to "oarp"
+  std::string planner =
+      PlannerRegistry::kDefault;  // a registered name; OARP fields apply to "oarp"
   RobotModel robot;
   PartitionSolver partition_solver = PartitionSolver::kPushRelabel;
   TourSolver tour_solver = TourSolver::kGtsp;
@@ -39,7 +40,8 @@ struct PlanOptions {
   PlanRequest ToRequest() const;
 };
 
-absl::StatusOr<EngineResult> PlanCoverageWithArea(const OccupancyMap& map, const PlanOptions& options,
+absl::StatusOr<EngineResult> PlanCoverageWithArea(const OccupancyMap& map,
+                                                  const PlanOptions& options,
                                                   ArtifactCache* cache = nullptr,
                                                   const std::string& map_id = "local",
                                                   EngineLimits limits = {});

@@ -13,13 +13,14 @@ std::string PoseText(const std::optional<Pose2>& p) {
 
 }  // namespace
 
-PlanMemoryKeys PlanMemoryKeysFor(const ArtifactKey<CoverageArea>& area_key, std::string_view planner,
-                                 const PlannerOptions& options, const CommonOptions& common,
+PlanMemoryKeys PlanMemoryKeysFor(const ArtifactKey<CoverageArea>& area_key,
+                                 std::string_view planner, const PlannerOptions& options,
+                                 const CommonOptions& common,
                                  const std::optional<BatteryOptions>& battery) {
   const RobotModel& r = common.robot;
-  std::string params = absl::StrFormat("planner=%s;options=%s;robot=%.17g,%.17g,%.17g,%.17g", planner,
-                                       options.CacheText(), r.tool_width_m, r.max_speed_mps,
-                                       r.acceleration_mps2, r.turn_rate_deg_s);
+  std::string params = absl::StrFormat("planner=%s;options=%s;robot=%.17g,%.17g,%.17g,%.17g",
+                                       planner, options.CacheText(), r.tool_width_m,
+                                       r.max_speed_mps, r.acceleration_mps2, r.turn_rate_deg_s);
   if (battery.has_value()) {
     const BatteryOptions& b = *battery;
     absl::StrAppendFormat(&params, ";battery=%.17g,%s,%.17g,%.17g,%.17g,%.17g,%d,[%s]", b.capacity,
@@ -32,10 +33,11 @@ PlanMemoryKeys PlanMemoryKeysFor(const ArtifactKey<CoverageArea>& area_key, std:
   const auto base = area_key.Derive<RememberedPlan>("plan", params);
   PlanMemoryKeys keys;
   keys.tour = base.Derive<RememberedTour>("tour", "").text();
-  keys.exact = base.Derive<RememberedPlan>(
-                       "exact", absl::StrFormat("seed=%d;threads=%d;start=%s;end=%s", common.seed,
-                                                common.num_threads, PoseText(r.start), PoseText(r.end)))
-                   .text();
+  keys.exact =
+      base.Derive<RememberedPlan>(
+              "exact", absl::StrFormat("seed=%d;threads=%d;start=%s;end=%s", common.seed,
+                                       common.num_threads, PoseText(r.start), PoseText(r.end)))
+          .text();
   return keys;
 }
 

@@ -58,7 +58,8 @@ class RememberedPlan final : public Artifact {
   double time_limit_s = 0.0;
   // True when it answers an identical request with `time_limit_s` at once.
   bool Answers(double request_time_limit_s) const {
-    return plan.termination.limit != TerminationLimit::kTime || request_time_limit_s <= time_limit_s;
+    return plan.termination.limit != TerminationLimit::kTime ||
+           request_time_limit_s <= time_limit_s;
   }
   size_t MemoryBytes() const override { return sizeof(*this) - sizeof(plan) + plan.MemoryBytes(); }
 };
@@ -77,8 +78,9 @@ struct PlanMemoryKeys {
 
 // Keys of a request planned on `area_key`. `common.robot.start/end` must
 // already hold the effective poses (a battery tour's station).
-PlanMemoryKeys PlanMemoryKeysFor(const ArtifactKey<CoverageArea>& area_key, std::string_view planner,
-                                 const PlannerOptions& options, const CommonOptions& common,
+PlanMemoryKeys PlanMemoryKeysFor(const ArtifactKey<CoverageArea>& area_key,
+                                 std::string_view planner, const PlannerOptions& options,
+                                 const CommonOptions& common,
                                  const std::optional<BatteryOptions>& battery);
 
 template <typename T>

@@ -1,7 +1,7 @@
 // The planners this build ships. Adding a planner: its folder under
 // planner/, one Register line here, its options message in the proto.
-#include "planner/engine/engine.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
+#include "planner/engine/engine.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/stc/stc_planner.h"
 

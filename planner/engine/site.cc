@@ -37,8 +37,8 @@ absl::StatusOr<SiteMap> SiteFromPolygons(std::shared_ptr<const Area> free_space,
     return absl::InvalidArgumentError("map.polygons: the map has no polygon (no free space)");
   }
   if (!(resolution > 0.0) || !std::isfinite(resolution)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("map.polygons.resolution must be a positive number of metres, got %g", resolution));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "map.polygons.resolution must be a positive number of metres, got %g", resolution));
   }
   const Point2 lo = free_space->min_corner(), hi = free_space->max_corner();
   const double pixels = ((hi.x - lo.x) / resolution + 2) * ((hi.y - lo.y) / resolution + 2);
@@ -91,7 +91,8 @@ std::string AreaZones::CacheText() const {
   }
   if (has_no_go()) {
     const std::string t = no_go->CanonicalText();
-    absl::StrAppend(&out, out.empty() ? "" : ";", "no_go=", absl::StrFormat("%016x:%d", Fnv1a(t), t.size()));
+    absl::StrAppend(&out, out.empty() ? "" : ";",
+                    "no_go=", absl::StrFormat("%016x:%d", Fnv1a(t), t.size()));
   }
   return out;
 }

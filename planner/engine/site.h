@@ -58,7 +58,8 @@ class GridArtifact final : public Artifact {
   double map_free_area_m2 = 0.0;
   double build_ms = 0.0;
   size_t MemoryBytes() const override {
-    return sizeof(*this) + (grid ? grid->MemoryBytes() : 0) + free_fraction.capacity() * sizeof(float);
+    return sizeof(*this) + (grid ? grid->MemoryBytes() : 0) +
+           free_fraction.capacity() * sizeof(float);
   }
 };
 

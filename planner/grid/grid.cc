@@ -9,12 +9,12 @@ namespace covplan {
 
 absl::Status GridOptions::Validate() const {
   if (!std::isfinite(cell_size) || cell_size <= 0.0) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "tool width must be a positive number of metres, got %g", cell_size));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("tool width must be a positive number of metres, got %g", cell_size));
   }
   if (!std::isfinite(min_free_fraction) || min_free_fraction < 0.0 || min_free_fraction >= 1.0) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "min_free_fraction must be in [0, 1), got %g", min_free_fraction));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("min_free_fraction must be in [0, 1), got %g", min_free_fraction));
   }
   if (max_cells <= 0) return absl::InvalidArgumentError("max_cells must be positive");
   return absl::OkStatus();
@@ -53,7 +53,8 @@ Grid Grid::FromAscii(const std::vector<std::string>& rows_top_down, double cell_
       const char ch = rows_top_down[i][c];
       free[static_cast<size_t>(r) * cols + c] = ch != '#' ? 1 : 0;
       if (ch == '|') walls[static_cast<size_t>(r) * cols + c] |= kWallRight, any_wall = true;
-      if (ch == '_' && r > 0) walls[static_cast<size_t>(r - 1) * cols + c] |= kWallUp, any_wall = true;
+      if (ch == '_' && r > 0)
+        walls[static_cast<size_t>(r - 1) * cols + c] |= kWallUp, any_wall = true;
     }
   }
   if (!any_wall) walls.clear();
@@ -74,7 +75,8 @@ CellIndex Grid::CellAt(Point2 p) const {
     if (v > n + 1.0) return n + 1;
     return static_cast<int>(std::floor(v));
   };
-  return {index((p.y - origin_.y) / cell_size_, rows_), index((p.x - origin_.x) / cell_size_, cols_)};
+  return {index((p.y - origin_.y) / cell_size_, rows_),
+          index((p.x - origin_.x) / cell_size_, cols_)};
 }
 
 std::vector<std::string> Grid::ToRowStrings() const {
@@ -135,7 +137,7 @@ class FreeAreaIntegrator {
     const int c0 = static_cast<int>(std::floor(x0));
     const int c1 = static_cast<int>(std::floor(x1));  // column containing x1
     if (c0 == c1) return (x1 - x0) * (row[c0 + 1] - row[c0]);
-    double s = (c0 + 1 - x0) * (row[c0 + 1] - row[c0]);   // partial first column
+    double s = (c0 + 1 - x0) * (row[c0 + 1] - row[c0]);    // partial first column
     s += row[c1] - row[c0 + 1];                            // full columns
     if (c1 < w) s += (x1 - c1) * (row[c1 + 1] - row[c1]);  // partial last column
     return s;
@@ -149,8 +151,10 @@ class FreeAreaIntegrator {
 // coordinates (x0, y) .. (x1, y) (horizontal) is not free. A coordinate on a
 // pixel boundary touches the pixels on both sides.
 bool HorizontalLineBlocked(const OccupancyMap& map, double y, double x0, double x1) {
-  const int r_lo = static_cast<int>(std::floor(y - 1e-9)), r_hi = static_cast<int>(std::floor(y + 1e-9));
-  const int c0 = std::max(0, static_cast<int>(std::floor(x0))), c1 = std::min(map.width() - 1, static_cast<int>(std::ceil(x1)) - 1);
+  const int r_lo = static_cast<int>(std::floor(y - 1e-9)),
+            r_hi = static_cast<int>(std::floor(y + 1e-9));
+  const int c0 = std::max(0, static_cast<int>(std::floor(x0))),
+            c1 = std::min(map.width() - 1, static_cast<int>(std::ceil(x1)) - 1);
   for (int r = std::max(0, r_lo); r <= std::min(map.height() - 1, r_hi); ++r) {
     for (int c = c0; c <= c1; ++c) {
       if (!map.IsFree(r, c)) return true;
@@ -160,8 +164,10 @@ bool HorizontalLineBlocked(const OccupancyMap& map, double y, double x0, double 
 }
 
 bool VerticalLineBlocked(const OccupancyMap& map, double x, double y0, double y1) {
-  const int c_lo = static_cast<int>(std::floor(x - 1e-9)), c_hi = static_cast<int>(std::floor(x + 1e-9));
-  const int r0 = std::max(0, static_cast<int>(std::floor(y0))), r1 = std::min(map.height() - 1, static_cast<int>(std::ceil(y1)) - 1);
+  const int c_lo = static_cast<int>(std::floor(x - 1e-9)),
+            c_hi = static_cast<int>(std::floor(x + 1e-9));
+  const int r0 = std::max(0, static_cast<int>(std::floor(y0))),
+            r1 = std::min(map.height() - 1, static_cast<int>(std::ceil(y1)) - 1);
   for (int c = std::max(0, c_lo); c <= std::min(map.width() - 1, c_hi); ++c) {
     for (int r = r0; r <= r1; ++r) {
       if (!map.IsFree(r, c)) return true;
@@ -187,9 +193,9 @@ absl::StatusOr<GridFrame> PlanGridFrame(const OccupancyMap& map, const GridOptio
         options.cell_size, res));
   }
   if (options.cell_size > width_m || options.cell_size > height_m) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "tool width %g m is wider than the map (%g m x %g m)", options.cell_size, width_m,
-        height_m));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("tool width %g m is wider than the map (%g m x %g m)", options.cell_size,
+                        width_m, height_m));
   }
   GridFrame f;
   f.px_per_cell = Snap(options.cell_size / res);
@@ -220,7 +226,8 @@ std::vector<double> CellFreeFractions(const OccupancyMap& map, const GridFrame& 
 }
 
 absl::StatusOr<Grid> BuildGridFromFractions(const OccupancyMap& map, const GridOptions& options,
-                                            const GridFrame& f, const std::vector<double>& fractions) {
+                                            const GridFrame& f,
+                                            const std::vector<double>& fractions) {
   const int rows = f.rows, cols = f.cols;
   const double px_per_cell = f.px_per_cell;
   if (fractions.size() != static_cast<size_t>(rows) * cols) {

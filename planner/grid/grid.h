@@ -76,7 +76,9 @@ class Grid {
   bool IsFree(int r, int c) const { return InBounds(r, c) && free_[Index(r, c)] != 0; }
   bool IsFree(CellIndex c) const { return IsFree(c.row, c.col); }
   int64_t Index(int r, int c) const { return static_cast<int64_t>(r) * cols_ + c; }
-  CellIndex FromIndex(int64_t i) const { return {static_cast<int>(i / cols_), static_cast<int>(i % cols_)}; }
+  CellIndex FromIndex(int64_t i) const {
+    return {static_cast<int>(i / cols_), static_cast<int>(i % cols_)};
+  }
   int64_t CountFree() const;
   const std::vector<uint8_t>& free_flags() const { return free_; }
   const std::vector<uint8_t>& walls() const { return walls_; }

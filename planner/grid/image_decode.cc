@@ -54,9 +54,9 @@ absl::Status CheckDimensions(const char* format, int64_t width, int64_t height,
         absl::StrFormat("%s image has zero size (%d x %d pixels)", format, width, height));
   }
   if (width > kMaxSide || height > kMaxSide || width * height > o.max_pixels) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "%s image is %d x %d pixels, above the limit max_pixels = %d", format, width,
-        height, o.max_pixels));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("%s image is %d x %d pixels, above the limit max_pixels = %d", format,
+                        width, height, o.max_pixels));
   }
   return absl::OkStatus();
 }
@@ -103,8 +103,7 @@ class PgmTokenizer {
     while (pos_ < s_.size() && absl::ascii_isdigit(static_cast<unsigned char>(s_[pos_]))) {
       v = v * 10 + (s_[pos_++] - '0');
       if (v > max) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("bad PGM: ", what, " is larger than ", max));
+        return absl::InvalidArgumentError(absl::StrCat("bad PGM: ", what, " is larger than ", max));
       }
     }
     return v;
@@ -132,14 +131,14 @@ class PgmTokenizer {
 absl::StatusOr<OccupancyMap> DecodePgm(std::string_view bytes, const MapLoadOptions& o) {
   const bool binary = bytes[1] == '5';
   PgmTokenizer tok(bytes, 2);
-  if (tok.remaining() == 0 ||
-      (!IsPgmSpace(bytes[2]) && bytes[2] != '#')) {
+  if (tok.remaining() == 0 || (!IsPgmSpace(bytes[2]) && bytes[2] != '#')) {
     return absl::InvalidArgumentError("bad PGM header: expected whitespace after the magic number");
   }
   ASSIGN_OR_RETURN(const int64_t width, tok.Number("width", kMaxSide));
   ASSIGN_OR_RETURN(const int64_t height, tok.Number("height", kMaxSide));
   ASSIGN_OR_RETURN(const int64_t maxval, tok.Number("maxval", 65535));
-  if (maxval == 0) return absl::InvalidArgumentError("bad PGM header: maxval must be 1..65535, got 0");
+  if (maxval == 0)
+    return absl::InvalidArgumentError("bad PGM header: maxval must be 1..65535, got 0");
   RETURN_IF_ERROR(CheckDimensions("PGM", width, height, o));
 
   const int64_t pixels = width * height;
@@ -147,9 +146,9 @@ absl::StatusOr<OccupancyMap> DecodePgm(std::string_view bytes, const MapLoadOpti
   if (binary) {
     RETURN_IF_ERROR(tok.SingleSeparator());
     if (static_cast<int64_t>(tok.remaining()) < pixels * bytes_per_sample) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "PGM is truncated: %d x %d pixels need %d bytes of pixel data, found %d", width,
-          height, pixels * bytes_per_sample, tok.remaining()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("PGM is truncated: %d x %d pixels need %d bytes of pixel data, found %d",
+                          width, height, pixels * bytes_per_sample, tok.remaining()));
     }
   } else if (static_cast<int64_t>(tok.remaining()) < 2 * pixels - 1) {
     // Each ASCII sample takes a digit and a separator: cheap early rejection.
@@ -257,8 +256,7 @@ bool PngReadPixels(png_structp png, png_bytepp rows) {
 
 absl::StatusOr<OccupancyMap> DecodePng(std::string_view bytes, const MapLoadOptions& o) {
   PngSource src{reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), 0, {}};
-  png_structp png =
-      png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, PngErrorFn, PngWarningFn);
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, PngErrorFn, PngWarningFn);
   if (png == nullptr) return absl::ResourceExhaustedError("cannot allocate PNG decoder");
   png_infop info = png_create_info_struct(png);
   struct Destroy {
@@ -286,9 +284,9 @@ absl::StatusOr<OccupancyMap> DecodePng(std::string_view bytes, const MapLoadOpti
   if (!PngSetTransforms(png, info, &layout)) return png_failure();
   if ((layout.channels != 1 && layout.channels != 3) ||
       layout.rowbytes != static_cast<size_t>(layout.width) * layout.channels) {
-    return absl::InternalError(absl::StrFormat(
-        "unexpected PNG layout after conversion: %d channels, %d bytes per row",
-        layout.channels, layout.rowbytes));
+    return absl::InternalError(
+        absl::StrFormat("unexpected PNG layout after conversion: %d channels, %d bytes per row",
+                        layout.channels, layout.rowbytes));
   }
 
   std::vector<unsigned char> pixels(layout.rowbytes * layout.height);
@@ -303,9 +301,8 @@ absl::StatusOr<OccupancyMap> DecodePng(std::string_view bytes, const MapLoadOpti
   for (int r = 0; r < height; ++r) {
     const unsigned char* row = rows[r];
     for (int c = 0; c < width; ++c) {
-      const int sum = layout.channels == 1
-                          ? 3 * row[c]
-                          : row[3 * c] + row[3 * c + 1] + row[3 * c + 2];
+      const int sum =
+          layout.channels == 1 ? 3 * row[c] : row[3 * c] + row[3 * c + 1] + row[3 * c + 2];
       map.set(height - 1 - r, c, lut[sum]);
     }
   }
@@ -345,13 +342,12 @@ ImageFormat DetectImageFormat(std::string_view bytes) {
   return ImageFormat::kUnknown;
 }
 
-absl::StatusOr<OccupancyMap> DecodeMapImage(std::string_view bytes,
-                                            const MapLoadOptions& options) {
+absl::StatusOr<OccupancyMap> DecodeMapImage(std::string_view bytes, const MapLoadOptions& options) {
   RETURN_IF_ERROR(options.Validate());
   if (static_cast<int64_t>(bytes.size()) > options.max_file_bytes) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "image is %d bytes, above the limit max_file_bytes = %d", bytes.size(),
-        options.max_file_bytes));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("image is %d bytes, above the limit max_file_bytes = %d", bytes.size(),
+                        options.max_file_bytes));
   }
   switch (DetectImageFormat(bytes)) {
     case ImageFormat::kPgm:
@@ -362,9 +358,9 @@ absl::StatusOr<OccupancyMap> DecodeMapImage(std::string_view bytes,
       break;
   }
   if (bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '7') {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "unsupported Netpbm format P", std::string(1, bytes[1]),
-        ": only greyscale PGM (P2, P5) and PNG maps are supported"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("unsupported Netpbm format P", std::string(1, bytes[1]),
+                     ": only greyscale PGM (P2, P5) and PNG maps are supported"));
   }
   return absl::InvalidArgumentError(
       "unrecognised image format: expected a PGM (magic P2/P5) or PNG file");

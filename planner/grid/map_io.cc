@@ -48,9 +48,9 @@ absl::StatusOr<bool> YamlNegate(const YAML::Node& node) {
     bool b = false;
     if (YAML::convert<bool>::decode(node, b)) return b;
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "'negate' must be 0, 1, true or false",
-      node.IsScalar() ? absl::StrCat(", got '", node.Scalar(), "'") : std::string()));
+  return absl::InvalidArgumentError(
+      absl::StrCat("'negate' must be 0, 1, true or false",
+                   node.IsScalar() ? absl::StrCat(", got '", node.Scalar(), "'") : std::string()));
 }
 
 absl::StatusOr<MapYaml> ParseMapYamlRoot(const YAML::Node& root, const MapLoadOptions& defaults) {
@@ -106,9 +106,9 @@ absl::StatusOr<MapYaml> ParseMapYamlRoot(const YAML::Node& root, const MapLoadOp
   if (const YAML::Node mode = root["mode"]; mode.IsDefined() && !mode.IsNull()) {
     const std::string m = mode.IsScalar() ? absl::AsciiStrToLower(mode.Scalar()) : "";
     if (m != "trinary") {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "map mode '", mode.IsScalar() ? mode.Scalar() : "?",
-          "' is not supported: only 'trinary' maps (free / occupied / unknown) are"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("map mode '", mode.IsScalar() ? mode.Scalar() : "?",
+                       "' is not supported: only 'trinary' maps (free / occupied / unknown) are"));
     }
   }
   RETURN_IF_ERROR(out.options.Validate());
@@ -127,10 +127,13 @@ absl::StatusOr<std::string> ReadFile(const fs::path& path, int64_t max_bytes) {
   const fs::file_status st = fs::status(path, ec);
   if (!fs::exists(st)) return absl::NotFoundError(absl::StrCat("file not found: ", path.string()));
   if (fs::is_directory(st)) {
-    return absl::InvalidArgumentError(absl::StrCat(path.string(), " is a directory, not a map file"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(path.string(), " is a directory, not a map file"));
   }
   const uintmax_t size = fs::file_size(path, ec);
-  if (ec) return absl::InvalidArgumentError(absl::StrCat("cannot read ", path.string(), ": ", ec.message()));
+  if (ec)
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot read ", path.string(), ": ", ec.message()));
   if (size > static_cast<uintmax_t>(max_bytes)) {
     return absl::InvalidArgumentError(absl::StrFormat(
         "%s is %d bytes, above the limit max_file_bytes = %d", path.string(), size, max_bytes));
@@ -187,9 +190,9 @@ bool HasYamlExtension(const fs::path& path) {
 
 absl::StatusOr<MapYaml> ParseMapYaml(std::string_view yaml_text, const MapLoadOptions& defaults) {
   if (yaml_text.size() > kMaxYamlBytes) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "map YAML is %d bytes; a map_server YAML is a few lines (limit %d)", yaml_text.size(),
-        kMaxYamlBytes));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("map YAML is %d bytes; a map_server YAML is a few lines (limit %d)",
+                        yaml_text.size(), kMaxYamlBytes));
   }
   // yaml-cpp reports syntax errors, bad conversions and excessive nesting by
   // exceptions; none may escape this library.
@@ -236,27 +239,33 @@ absl::Status SaveMapYamlPgm(const OccupancyMap& map, const std::string& yaml_pat
   fs::path pgm_file = yaml_file;
   pgm_file.replace_extension(".pgm");
 
-  std::string pgm = absl::StrFormat("P5\n# covplan occupancy map\n%d %d\n255\n", map.width(),
-                                    map.height());
+  std::string pgm =
+      absl::StrFormat("P5\n# covplan occupancy map\n%d %d\n255\n", map.width(), map.height());
   const size_t header = pgm.size();
   pgm.resize(header + static_cast<size_t>(map.width()) * map.height());
   size_t i = header;
   for (int r = map.height() - 1; r >= 0; --r) {  // image top = largest y
     for (int c = 0; c < map.width(); ++c) {
       switch (map.at(r, c)) {
-        case CellState::kFree: pgm[i++] = static_cast<char>(254); break;
-        case CellState::kOccupied: pgm[i++] = static_cast<char>(0); break;
-        case CellState::kUnknown: pgm[i++] = static_cast<char>(205); break;
+        case CellState::kFree:
+          pgm[i++] = static_cast<char>(254);
+          break;
+        case CellState::kOccupied:
+          pgm[i++] = static_cast<char>(0);
+          break;
+        case CellState::kUnknown:
+          pgm[i++] = static_cast<char>(205);
+          break;
       }
     }
   }
   RETURN_IF_ERROR(WriteFile(pgm_file, pgm));
 
-  const std::string yaml = absl::StrCat(
-      "image: ", YamlQuote(pgm_file.filename().string()), "\n",
-      "resolution: ", ExactDouble(map.resolution()), "\n",
-      "origin: [", ExactDouble(map.origin().x), ", ", ExactDouble(map.origin().y), ", 0.0]\n",
-      "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n");
+  const std::string yaml =
+      absl::StrCat("image: ", YamlQuote(pgm_file.filename().string()), "\n",
+                   "resolution: ", ExactDouble(map.resolution()), "\n", "origin: [",
+                   ExactDouble(map.origin().x), ", ", ExactDouble(map.origin().y), ", 0.0]\n",
+                   "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n");
   return WriteFile(yaml_file, yaml);
 }
 

@@ -35,8 +35,8 @@ enum class ImageFormat { kUnknown, kPgm, kPng };
 struct MapLoadOptions {
   // For bare images (no YAML). Ignored when a YAML supplies them, unless
   // override_resolution is set.
-  double resolution = 0.0;       // metres per pixel; required for bare images
-  Point2 origin{0.0, 0.0};       // map-frame position of the bottom-left pixel corner
+  double resolution = 0.0;  // metres per pixel; required for bare images
+  Point2 origin{0.0, 0.0};  // map-frame position of the bottom-left pixel corner
   bool negate = false;
   double occupied_thresh = 0.65;
   double free_thresh = 0.196;
@@ -53,8 +53,7 @@ ImageFormat DetectImageFormat(std::string_view bytes);
 
 // Decodes image bytes (PGM or PNG, detected by magic) into an occupancy map
 // using options.resolution/origin/negate/thresholds.
-absl::StatusOr<OccupancyMap> DecodeMapImage(std::string_view bytes,
-                                            const MapLoadOptions& options);
+absl::StatusOr<OccupancyMap> DecodeMapImage(std::string_view bytes, const MapLoadOptions& options);
 
 // Parses a map_server YAML text. `load_image(name)` returns the bytes of the
 // image file the YAML names (relative to the YAML). The YAML's resolution,
@@ -62,8 +61,7 @@ absl::StatusOr<OccupancyMap> DecodeMapImage(std::string_view bytes,
 // override `options` (resolution only if !override_resolution).
 // `mode` other than "trinary" / absent is rejected.
 template <typename ImageLoader>
-absl::StatusOr<OccupancyMap> DecodeMapYaml(std::string_view yaml_text,
-                                           ImageLoader&& load_image,
+absl::StatusOr<OccupancyMap> DecodeMapYaml(std::string_view yaml_text, ImageLoader&& load_image,
                                            const MapLoadOptions& options);
 
 // Parses the YAML into options plus the image file name (helper for the above
@@ -72,20 +70,17 @@ struct MapYaml {
   std::string image;
   MapLoadOptions options;
 };
-absl::StatusOr<MapYaml> ParseMapYaml(std::string_view yaml_text,
-                                     const MapLoadOptions& defaults);
+absl::StatusOr<MapYaml> ParseMapYaml(std::string_view yaml_text, const MapLoadOptions& defaults);
 
 // Loads a map from disk: `.yaml`/`.yml` -> YAML + image; otherwise an image.
-absl::StatusOr<OccupancyMap> LoadMapFile(const std::string& path,
-                                         const MapLoadOptions& options);
+absl::StatusOr<OccupancyMap> LoadMapFile(const std::string& path, const MapLoadOptions& options);
 
 // Writes a map as YAML + 8-bit binary PGM (free 254, occupied 0, unknown 205).
 absl::Status SaveMapYamlPgm(const OccupancyMap& map, const std::string& yaml_path);
 
 // ---- implementation of the template ----
 template <typename ImageLoader>
-absl::StatusOr<OccupancyMap> DecodeMapYaml(std::string_view yaml_text,
-                                           ImageLoader&& load_image,
+absl::StatusOr<OccupancyMap> DecodeMapYaml(std::string_view yaml_text, ImageLoader&& load_image,
                                            const MapLoadOptions& options) {
   absl::StatusOr<MapYaml> parsed = ParseMapYaml(yaml_text, options);
   if (!parsed.ok()) return parsed.status();

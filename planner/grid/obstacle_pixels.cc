@@ -23,8 +23,9 @@ ObstaclePixels::ObstaclePixels(const OccupancyMap& map, double px_per_cell, int 
   // Pixels whose closed square [i, i+1] meets a cell's closed box [c*s, (c+1)*s]:
   // ceil(c*s) - 1 <= i <= floor((c+1)*s).
   auto range = [&](int c) {
-    return std::pair<int32_t, int32_t>(static_cast<int32_t>(std::ceil(c * px_per_cell_ - 1e-9)) - 1,
-                                       static_cast<int32_t>(std::floor((c + 1) * px_per_cell_ + 1e-9)));
+    return std::pair<int32_t, int32_t>(
+        static_cast<int32_t>(std::ceil(c * px_per_cell_ - 1e-9)) - 1,
+        static_cast<int32_t>(std::floor((c + 1) * px_per_cell_ + 1e-9)));
   };
   for (int r = 0; r < rows; ++r) {
     const auto [j_lo, j_hi] = range(r);
@@ -53,7 +54,8 @@ ObstaclePixels::ObstaclePixels(const OccupancyMap& map, double px_per_cell, int 
       for (int dc : {1, -1}) {
         const int c2 = c + dc;
         if (c2 < 0 || c2 >= cols) continue;
-        if (!CellDirty(r, c) && !CellDirty(r + 1, c2) && !CellDirty(r, c2) && !CellDirty(r + 1, c)) {
+        if (!CellDirty(r, c) && !CellDirty(r + 1, c2) && !CellDirty(r, c2) &&
+            !CellDirty(r + 1, c)) {
           continue;
         }
         if (SegmentBlocked({c + 0.5, r + 0.5}, {c2 + 0.5, r + 1.5})) {

@@ -17,8 +17,8 @@
 #ifndef COVPLAN_PLANNER_GRID_OBSTACLE_PIXELS_H_
 #define COVPLAN_PLANNER_GRID_OBSTACLE_PIXELS_H_
 
-#include <cstddef>
 #include <climits>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -30,7 +30,9 @@ class ObstaclePixels {
  public:
   ObstaclePixels(const OccupancyMap& map, double px_per_cell, int rows, int cols);
 
-  bool CellDirty(int r, int c) const { return box_[static_cast<size_t>(r) * cols_ + c].i0 != kClean; }
+  bool CellDirty(int r, int c) const {
+    return box_[static_cast<size_t>(r) * cols_ + c].i0 != kClean;
+  }
   // True when the part of segment a..b (cell units) inside the closed box of
   // cell (r, c) touches a non-free pixel.
   bool SegmentBlockedInCell(int r, int c, Point2 a, Point2 b) const;

@@ -24,34 +24,57 @@ int BoundType(double lo, double up) {
 
 absl::Status SimplexStatus(int rc) {
   switch (rc) {
-    case 0: return absl::OkStatus();
-    case GLP_ETMLIM: return absl::DeadlineExceededError("GLPK simplex hit its time limit");
-    case GLP_EITLIM: return absl::DeadlineExceededError("GLPK simplex hit its iteration limit");
-    case GLP_ENOPFS: return absl::FailedPreconditionError("LP has no primal feasible solution");
-    case GLP_ENODFS: return absl::FailedPreconditionError("LP has no dual feasible solution (unbounded)");
-    case GLP_EBADB: return absl::InternalError("GLPK: invalid initial basis");
-    case GLP_ESING: return absl::InternalError("GLPK: singular basis matrix");
-    case GLP_ECOND: return absl::InternalError("GLPK: ill-conditioned basis matrix");
-    case GLP_EBOUND: return absl::InternalError("GLPK: incorrect double bounds");
-    case GLP_EFAIL: return absl::InternalError("GLPK: solver failure");
-    case GLP_EOBJLL: return absl::InternalError("GLPK: objective below lower limit");
-    case GLP_EOBJUL: return absl::InternalError("GLPK: objective above upper limit");
-    default: return absl::InternalError(absl::StrFormat("GLPK simplex returned code %d", rc));
+    case 0:
+      return absl::OkStatus();
+    case GLP_ETMLIM:
+      return absl::DeadlineExceededError("GLPK simplex hit its time limit");
+    case GLP_EITLIM:
+      return absl::DeadlineExceededError("GLPK simplex hit its iteration limit");
+    case GLP_ENOPFS:
+      return absl::FailedPreconditionError("LP has no primal feasible solution");
+    case GLP_ENODFS:
+      return absl::FailedPreconditionError("LP has no dual feasible solution (unbounded)");
+    case GLP_EBADB:
+      return absl::InternalError("GLPK: invalid initial basis");
+    case GLP_ESING:
+      return absl::InternalError("GLPK: singular basis matrix");
+    case GLP_ECOND:
+      return absl::InternalError("GLPK: ill-conditioned basis matrix");
+    case GLP_EBOUND:
+      return absl::InternalError("GLPK: incorrect double bounds");
+    case GLP_EFAIL:
+      return absl::InternalError("GLPK: solver failure");
+    case GLP_EOBJLL:
+      return absl::InternalError("GLPK: objective below lower limit");
+    case GLP_EOBJUL:
+      return absl::InternalError("GLPK: objective above upper limit");
+    default:
+      return absl::InternalError(absl::StrFormat("GLPK simplex returned code %d", rc));
   }
 }
 
 absl::Status IntoptStatus(int rc) {
   switch (rc) {
-    case 0: return absl::OkStatus();
-    case GLP_ETMLIM: return absl::DeadlineExceededError("GLPK branch-and-bound hit its time limit");
-    case GLP_ENOPFS: return absl::FailedPreconditionError("MIP has no primal feasible solution");
-    case GLP_ENODFS: return absl::FailedPreconditionError("MIP relaxation has no dual feasible solution");
-    case GLP_EROOT: return absl::InternalError("GLPK: optimal basis for the relaxation not provided");
-    case GLP_EBOUND: return absl::InternalError("GLPK: incorrect bounds on integer columns");
-    case GLP_EFAIL: return absl::InternalError("GLPK: MIP solver failure");
-    case GLP_EMIPGAP: return absl::OkStatus();  // relative gap reached: solution is usable
-    case GLP_ESTOP: return absl::CancelledError("GLPK branch-and-bound stopped");
-    default: return absl::InternalError(absl::StrFormat("GLPK intopt returned code %d", rc));
+    case 0:
+      return absl::OkStatus();
+    case GLP_ETMLIM:
+      return absl::DeadlineExceededError("GLPK branch-and-bound hit its time limit");
+    case GLP_ENOPFS:
+      return absl::FailedPreconditionError("MIP has no primal feasible solution");
+    case GLP_ENODFS:
+      return absl::FailedPreconditionError("MIP relaxation has no dual feasible solution");
+    case GLP_EROOT:
+      return absl::InternalError("GLPK: optimal basis for the relaxation not provided");
+    case GLP_EBOUND:
+      return absl::InternalError("GLPK: incorrect bounds on integer columns");
+    case GLP_EFAIL:
+      return absl::InternalError("GLPK: MIP solver failure");
+    case GLP_EMIPGAP:
+      return absl::OkStatus();  // relative gap reached: solution is usable
+    case GLP_ESTOP:
+      return absl::CancelledError("GLPK branch-and-bound stopped");
+    default:
+      return absl::InternalError(absl::StrFormat("GLPK intopt returned code %d", rc));
   }
 }
 
@@ -122,7 +145,8 @@ absl::StatusOr<LpSolution> LinearProgram::Solve(const LpSolveOptions& options) {
   absl::Status st = SimplexStatus(glp_simplex(lp, &smcp));
   if (!st.ok()) return st;
   const int status = glp_get_status(lp);
-  if (status == GLP_NOFEAS || status == GLP_INFEAS) return absl::FailedPreconditionError("LP is infeasible");
+  if (status == GLP_NOFEAS || status == GLP_INFEAS)
+    return absl::FailedPreconditionError("LP is infeasible");
   if (status == GLP_UNBND) return absl::FailedPreconditionError("LP is unbounded");
   if (status != GLP_OPT) return absl::InternalError(absl::StrFormat("GLPK LP status %d", status));
 
@@ -131,7 +155,8 @@ absl::StatusOr<LpSolution> LinearProgram::Solve(const LpSolveOptions& options) {
   sol.integral = true;
   for (int j = 0; j < num_cols_; ++j) {
     sol.values[j] = glp_get_col_prim(lp, j + 1);
-    if (integer_[j] && std::abs(sol.values[j] - std::round(sol.values[j])) > 1e-6) sol.integral = false;
+    if (integer_[j] && std::abs(sol.values[j] - std::round(sol.values[j])) > 1e-6)
+      sol.integral = false;
   }
   sol.objective = glp_get_obj_val(lp);
   if (!options.integer || sol.integral) return sol;

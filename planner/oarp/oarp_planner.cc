@@ -27,7 +27,8 @@ constexpr int64_t kBytesPerCachedPair = 40;  // unordered_map node + bucket
 
 int64_t DenseTransitionBytes(int64_t num_ranks) {
   const int64_t v = 2 * std::min<int64_t>(num_ranks, 1 << 28) + 2;
-  return TransitionTable::EstimateBytes(static_cast<int>(std::min<int64_t>(v, 1 << 30))) + 3 * v * v * 8;
+  return TransitionTable::EstimateBytes(static_cast<int>(std::min<int64_t>(v, 1 << 30))) +
+         3 * v * v * 8;
 }
 
 int64_t SparseTransitionBytes(int64_t grid_cells, int64_t num_ranks, int num_threads) {
@@ -35,13 +36,14 @@ int64_t SparseTransitionBytes(int64_t grid_cells, int64_t num_ranks, int num_thr
   return EndpointGraph::EstimateBytes(grid_cells, 2 * num_ranks, kCandidateNeighbours, threads) +
          threads * grid_cells * AnyAngleSearch::kBytesPerCell +        // tour runs, then the legs
          threads * (num_ranks * 2 * 64 + kSparseTourBytesPerThread) +  // tour state per run
-         num_ranks * 2 * 128 +                                        // legs and waypoints
+         num_ranks * 2 * 128 +                                         // legs and waypoints
          kCachedPairs * kBytesPerCachedPair;
 }
 
 absl::Status OarpOptions::Validate() const {
   if (partition_solver != PartitionSolver::kMinCut && partition_solver != PartitionSolver::kLp &&
-      partition_solver != PartitionSolver::kMatching && partition_solver != PartitionSolver::kPushRelabel) {
+      partition_solver != PartitionSolver::kMatching &&
+      partition_solver != PartitionSolver::kPushRelabel) {
     return absl::InvalidArgumentError("oarp.partition_solver: unknown solver");
   }
   if (tour_solver != TourSolver::kGreedy && tour_solver != TourSolver::kGtsp) {
@@ -74,22 +76,24 @@ absl::StatusOr<OarpPlanner::Artifacts> OarpPlanner::GetArtifacts(const PlanConte
   const CommonOptions& common = *ctx.common;
   const CoverageArea& area = *ctx.area;
   std::unique_ptr<RankPartitioner> partitioner = MakePartitioner(options.partition_solver);
-  const auto pkey = ctx.area_key.Derive<PartitionArtifact>("partition", std::string(partitioner->name()));
+  const auto pkey =
+      ctx.area_key.Derive<PartitionArtifact>("partition", std::string(partitioner->name()));
   bool hit = false;
   Artifacts a;
-  ASSIGN_OR_RETURN(a.partition, GetOrBuild(*ctx.cache, pkey, common.stop,
-                                           [&](const StopToken& stop)
-                                               -> absl::StatusOr<std::shared_ptr<const PartitionArtifact>> {
-                                             const absl::Time t = absl::Now();
-                                             ASSIGN_OR_RETURN(RankPartition p,
-                                                              partitioner->Partition(*area.cover, stop));
-                                             auto out = std::make_shared<PartitionArtifact>();
-                                             out->partition = std::make_shared<const RankPartition>(std::move(p));
-                                             out->solver = std::string(partitioner->name());
-                                             out->build_ms = MsSince(t);
-                                             return std::shared_ptr<const PartitionArtifact>(std::move(out));
-                                           },
-                                           &hit));
+  ASSIGN_OR_RETURN(
+      a.partition,
+      GetOrBuild(
+          *ctx.cache, pkey, common.stop,
+          [&](const StopToken& stop) -> absl::StatusOr<std::shared_ptr<const PartitionArtifact>> {
+            const absl::Time t = absl::Now();
+            ASSIGN_OR_RETURN(RankPartition p, partitioner->Partition(*area.cover, stop));
+            auto out = std::make_shared<PartitionArtifact>();
+            out->partition = std::make_shared<const RankPartition>(std::move(p));
+            out->solver = std::string(partitioner->name());
+            out->build_ms = MsSince(t);
+            return std::shared_ptr<const PartitionArtifact>(std::move(out));
+          },
+          &hit));
   if (!hit && ctx.all_cached != nullptr) *ctx.all_cached = false;
   const std::vector<Rank>& ranks = a.partition->partition->ranks;
   const int64_t num_ranks = static_cast<int64_t>(ranks.size());
@@ -102,8 +106,9 @@ absl::StatusOr<OarpPlanner::Artifacts> OarpPlanner::GetArtifacts(const PlanConte
   // Dense exact transitions while they fit their budget, sparse above.
   const int64_t dense_bytes = DenseTransitionBytes(num_ranks);
   const bool sparse = dense_bytes > ctx.limits.dense_transition_bytes;
-  const int64_t need = sparse ? SparseTransitionBytes(area.drive->size(), num_ranks, common.num_threads)
-                              : dense_bytes;
+  const int64_t need =
+      sparse ? SparseTransitionBytes(area.drive->size(), num_ranks, common.num_threads)
+             : dense_bytes;
   if (need > ctx.limits.max_transition_bytes) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "the map needs %d coverage ranks at tool width %g m on a %d-cell drive grid: the %s "
@@ -113,43 +118,47 @@ absl::StatusOr<OarpPlanner::Artifacts> OarpPlanner::GetArtifacts(const PlanConte
         need >> 20, ctx.limits.max_transition_bytes >> 20));
   }
   if (sparse) {
-    const auto ckey = pkey.Derive<TransitionArtifact>("candidates", absl::StrFormat("%d", kCandidateNeighbours));
-    ASSIGN_OR_RETURN(a.transitions, GetOrBuild(*ctx.cache, ckey, common.stop,
-                                               [&](const StopToken& stop)
-                                                   -> absl::StatusOr<std::shared_ptr<const TransitionArtifact>> {
-                                                 const absl::Time t = absl::Now();
-                                                 auto out = std::make_shared<TransitionArtifact>();
-                                                 std::vector<CellIndex> endpoints;
-                                                 endpoints.reserve(2 * ranks.size());
-                                                 for (const Rank& r : ranks) {
-                                                   endpoints.push_back(r.first);
-                                                   endpoints.push_back(r.last);
-                                                 }
-                                                 EndpointGraph::Options go;
-                                                 go.neighbours = kCandidateNeighbours;
-                                                 ASSIGN_OR_RETURN(out->graph,
-                                                                  EndpointGraph::Build(*area.drive, std::move(endpoints), go,
-                                                                                       stop, common.num_threads));
-                                                 out->build_ms = MsSince(t);
-                                                 return std::shared_ptr<const TransitionArtifact>(std::move(out));
-                                               },
-                                               &hit));
+    const auto ckey =
+        pkey.Derive<TransitionArtifact>("candidates", absl::StrFormat("%d", kCandidateNeighbours));
+    ASSIGN_OR_RETURN(a.transitions,
+                     GetOrBuild(
+                         *ctx.cache, ckey, common.stop,
+                         [&](const StopToken& stop)
+                             -> absl::StatusOr<std::shared_ptr<const TransitionArtifact>> {
+                           const absl::Time t = absl::Now();
+                           auto out = std::make_shared<TransitionArtifact>();
+                           std::vector<CellIndex> endpoints;
+                           endpoints.reserve(2 * ranks.size());
+                           for (const Rank& r : ranks) {
+                             endpoints.push_back(r.first);
+                             endpoints.push_back(r.last);
+                           }
+                           EndpointGraph::Options go;
+                           go.neighbours = kCandidateNeighbours;
+                           ASSIGN_OR_RETURN(out->graph,
+                                            EndpointGraph::Build(*area.drive, std::move(endpoints),
+                                                                 go, stop, common.num_threads));
+                           out->build_ms = MsSince(t);
+                           return std::shared_ptr<const TransitionArtifact>(std::move(out));
+                         },
+                         &hit));
     if (!hit && ctx.all_cached != nullptr) *ctx.all_cached = false;
     return a;
   }
   const auto tkey = pkey.Derive<TransitionArtifact>("transitions", "");
-  ASSIGN_OR_RETURN(a.transitions, GetOrBuild(*ctx.cache, tkey, common.stop,
-                                             [&](const StopToken& stop)
-                                                 -> absl::StatusOr<std::shared_ptr<const TransitionArtifact>> {
-                                               const absl::Time t = absl::Now();
-                                               auto out = std::make_shared<TransitionArtifact>();
-                                               ASSIGN_OR_RETURN(out->table,
-                                                                TransitionTable::Build(*area.drive, ranks, stop,
-                                                                                       common.num_threads));
-                                               out->build_ms = MsSince(t);
-                                               return std::shared_ptr<const TransitionArtifact>(std::move(out));
-                                             },
-                                             &hit));
+  ASSIGN_OR_RETURN(
+      a.transitions,
+      GetOrBuild(
+          *ctx.cache, tkey, common.stop,
+          [&](const StopToken& stop) -> absl::StatusOr<std::shared_ptr<const TransitionArtifact>> {
+            const absl::Time t = absl::Now();
+            auto out = std::make_shared<TransitionArtifact>();
+            ASSIGN_OR_RETURN(out->table,
+                             TransitionTable::Build(*area.drive, ranks, stop, common.num_threads));
+            out->build_ms = MsSince(t);
+            return std::shared_ptr<const TransitionArtifact>(std::move(out));
+          },
+          &hit));
   if (!hit && ctx.all_cached != nullptr) *ctx.all_cached = false;
   return a;
 }
@@ -181,8 +190,8 @@ absl::StatusOr<CoveragePlan> OarpPlanner::Plan(const PlanContext& ctx) const {
       so.warm_vertices = *ctx.warm_tour;
       so.warm_kicks = ctx.warm_trials != 0;  // a new start pose: the descent only
     }
-    ASSIGN_OR_RETURN(SparseTour tour, PlanSparseRankTour(drive, ranks, *a.transitions->graph, common.robot,
-                                                         so, common.stop));
+    ASSIGN_OR_RETURN(SparseTour tour, PlanSparseRankTour(drive, ranks, *a.transitions->graph,
+                                                         common.robot, so, common.stop));
     vertices = std::move(tour.vertices);
     plan.path = std::move(tour.path);
     plan.termination = tour.termination;

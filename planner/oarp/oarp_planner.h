@@ -30,7 +30,8 @@ namespace covplan {
 enum class TourSolver { kGreedy, kGtsp };
 
 struct OarpOptions final : PlannerOptions {
-  PartitionSolver partition_solver = PartitionSolver::kPushRelabel;  // fastest exact (docs/benchmarks.md §1d)
+  PartitionSolver partition_solver =
+      PartitionSolver::kPushRelabel;  // fastest exact (docs/benchmarks.md §1d)
   TourSolver tour_solver = TourSolver::kGtsp;
   // kFast/kDefault stop by themselves when the search converges (often well
   // within the budget); kThorough keeps improving until the budget is spent.

@@ -13,7 +13,9 @@ absl::StatusOr<RankPartition> LpPartitioner::Partition(const Grid& grid,
                                                        const StopToken& stop) const {
   if (grid.size() == 0) return absl::InvalidArgumentError("grid is empty");
   LinearProgram lp;
-  struct Vars { int xh, xv; };
+  struct Vars {
+    int xh, xv;
+  };
   std::vector<Vars> var(grid.size(), Vars{-1, -1});
   for (int64_t i = 0; i < grid.size(); ++i) {
     if (!grid.free_flags()[i]) continue;

@@ -45,7 +45,8 @@ ConflictGraph BuildConflictGraph(const Grid& grid) {
       if (!grid.Passable(r, c, 0, 1)) continue;
       const int32_t i = static_cast<int32_t>(grid.Index(r, c));
       uint8_t mask = 0;
-      for (int k = r > 0 ? 0 : 2; k < 4; ++k) mask |= static_cast<uint8_t>(is_v[i + g.offset[k]] << k);
+      for (int k = r > 0 ? 0 : 2; k < 4; ++k)
+        mask |= static_cast<uint8_t>(is_v[i + g.offset[k]] << k);
       g.nb[i] = mask;
       g.h_nodes.push_back(i);
     }
@@ -166,8 +167,8 @@ absl::Status HopcroftKarp(const ConflictGraph& g, const StopToken& stop, Matchin
 absl::Status MultiSourceBfsGraft(const ConflictGraph& g, const StopToken& stop, Matching& m) {
   const int64_t n = static_cast<int64_t>(m.mate_h.size());
   std::vector<int32_t> root_of(n, kNone);  // H node: root of its tree (kNone = in no tree)
-  std::vector<int32_t> parent(n, kNone);   // V node: the H node that reached it (kNone = in no tree)
-  std::vector<int32_t> leaf(n, kNone);     // root: the free V node its tree met
+  std::vector<int32_t> parent(n, kNone);  // V node: the H node that reached it (kNone = in no tree)
+  std::vector<int32_t> leaf(n, kNone);    // root: the free V node its tree met
   std::vector<int32_t> frontier, next, tree_v, kept_v, released_v;
   for (int32_t h : g.h_nodes) {
     if (m.mate_h[h] == kNone) root_of[h] = h, frontier.push_back(h);
@@ -289,7 +290,8 @@ absl::Status PothenFan(const ConflictGraph& g, const StopToken& stop, Matching& 
         if (free_v != kNone) {
           stamp_v[free_v] = phase;
           stack_v.push_back(free_v);
-          for (size_t l = 0; l < stack_h.size(); ++l) m.mate_h[stack_h[l]] = stack_v[l], m.mate_v[stack_v[l]] = stack_h[l];
+          for (size_t l = 0; l < stack_h.size(); ++l)
+            m.mate_h[stack_h[l]] = stack_v[l], m.mate_v[stack_v[l]] = stack_h[l];
           ++m.size, any = true;
           break;
         }
@@ -328,7 +330,8 @@ absl::StatusOr<std::vector<uint8_t>> ReachableFromFreeH(const ConflictGraph& g, 
     for (int k = 0; k < 4; ++k) {
       if (!(g.nb[h] >> k & 1)) continue;
       const int32_t w = m.mate_v[h + g.offset[k]];
-      if (w == kNone) return absl::InternalError("matching is not maximum: an augmenting path is left");
+      if (w == kNone)
+        return absl::InternalError("matching is not maximum: an augmenting path is left");
       if (!reached[w]) reached[w] = 1, queue.push_back(w);
     }
   }
@@ -340,7 +343,8 @@ absl::StatusOr<std::vector<uint8_t>> ReachableFromFreeH(const ConflictGraph& g, 
 absl::StatusOr<RankPartition> MatchingPartitioner::Partition(const Grid& grid,
                                                              const StopToken& stop) const {
   if (grid.size() == 0) return absl::InvalidArgumentError("grid is empty");
-  if (grid.size() > INT32_MAX / 2) return absl::InvalidArgumentError("grid too large for the matching");
+  if (grid.size() > INT32_MAX / 2)
+    return absl::InvalidArgumentError("grid too large for the matching");
   const ConflictGraph g = BuildConflictGraph(grid);
   if (g.num_free == 0) return absl::InvalidArgumentError("grid has no free cell");
   if (stop.ShouldStop()) return absl::DeadlineExceededError("partition stopped before matching");
@@ -349,9 +353,10 @@ absl::StatusOr<RankPartition> MatchingPartitioner::Partition(const Grid& grid,
   m.mate_h.assign(grid.size(), kNone);
   m.mate_v.assign(grid.size(), kNone);
   if (greedy_start_) GreedyMatching(g, m);
-  const absl::Status solved = algorithm_ == MatchingAlgorithm::kHopcroftKarp ? HopcroftKarp(g, stop, m)
-                              : algorithm_ == MatchingAlgorithm::kPothenFan ? PothenFan(g, stop, m)
-                                                                            : MultiSourceBfsGraft(g, stop, m);
+  const absl::Status solved =
+      algorithm_ == MatchingAlgorithm::kHopcroftKarp ? HopcroftKarp(g, stop, m)
+      : algorithm_ == MatchingAlgorithm::kPothenFan  ? PothenFan(g, stop, m)
+                                                     : MultiSourceBfsGraft(g, stop, m);
   if (!solved.ok()) return solved;
   absl::StatusOr<std::vector<uint8_t>> z_h = ReachableFromFreeH(g, m);
   if (!z_h.ok()) return z_h.status();
@@ -385,12 +390,14 @@ absl::StatusOr<RankPartition> MatchingPartitioner::Partition(const Grid& grid,
   }
   const int64_t expected_kept = static_cast<int64_t>(g.h_nodes.size()) + g.num_v - m.size;
   if (kept != expected_kept) {
-    return absl::InternalError(absl::StrFormat("König set has %d adjacencies, expected %d", kept, expected_kept));
+    return absl::InternalError(
+        absl::StrFormat("König set has %d adjacencies, expected %d", kept, expected_kept));
   }
 
   std::vector<uint8_t> orientation(grid.size(), 0);
   for (int64_t i = 0; i < grid.size(); ++i) {
-    if (held[i] == 3) return absl::InternalError("König set keeps an H and a V adjacency of one cell");
+    if (held[i] == 3)
+      return absl::InternalError("König set keeps an H and a V adjacency of one cell");
     if (held[i] == 2) orientation[i] = 1;
   }
   return CheckedPartition(grid, std::move(orientation), g.num_free - expected_kept, "matching");

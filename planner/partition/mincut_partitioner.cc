@@ -9,13 +9,12 @@
 #include <boost/property_map/property_map.hpp>
 #include <boost/range/iterator_range.hpp>
 
-
 namespace covplan {
 namespace {
 
-using CsrGraph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property,
-                                                    boost::no_property, boost::no_property,
-                                                    uint32_t, uint32_t>;
+using CsrGraph =
+    boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
+                                       boost::no_property, uint32_t, uint32_t>;
 using Traits = boost::graph_traits<CsrGraph>;
 using EdgeDesc = Traits::edge_descriptor;
 
@@ -24,7 +23,8 @@ constexpr uint32_t kNone = UINT32_MAX;
 // Calls arc(u, v) for every unit-capacity arc of the cut graph
 // (algorithms.md §2); s and t are the terminal node ids.
 template <typename F>
-void ForEachArc(const Grid& grid, const std::vector<uint32_t>& node, uint32_t s, uint32_t t, F&& arc) {
+void ForEachArc(const Grid& grid, const std::vector<uint32_t>& node, uint32_t s, uint32_t t,
+                F&& arc) {
   for (int r = 0; r < grid.rows(); ++r) {
     for (int c = 0; c < grid.cols(); ++c) {
       const uint32_t v = node[grid.Index(r, c)];

@@ -13,10 +13,14 @@ namespace covplan {
 
 std::unique_ptr<RankPartitioner> MakePartitioner(PartitionSolver solver) {
   switch (solver) {
-    case PartitionSolver::kLp: return std::make_unique<LpPartitioner>();
-    case PartitionSolver::kMatching: return std::make_unique<MatchingPartitioner>();
-    case PartitionSolver::kPushRelabel: return std::make_unique<PushRelabelPartitioner>();
-    case PartitionSolver::kMinCut: break;
+    case PartitionSolver::kLp:
+      return std::make_unique<LpPartitioner>();
+    case PartitionSolver::kMatching:
+      return std::make_unique<MatchingPartitioner>();
+    case PartitionSolver::kPushRelabel:
+      return std::make_unique<PushRelabelPartitioner>();
+    case PartitionSolver::kMinCut:
+      break;
   }
   return std::make_unique<MinCutPartitioner>();
 }
@@ -28,8 +32,9 @@ absl::StatusOr<RankPartition> CheckedPartition(const Grid& grid, std::vector<uin
   result.ranks = RanksFromOrientation(grid, result.orientation);
   result.objective = static_cast<double>(optimum);
   if (static_cast<int64_t>(result.ranks.size()) != optimum) {
-    return absl::InternalError(absl::StrFormat("%s: optimum %d disagrees with the %d ranks of its orientation",
-                                               solver, optimum, result.ranks.size()));
+    return absl::InternalError(
+        absl::StrFormat("%s: optimum %d disagrees with the %d ranks of its orientation", solver,
+                        optimum, result.ranks.size()));
   }
   return result;
 }

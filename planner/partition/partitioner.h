@@ -32,7 +32,8 @@ class RankPartitioner {
   virtual std::string_view name() const = 0;
   // InvalidArgument on an empty grid; DeadlineExceeded/Cancelled if `stop`
   // fires (the LP gets the remaining time as its GLPK time limit).
-  virtual absl::StatusOr<RankPartition> Partition(const Grid& grid, const StopToken& stop) const = 0;
+  virtual absl::StatusOr<RankPartition> Partition(const Grid& grid,
+                                                  const StopToken& stop) const = 0;
 };
 
 std::unique_ptr<RankPartitioner> MakePartitioner(PartitionSolver solver);

@@ -22,7 +22,9 @@ constexpr uint8_t kArcCol = 1, kArcRow = 2, kSink = 4, kFlowCol = 8, kFlowRow = 
 enum Residual : int8_t { kNone = -1, kForwardCol, kForwardRow, kBackRow, kBackCol };
 constexpr uint32_t kPollMask = (1u << 14) - 1;  // poll the stop token every 16,384 steps
 
-absl::Status Stopped() { return absl::DeadlineExceededError("partition stopped during push-relabel"); }
+absl::Status Stopped() {
+  return absl::DeadlineExceededError("partition stopped during push-relabel");
+}
 
 class GridFlow {
  public:
@@ -163,17 +165,21 @@ class GridFlow {
     for (int32_t i = 0; i < n_; ++i) {
       const uint8_t s = state_[i];
       if (((s & kFlowCol) && !(s & kArcCol)) || ((s & kFlowRow) && !(s & kArcRow))) {
-        return absl::InternalError(absl::StrFormat("push-relabel: flow on a missing arc at cell %d", i));
+        return absl::InternalError(
+            absl::StrFormat("push-relabel: flow on a missing arc at cell %d", i));
       }
       if ((s & kSinkUsed) && !(s & kSink)) {
-        return absl::InternalError(absl::StrFormat("push-relabel: flow to t from a non-sink cell %d", i));
+        return absl::InternalError(
+            absl::StrFormat("push-relabel: flow to t from a non-sink cell %d", i));
       }
       sinks_used += (s & kSinkUsed) != 0;
       const int in = ((s & kSource) ? 1 : 0) + (i > 0 && (state_[i - 1] & kFlowCol) ? 1 : 0) +
                      (i >= cols_ && (state_[i - cols_] & kFlowRow) ? 1 : 0);
-      const int out = ((s & kFlowCol) ? 1 : 0) + ((s & kFlowRow) ? 1 : 0) + ((s & kSinkUsed) ? 1 : 0);
+      const int out =
+          ((s & kFlowCol) ? 1 : 0) + ((s & kFlowRow) ? 1 : 0) + ((s & kSinkUsed) ? 1 : 0);
       if (excess_[i] < 0 || in - out != excess_[i]) {
-        return absl::InternalError(absl::StrFormat("push-relabel: flow not conserved at cell %d", i));
+        return absl::InternalError(
+            absl::StrFormat("push-relabel: flow not conserved at cell %d", i));
       }
     }
     if (sinks_used != flow_) {
@@ -251,11 +257,20 @@ class GridFlow {
   int32_t Push(int32_t u, Residual arc) {
     int32_t v = u;
     switch (arc) {
-      case kForwardCol: v = u + 1, state_[u] |= kFlowCol; break;
-      case kForwardRow: v = u + cols_, state_[u] |= kFlowRow; break;
-      case kBackRow: v = u - cols_, state_[v] &= static_cast<uint8_t>(~kFlowRow); break;
-      case kBackCol: v = u - 1, state_[v] &= static_cast<uint8_t>(~kFlowCol); break;
-      case kNone: return u;
+      case kForwardCol:
+        v = u + 1, state_[u] |= kFlowCol;
+        break;
+      case kForwardRow:
+        v = u + cols_, state_[u] |= kFlowRow;
+        break;
+      case kBackRow:
+        v = u - cols_, state_[v] &= static_cast<uint8_t>(~kFlowRow);
+        break;
+      case kBackCol:
+        v = u - 1, state_[v] &= static_cast<uint8_t>(~kFlowCol);
+        break;
+      case kNone:
+        return u;
     }
     --excess_[u], ++excess_[v];
     return v;
@@ -313,7 +328,8 @@ class GridFlow {
 namespace push_relabel_internal {
 
 absl::Status AuditDamagedFlow(const Grid& grid, FlowDamage damage) {
-  if (grid.size() == 0 || grid.CountFree() == 0) return absl::FailedPreconditionError("no free cell");
+  if (grid.size() == 0 || grid.CountFree() == 0)
+    return absl::FailedPreconditionError("no free cell");
   GridFlow flow(grid);
   RETURN_IF_ERROR(flow.MaxPreflow(StopToken()).status());
   if (!flow.Damage(damage)) return absl::FailedPreconditionError("no cell to damage");
@@ -325,8 +341,10 @@ absl::Status AuditDamagedFlow(const Grid& grid, FlowDamage damage) {
 absl::StatusOr<RankPartition> PushRelabelPartitioner::Partition(const Grid& grid,
                                                                 const StopToken& stop) const {
   if (grid.size() == 0) return absl::InvalidArgumentError("grid is empty");
-  if (grid.size() > INT32_MAX / 2) return absl::InvalidArgumentError("grid too large for push-relabel");
-  if (stop.ShouldStop()) return absl::DeadlineExceededError("partition stopped before push-relabel");
+  if (grid.size() > INT32_MAX / 2)
+    return absl::InvalidArgumentError("grid too large for push-relabel");
+  if (stop.ShouldStop())
+    return absl::DeadlineExceededError("partition stopped before push-relabel");
   GridFlow flow(grid);
   if (flow.free_cells() == 0) return absl::InvalidArgumentError("grid has no free cell");
   ASSIGN_OR_RETURN(const int64_t value, flow.MaxPreflow(stop));

@@ -26,9 +26,10 @@ struct Rank {
 
 // An orientation per free cell plus the ranks it induces.
 struct RankPartition {
-  std::vector<uint8_t> orientation;  // per grid cell (Grid::Index); 0 = H, 1 = V; ignored for blocked cells
+  std::vector<uint8_t>
+      orientation;  // per grid cell (Grid::Index); 0 = H, 1 = V; ignored for blocked cells
   std::vector<Rank> ranks;
-  double objective = 0.0;            // optimum reported by the solver (== ranks.size())
+  double objective = 0.0;  // optimum reported by the solver (== ranks.size())
 
   size_t MemoryBytes() const {
     return sizeof(*this) + orientation.capacity() + ranks.capacity() * sizeof(Rank);

@@ -1,6 +1,5 @@
 #include "planner/plan/coverage_plan.h"
 
-
 namespace covplan {
 
 const char* TerminationReasonName(TerminationReason r) {

@@ -22,11 +22,11 @@
 namespace covplan {
 
 enum class SegmentKind : uint8_t {
-  kStart = 0,       // first waypoint; no segment ends here
-  kCoverage = 1,    // the straight segment ending here sweeps new cells
-  kTransition = 2,  // the segment ending here moves without sweeping new cells
-  kToStation = 3,   // drives to a service station (battery-split tours)
-  kFromStation = 4, // drives back from a service station to resume
+  kStart = 0,        // first waypoint; no segment ends here
+  kCoverage = 1,     // the straight segment ending here sweeps new cells
+  kTransition = 2,   // the segment ending here moves without sweeping new cells
+  kToStation = 3,    // drives to a service station (battery-split tours)
+  kFromStation = 4,  // drives back from a service station to resume
 };
 
 struct Waypoint {
@@ -83,8 +83,8 @@ const char* PlanOriginName(PlanOrigin s);  // "cold", "cache_hit", "improved", "
 // Statistics every planner fills (the engine computes the path-derived ones
 // from the waypoints, so they agree with the path by construction).
 struct PlanStats {
-  int64_t num_ranks = 0;            // OARP: ranks; other planners: coverage segments
-  int64_t num_turns = 0;            // heading changes > 1e-6 rad along the path
+  int64_t num_ranks = 0;  // OARP: ranks; other planners: coverage segments
+  int64_t num_turns = 0;  // heading changes > 1e-6 rad along the path
   double coverage_length_m = 0.0;
   double transition_length_m = 0.0;
   double covered_free_area_ratio = 0.0;
@@ -110,8 +110,8 @@ struct PlanStats {
   double partition_ms = 0.0;
   double transitions_ms = 0.0;
   double tour_ms = 0.0;
-  bool tour_cut_short = false;  // kept for old callers: termination.limit_reached()
-  bool decomposition_cached = false;  // every per-map artifact came from the cache
+  bool tour_cut_short = false;                 // kept for old callers: termination.limit_reached()
+  bool decomposition_cached = false;           // every per-map artifact came from the cache
   PlanOrigin plan_source = PlanOrigin::kCold;  // set by the engine
   std::string partition_solver;
   std::string tour_solver;
@@ -119,7 +119,8 @@ struct PlanStats {
   int64_t charge_cycles = 0;
   double energy_total = 0.0;          // sum over the cycles
   double energy_unconstrained = 0.0;  // the same tour from the station and back, no charges
-  double energy_lower_bound = 0.0;    // unconstrained + the return legs no split avoids (see charge_cycles.h)
+  double energy_lower_bound =
+      0.0;  // unconstrained + the return legs no split avoids (see charge_cycles.h)
 };
 
 // One charge cycle of a battery plan: path[first_waypoint] and
@@ -131,9 +132,9 @@ struct ChargeCycle {
   int last_waypoint = 0;
   int resume_waypoint = 0;
   int leave_waypoint = 0;
-  double energy = 0.0;        // the whole cycle, station to station
-  double energy_at_leave = 0.0;  // used when leaving for the station
-  int resume_unit = -1;       // tag (Waypoint::rank) of the unit work resumes in
+  double energy = 0.0;            // the whole cycle, station to station
+  double energy_at_leave = 0.0;   // used when leaving for the station
+  int resume_unit = -1;           // tag (Waypoint::rank) of the unit work resumes in
   bool resumes_mid_unit = false;  // the previous cycle left this unit unfinished
 };
 
@@ -145,8 +146,8 @@ class PlannerDetail {
 };
 
 struct CoveragePlan {
-  std::string planner;              // registered name, e.g. "oarp"
-  std::shared_ptr<const Grid> grid; // the grid the path was planned on (drive grid)
+  std::string planner;               // registered name, e.g. "oarp"
+  std::shared_ptr<const Grid> grid;  // the grid the path was planned on (drive grid)
   std::vector<Waypoint> path;
   std::vector<CoverageSweep> sweeps;  // one per coverage segment, in path order
   std::vector<ChargeCycle> cycles;    // battery plans only, in path order

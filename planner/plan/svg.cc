@@ -37,8 +37,10 @@ void AppendRuns(std::string* out, int rows, int cols, double x0, double y0, doub
 void AppendPolygons(std::string* out, const std::vector<PolygonInput>& polygons, const char* fill,
                     const char* stroke, double stroke_width) {
   if (polygons.empty()) return;
-  absl::StrAppendFormat(out, "<g fill=\"%s\" fill-opacity=\"0.35\" fill-rule=\"evenodd\" stroke=\"%s\" "
-                             "stroke-width=\"%.4f\">\n", fill, stroke, stroke_width);
+  absl::StrAppendFormat(out,
+                        "<g fill=\"%s\" fill-opacity=\"0.35\" fill-rule=\"evenodd\" stroke=\"%s\" "
+                        "stroke-width=\"%.4f\">\n",
+                        fill, stroke, stroke_width);
   for (const PolygonInput& p : polygons) {
     absl::StrAppend(out, "<path d=\"");
     auto ring = [&](const std::vector<Point2>& pts) {
@@ -54,7 +56,8 @@ void AppendPolygons(std::string* out, const std::vector<PolygonInput>& polygons,
   absl::StrAppend(out, "</g>\n");
 }
 
-std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, const SvgZones& zones) {
+std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map,
+                          const SvgZones& zones) {
   const Grid& grid = *plan.grid;
   const double s = grid.cell_size();
   const Point2 o = grid.origin();
@@ -71,8 +74,9 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
                         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
                         "viewBox=\"%.4f %.4f %.4f %.4f\">\n",
                         w * px_per_m, (h + legend_h) * px_per_m, o.x, -legend_h, w, h + legend_h);
-  absl::StrAppendFormat(&out, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" fill=\"#ffffff\"/>\n",
-                        o.x, -legend_h, w, h + legend_h);
+  absl::StrAppendFormat(
+      &out, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" fill=\"#ffffff\"/>\n", o.x,
+      -legend_h, w, h + legend_h);
   // Map frame: y up. Flip about the map's vertical extent.
   absl::StrAppendFormat(&out, "<g transform=\"matrix(1 0 0 -1 0 %.4f)\">\n", h + 2 * o.y);
   AppendRuns(&out, grid.rows(), grid.cols(), o.x, o.y, s, "#e3ecf7",
@@ -89,8 +93,9 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
   AppendPolygons(&out, zones.no_go, "#e03131", "#a61e1e", 0.08 * s);
   // Coverage segments, coloured by direction (horizontal / vertical sweeps),
   // or, in battery plans, by charge cycle (station legs dotted, same colour).
-  static constexpr const char* kCycleColours[] = {"#e6194b", "#3cb44b", "#4363d8", "#f58231", "#911eb4",
-                                                  "#42d4f4", "#f032e6", "#9a6324", "#469990", "#808000"};
+  static constexpr const char* kCycleColours[] = {"#e6194b", "#3cb44b", "#4363d8", "#f58231",
+                                                  "#911eb4", "#42d4f4", "#f032e6", "#9a6324",
+                                                  "#469990", "#808000"};
   std::vector<int> cycle_of(plan.path.size(), -1);
   for (size_t c = 0; c < plan.cycles.size(); ++c) {
     for (int w = plan.cycles[c].first_waypoint + 1; w <= plan.cycles[c].last_waypoint; ++w) {
@@ -98,21 +103,27 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
     }
   }
   const double stroke = 0.55 * s;
-  absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-linecap=\"round\" fill=\"none\">\n", stroke);
+  absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-linecap=\"round\" fill=\"none\">\n",
+                        stroke);
   for (size_t i = 1; i < plan.path.size(); ++i) {
     const Waypoint& a = plan.path[i - 1];
     const Waypoint& b = plan.path[i];
     if (b.kind != SegmentKind::kCoverage) continue;
     const bool horizontal = std::abs(b.y - a.y) <= std::abs(b.x - a.x);
-    const char* color = cycle_of[i] >= 0 ? kCycleColours[cycle_of[i] % 10] : horizontal ? "#f08c2e" : "#8e44ad";
-    absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\" stroke-opacity=\"0.8\"/>\n",
+    const char* color = cycle_of[i] >= 0 ? kCycleColours[cycle_of[i] % 10]
+                        : horizontal     ? "#f08c2e"
+                                         : "#8e44ad";
+    absl::StrAppendFormat(&out,
+                          "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\" "
+                          "stroke-opacity=\"0.8\"/>\n",
                           a.x, a.y, b.x, b.y, color);
   }
   absl::StrAppend(&out, "</g>\n");
   // Transitions as dashed polylines.
-  absl::StrAppendFormat(&out,
-                        "<g stroke=\"#1f8a5b\" stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" fill=\"none\">\n",
-                        0.12 * s, 0.3 * s, 0.2 * s);
+  absl::StrAppendFormat(
+      &out,
+      "<g stroke=\"#1f8a5b\" stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" fill=\"none\">\n",
+      0.12 * s, 0.3 * s, 0.2 * s);
   for (size_t i = 1; i < plan.path.size(); ++i) {
     if (plan.path[i].kind != SegmentKind::kTransition) continue;
     absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\"/>\n",
@@ -120,22 +131,28 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
   }
   absl::StrAppend(&out, "</g>\n");
   if (!plan.cycles.empty()) {
-    absl::StrAppendFormat(&out, "<g stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" fill=\"none\">\n",
-                          0.15 * s, 0.1 * s, 0.25 * s);
+    absl::StrAppendFormat(
+        &out, "<g stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" fill=\"none\">\n", 0.15 * s,
+        0.1 * s, 0.25 * s);
     for (size_t i = 1; i < plan.path.size(); ++i) {
       const SegmentKind k = plan.path[i].kind;
-      if ((k != SegmentKind::kToStation && k != SegmentKind::kFromStation) || cycle_of[i] < 0) continue;
-      absl::StrAppendFormat(&out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\"/>\n",
-                            plan.path[i - 1].x, plan.path[i - 1].y, plan.path[i].x, plan.path[i].y,
-                            kCycleColours[cycle_of[i] % 10]);
+      if ((k != SegmentKind::kToStation && k != SegmentKind::kFromStation) || cycle_of[i] < 0)
+        continue;
+      absl::StrAppendFormat(
+          &out, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"%s\"/>\n",
+          plan.path[i - 1].x, plan.path[i - 1].y, plan.path[i].x, plan.path[i].y,
+          kCycleColours[cycle_of[i] % 10]);
     }
     absl::StrAppend(&out, "</g>\n");
   }
   if (!plan.path.empty()) {
     const Waypoint& st = plan.path.front();
     const Waypoint& en = plan.path.back();
-    absl::StrAppendFormat(&out, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"#1aa33a\"/>\n", st.x, st.y, 0.45 * s);
-    absl::StrAppendFormat(&out, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"%.4f\"/>\n",
+    absl::StrAppendFormat(&out, "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"#1aa33a\"/>\n",
+                          st.x, st.y, 0.45 * s);
+    absl::StrAppendFormat(&out,
+                          "<circle cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"none\" "
+                          "stroke=\"#d62728\" stroke-width=\"%.4f\"/>\n",
                           en.x, en.y, 0.6 * s, 0.15 * s);
   }
   absl::StrAppend(&out, "</g>\n");
@@ -153,14 +170,17 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map, con
   const double fs = std::min(0.45 * legend_h, (w - 0.4) / (0.56 * chars));
   const std::string sweeps_legend =
       plan.cycles.empty()
-          ? std::string("<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
-                        "<tspan fill=\"#8e44ad\">vertical ranks</tspan>")
-          : absl::StrFormat("<tspan fill=\"#e6194b\">%d charge cycles</tspan> (colours; station legs dotted)",
-                            static_cast<int>(plan.cycles.size()));
+          ? std::string(
+                "<tspan fill=\"#f08c2e\">horizontal ranks</tspan> · "
+                "<tspan fill=\"#8e44ad\">vertical ranks</tspan>")
+          : absl::StrFormat(
+                "<tspan fill=\"#e6194b\">%d charge cycles</tspan> (colours; station legs dotted)",
+                static_cast<int>(plan.cycles.size()));
   absl::StrAppendFormat(&out,
                         "<text x=\"%.4f\" y=\"%.4f\" font-family=\"sans-serif\" font-size=\"%.4f\">"
                         "%s · <tspan fill=\"#1f8a5b\">transitions</tspan>%s%s</text>\n",
-                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), sweeps_legend, summary, zone_legend);
+                        o.x + 0.2, -0.35 * legend_h, std::max(fs, 1e-3), sweeps_legend, summary,
+                        zone_legend);
   absl::StrAppend(&out, "</svg>\n");
   return out;
 }

@@ -120,8 +120,8 @@ struct Affine {
 // orientation splits their line into two ranks (only ever chosen to keep two
 // touching old ranks under a budget). m = ½Σy = |W| - Σq.
 struct BaseModel {
-  std::vector<int> x;                    // column per grid cell; -1 outside W
-  std::vector<std::array<int, 4>> link;  // q column behind each slot; -1 at a border
+  std::vector<int> x;                       // column per grid cell; -1 outside W
+  std::vector<std::array<int, 4>> link;     // q column behind each slot; -1 at a border
   Affine X(int64_t cell, int slot) const {  // x_H for L/R, x_V for B/T
     Affine a;
     if (IsVerticalSlot(slot)) a.constant = 1.0;
@@ -188,7 +188,7 @@ void ForEachRun(const Grid& w, Orientation o, F f) {
 
 struct Built {
   BaseModel base;
-  Affine new_ranks;  // m_new (ILP-1) or α + β/2 (ILP-2)
+  Affine new_ranks;                     // m_new (ILP-1) or α + β/2 (ILP-2)
   std::vector<std::pair<int, Rank>> z;  // ILP-1: column and the rank it stands for
 };
 
@@ -196,7 +196,8 @@ struct Built {
 // Σ_i z_ij = y_end(j); m_new = Σ(1 - z̄)z.
 Built BuildIlp1(const Grid& w, const std::set<RankKey>& old_in_w, double eps, LinearProgram& lp) {
   Built b;
-  b.base = AddBaseModel(w, [](int64_t, int) { return 0.5; }, lp);
+  b.base = AddBaseModel(
+      w, [](int64_t, int) { return 0.5; }, lp);
   for (Orientation o : {Orientation::kHorizontal, Orientation::kVertical}) {
     const int start_slot = o == Orientation::kHorizontal ? kLeft : kBottom;
     const int end_slot = o == Orientation::kHorizontal ? kRight : kTop;
@@ -356,9 +357,9 @@ absl::StatusOr<RankReplanResult> RankReplan(const RankReplanInput& input, RankRe
 
   absl::StatusOr<LpSolution> sol = SolveWithin(lp, stop, out);
   if (absl::IsFailedPrecondition(sol.status())) {
-    return absl::FailedPreconditionError(absl::StrFormat(
-        "%s: no rank partition of W within a budget of %d new ranks (%s)", ilp1 ? "ILP-1" : "ILP-2",
-        input.budget, sol.status().message()));
+    return absl::FailedPreconditionError(
+        absl::StrFormat("%s: no rank partition of W within a budget of %d new ranks (%s)",
+                        ilp1 ? "ILP-1" : "ILP-2", input.budget, sol.status().message()));
   }
   if (!sol.ok()) return sol.status();
 

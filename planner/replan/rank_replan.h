@@ -61,7 +61,7 @@ struct RankReplanInput {
 };
 
 struct RankReplanResult {
-  std::vector<Rank> ranks;  // exact cover of W's free cells by straight ranks
+  std::vector<Rank> ranks;   // exact cover of W's free cells by straight ranks
   std::vector<bool> is_new;  // per rank: not identical (orientation and ends) to an old rank
   int64_t num_new = 0;       // true count (CountNewRanks), always <= budget
   // ILP-2 only: the bound α + β/2 of the solution (>= num_new); ILP-1: == num_new.

@@ -33,8 +33,8 @@ absl::StatusOr<Located> Locate(const CoveragePlan& plan, const RobotProgress& pr
   if (progress.distance_m.has_value()) {
     const double d = *progress.distance_m;
     if (!std::isfinite(d) || d < 0.0) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "progress.distance_m must be a finite distance >= 0, got %g", d));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("progress.distance_m must be a finite distance >= 0, got %g", d));
     }
     double cum = 0.0;
     for (int i = 1; i < n; ++i) {
@@ -58,7 +58,8 @@ absl::StatusOr<Located> Locate(const CoveragePlan& plan, const RobotProgress& pr
           progress.waypoint, n - 1));
     }
     if (!progress.position.has_value() || !Finite(*progress.position)) {
-      return absl::InvalidArgumentError("progress.position: a finite x, y is required with progress.waypoint");
+      return absl::InvalidArgumentError(
+          "progress.position: a finite x, y is required with progress.waypoint");
     }
     const Waypoint& a = path[progress.waypoint - 1];
     const Waypoint& b = path[progress.waypoint];
@@ -79,7 +80,8 @@ absl::StatusOr<Located> Locate(const CoveragePlan& plan, const RobotProgress& pr
   const Waypoint& a = path[at.segment - 1];
   const Waypoint& b = path[at.segment];
   at.at = Lerp({a.x, a.y}, {b.x, b.y}, at.t);
-  at.heading = std::hypot(b.x - a.x, b.y - a.y) > kMinSegmentM ? std::atan2(b.y - a.y, b.x - a.x) : b.theta;
+  at.heading =
+      std::hypot(b.x - a.x, b.y - a.y) > kMinSegmentM ? std::atan2(b.y - a.y, b.x - a.x) : b.theta;
   return at;
 }
 
@@ -91,15 +93,16 @@ absl::StatusOr<std::vector<uint8_t>> BlockedCells(const Grid& drive, const Obser
   for (size_t k = 0; k < obs.cells.size(); ++k) {
     const CellIndex c = obs.cells[k];
     if (!drive.InBounds(c.row, c.col)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "obstacles.cells[%d] (%d, %d) lies outside the %d x %d grid", k, c.row, c.col,
-          drive.rows(), drive.cols()));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("obstacles.cells[%d] (%d, %d) lies outside the %d x %d grid", k, c.row,
+                          c.col, drive.rows(), drive.cols()));
     }
     block(c.row, c.col);
   }
   for (size_t k = 0; k < obs.points.size(); ++k) {
     if (!Finite(obs.points[k])) {
-      return absl::InvalidArgumentError(absl::StrFormat("obstacles.points[%d] is not a finite point", k));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("obstacles.points[%d] is not a finite point", k));
     }
     const CellIndex c = drive.CellAt(obs.points[k]);
     if (drive.InBounds(c.row, c.col)) block(c.row, c.col);  // points off the map are ignored
@@ -157,8 +160,8 @@ std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
   return legs;
 }
 
-Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs, Point2 robot,
-                double heading) {
+Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs,
+                Point2 robot, double heading) {
   // A cell the walk must not touch: free on the old drive grid, not on the
   // new one (a new obstacle, or cut off by one). Cells that were never free
   // (a dock's cell, which the old path left by its join move) stay open.
@@ -171,12 +174,14 @@ Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>
   w.path.push_back({robot.x, robot.y, heading, SegmentKind::kStart, -1});
   Point2 cursor = robot;
   double cur_heading = heading;
-  auto emit = [&](Point2 to, SegmentKind kind, std::vector<CellIndex> cells, double axis, int tag = -1) {
+  auto emit = [&](Point2 to, SegmentKind kind, std::vector<CellIndex> cells, double axis,
+                  int tag = -1) {
     const double dx = to.x - cursor.x, dy = to.y - cursor.y;
     const bool moves = std::hypot(dx, dy) >= kMinSegmentM;
     if (kind == SegmentKind::kCoverage) {
-      cells.erase(std::remove_if(cells.begin(), cells.end(), [&](CellIndex c) { return !drive.IsFree(c); }),
-                  cells.end());
+      cells.erase(
+          std::remove_if(cells.begin(), cells.end(), [&](CellIndex c) { return !drive.IsFree(c); }),
+          cells.end());
       if (cells.empty() && !moves) return;
       if (cells.empty()) kind = SegmentKind::kTransition;
     } else if (!moves) {
@@ -207,8 +212,9 @@ Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>
   // the trip to or from the station goes on, only around the obstacle).
   auto detour = [&](Point2 from, Point2 to, SegmentKind rejoined) {
     const SegmentKind kind =
-        rejoined == SegmentKind::kToStation || rejoined == SegmentKind::kFromStation ? rejoined
-                                                                                      : SegmentKind::kTransition;
+        rejoined == SegmentKind::kToStation || rejoined == SegmentKind::kFromStation
+            ? rejoined
+            : SegmentKind::kTransition;
     const CellIndex a = join(from), b = join(to);
     search.Run(a, StopToken());
     std::vector<CellIndex> corners = search.PathTo(b);
@@ -222,7 +228,8 @@ Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>
   for (size_t j = 0; j < legs.size(); ++j) {
     const Leg& leg = legs[j];
     const double len = std::hypot(leg.b.x - leg.a.x, leg.b.y - leg.a.y);
-    const double axis = len >= kMinSegmentM ? std::atan2(leg.b.y - leg.a.y, leg.b.x - leg.a.x) : cur_heading;
+    const double axis =
+        len >= kMinSegmentM ? std::atan2(leg.b.y - leg.a.y, leg.b.x - leg.a.x) : cur_heading;
     const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
     double run_start = 0.0, last_free_t = 0.0;
     Point2 prev = leg.a;
@@ -241,9 +248,11 @@ Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>
           continue;
         }
         // Entering a blocked stretch: drive up to the last free point.
-        emit(Lerp(leg.a, leg.b, last_free_t), leg.kind, part_cells(leg, run_start, last_free_t), axis);
+        emit(Lerp(leg.a, leg.b, last_free_t), leg.kind, part_cells(leg, run_start, last_free_t),
+             axis);
         last_free = cursor;
-        w.at_encounter.push_back({w.path.size(), w.sweeps.size(), cursor, cur_heading, static_cast<int>(j)});
+        w.at_encounter.push_back(
+            {w.path.size(), w.sweeps.size(), cursor, cur_heading, static_cast<int>(j)});
         blocked = true;
       } else if (open && drive.IsFree(cell)) {
         // Out of it (drive' is one component: every free cell is reachable).

@@ -30,8 +30,8 @@ struct Leg {
 };
 
 struct Located {
-  int segment = 1;   // the old segment path[segment - 1] -> path[segment]
-  double t = 0.0;    // position on it, 0..1
+  int segment = 1;  // the old segment path[segment - 1] -> path[segment]
+  double t = 0.0;   // position on it, 0..1
   Point2 at;
   double heading = 0.0;
 };
@@ -65,21 +65,21 @@ struct Walk {
     double heading = 0.0;
     int leg = -1;
   };
-  std::vector<Waypoint> path;        // from the robot
+  std::vector<Waypoint> path;  // from the robot
   std::vector<CoverageSweep> sweeps;
-  std::vector<uint8_t> swept;        // per cell
-  int encounters = 0;                // blocked stretches met
-  bool stopped = false;              // a prefix: stops at an encounter
+  std::vector<uint8_t> swept;  // per cell
+  int encounters = 0;          // blocked stretches met
+  bool stopped = false;        // a prefix: stops at an encounter
   Point2 end;
   double end_heading = 0.0;
-  int end_leg = -1;                  // leg where the walk ends
+  int end_leg = -1;  // leg where the walk ends
   std::vector<Snapshot> at_encounter;
 
   // The walk up to (not into) encounter k.
   Walk Prefix(int k, const Grid& drive) const;
 };
-Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs, Point2 robot,
-                double heading);
+Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs,
+                Point2 robot, double heading);
 
 }  // namespace covplan::replan_internal
 

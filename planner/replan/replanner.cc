@@ -82,13 +82,16 @@ std::vector<PolylineElement> TourElements(const Context& c, const Walk& walk,
   for (size_t r = 0; r < ranks.size(); ++r) {
     if (is_new[r]) continue;
     const Rank& k = ranks[r];
-    kept[{static_cast<int>(k.orientation), k.first.row, k.first.col, k.last.row, k.last.col}] = static_cast<int>(r);
+    kept[{static_cast<int>(k.orientation), k.first.row, k.first.col, k.last.row, k.last.col}] =
+        static_cast<int>(r);
   }
   auto kept_index = [&](int old_segment) -> int {
     const int tag = old.path[old_segment].rank;
-    if (c.old_oarp == nullptr || tag < 0 || tag >= static_cast<int>(c.old_oarp->ranks.size())) return -1;
+    if (c.old_oarp == nullptr || tag < 0 || tag >= static_cast<int>(c.old_oarp->ranks.size()))
+      return -1;
     const Rank& k = c.old_oarp->ranks[tag];
-    auto it = kept.find({static_cast<int>(k.orientation), k.first.row, k.first.col, k.last.row, k.last.col});
+    auto it = kept.find(
+        {static_cast<int>(k.orientation), k.first.row, k.first.col, k.last.row, k.last.col});
     return it == kept.end() ? -1 : it->second;
   };
   const Grid& old_drive = *c.old->area->drive;
@@ -120,7 +123,8 @@ std::vector<PolylineElement> TourElements(const Context& c, const Walk& walk,
       piece.kind = TourElementKind::kPathPiece;
       double len = 0;
       for (size_t k = 1; k < piece.points.size(); ++k) {
-        len += std::hypot(piece.points[k].x - piece.points[k - 1].x, piece.points[k].y - piece.points[k - 1].y);
+        len += std::hypot(piece.points[k].x - piece.points[k - 1].x,
+                          piece.points[k].y - piece.points[k - 1].y);
       }
       ++stats->kept_path_pieces;
       stats->kept_path_m += len;
@@ -146,7 +150,8 @@ std::vector<PolylineElement> TourElements(const Context& c, const Walk& walk,
     piece.points.push_back({wb.x, wb.y});
     piece.kinds.push_back(wb.kind);
     auto sw = sweep_at.find(i);
-    piece.sweeps.push_back(coverage && sw != sweep_at.end() ? sw->second->cells : std::vector<CellIndex>{});
+    piece.sweeps.push_back(coverage && sw != sweep_at.end() ? sw->second->cells
+                                                            : std::vector<CellIndex>{});
     piece.tags.push_back(coverage ? r : -1);
     if (coverage) {
       used[r] = true;
@@ -165,11 +170,16 @@ std::vector<PolylineElement> TourElements(const Context& c, const Walk& walk,
 
 const char* ReplanMethodName(ReplanMethod m) {
   switch (m) {
-    case ReplanMethod::kAuto: return "auto";
-    case ReplanMethod::kIlp1: return "ilp1";
-    case ReplanMethod::kIlp2: return "ilp2";
-    case ReplanMethod::kGreedyDetour: return "greedy_detour";
-    case ReplanMethod::kFull: return "full";
+    case ReplanMethod::kAuto:
+      return "auto";
+    case ReplanMethod::kIlp1:
+      return "ilp1";
+    case ReplanMethod::kIlp2:
+      return "ilp2";
+    case ReplanMethod::kGreedyDetour:
+      return "greedy_detour";
+    case ReplanMethod::kFull:
+      return "full";
   }
   return "unknown";
 }
@@ -177,8 +187,8 @@ const char* ReplanMethodName(ReplanMethod m) {
 namespace {
 
 // Appends transitions from `from` to `to` over `drive` (false when stopped).
-absl::StatusOr<bool> AppendRoute(const Grid& drive, Point2 from, const Pose2& to, const StopToken& stop,
-                                 std::vector<Waypoint>* path) {
+absl::StatusOr<bool> AppendRoute(const Grid& drive, Point2 from, const Pose2& to,
+                                 const StopToken& stop, std::vector<Waypoint>* path) {
   if (std::hypot(from.x - to.x, from.y - to.y) < kMinSegmentM) return true;
   ASSIGN_OR_RETURN(CellIndex a, JoinCell(drive, Pose2{from.x, from.y, 0}, "start"));
   ASSIGN_OR_RETURN(CellIndex b, JoinCell(drive, to, "end"));
@@ -227,8 +237,8 @@ absl::StatusOr<bool> TourReplan(const Context& c, const Walk& walk, const std::v
   out->stats.transitions_ms = model->transitions_ms();
   const absl::Time t1 = absl::Now();
   OrdererOptions oo;
-  oo.time_limit_s = std::max(1e-3, std::min(options.tour_time_limit_s,
-                                            tour_budget_s - absl::ToDoubleSeconds(t1 - t0)));
+  oo.time_limit_s = std::max(
+      1e-3, std::min(options.tour_time_limit_s, tour_budget_s - absl::ToDoubleSeconds(t1 - t0)));
   oo.seed = options.seed;
   oo.num_threads = options.num_threads;
   absl::StatusOr<TourOrder> order = GtspOrderer(oo).Order(*model, stop);
@@ -264,10 +274,11 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
         return w.kind == SegmentKind::kToStation || w.kind == SegmentKind::kFromStation;
       });
   if (battery_plan && options.method != ReplanMethod::kGreedyDetour) {
-    return absl::FailedPreconditionError(absl::StrFormat(
-        "a battery plan (charge cycles) can only be replanned with method greedy_detour, got %s: the other "
-        "methods would drop its station legs; plan again with the battery",
-        ReplanMethodName(options.method)));
+    return absl::FailedPreconditionError(
+        absl::StrFormat("a battery plan (charge cycles) can only be replanned with method "
+                        "greedy_detour, got %s: the other "
+                        "methods would drop its station legs; plan again with the battery",
+                        ReplanMethodName(options.method)));
   }
   Context c;
   c.old = &old;
@@ -280,15 +291,18 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   // Probed a hair behind the robot along its segment: a robot exactly on a
   // cell border stands in the cell it came from, not in the one ahead (which
   // a new obstacle may block).
-  const Point2 probe{c.at.at.x - 1e-6 * std::cos(c.at.heading), c.at.at.y - 1e-6 * std::sin(c.at.heading)};
+  const Point2 probe{c.at.at.x - 1e-6 * std::cos(c.at.heading),
+                     c.at.at.y - 1e-6 * std::sin(c.at.heading)};
   absl::StatusOr<CellIndex> joined = JoinCell(old_drive, Pose2{probe.x, probe.y, 0}, "robot");
   if (!joined.ok()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "progress: the robot at (%.3f, %.3f) is neither in nor next to a free cell of the plan's grid",
-        c.at.at.x, c.at.at.y));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("progress: the robot at (%.3f, %.3f) is neither in nor next to a free cell "
+                        "of the plan's grid",
+                        c.at.at.x, c.at.at.y));
   }
   const CellIndex robot_cell = *joined;
-  ASSIGN_OR_RETURN(std::vector<uint8_t> blocked, replan_internal::BlockedCells(old_drive, observations));
+  ASSIGN_OR_RETURN(std::vector<uint8_t> blocked,
+                   replan_internal::BlockedCells(old_drive, observations));
   std::vector<uint8_t> covered;
   c.legs = replan_internal::RemainingLegs(old.plan, c.at, &covered);
   const Waypoint& last = old.plan.path.back();
@@ -394,7 +408,8 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
   // The call's own deadline, less the time kept for building the reply.
   const StopToken call_stop =
       options.stop.has_deadline()
-          ? options.stop.WithEarlierDeadline(options.stop.deadline() - absl::Seconds(options.safety_margin_s))
+          ? options.stop.WithEarlierDeadline(options.stop.deadline() -
+                                             absl::Seconds(options.safety_margin_s))
           : options.stop;
 
   if (options.method == ReplanMethod::kGreedyDetour || whole.encounters == 0) {
@@ -429,7 +444,8 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
     const std::vector<bool> all_new(ranks.size(), true);
     bool done = false;
     if (!call_stop.ShouldStop() && !(ranks.empty() && st.remaining_cells > 0)) {
-      ASSIGN_OR_RETURN(done, TourReplan(c, at_robot, ranks, all_new, options, call_stop, 30.0, &out));
+      ASSIGN_OR_RETURN(done,
+                       TourReplan(c, at_robot, ranks, all_new, options, call_stop, 30.0, &out));
     }
     if (!done) greedy();
   } else {
@@ -443,8 +459,10 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
       st.kept_path_m = st.rank_replan_ms = st.transitions_ms = st.tour_ms = 0.0;
       st.rank_lp_integral = true;
       const double tau = PathTime(prefix.path, c.robot);
-      const double budget_s = tau - options.safety_margin_s - absl::ToDoubleSeconds(absl::Now() - start);
-      const StopToken stop = call_stop.WithEarlierDeadline(absl::Now() + absl::Seconds(std::max(0.0, budget_s)));
+      const double budget_s =
+          tau - options.safety_margin_s - absl::ToDoubleSeconds(absl::Now() - start);
+      const StopToken stop =
+          call_stop.WithEarlierDeadline(absl::Now() + absl::Seconds(std::max(0.0, budget_s)));
       // Without an estimator the budget is unlimited (the time limit still holds).
       const int64_t m_bar =
           estimator != nullptr ? estimator->Budget(0.7 * budget_s) : RankReplanInput::kUnlimited;
@@ -459,11 +477,12 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
       in.cells = &w;
       if (c.old_oarp != nullptr) in.old_ranks = c.old_oarp->ranks;
       in.budget = m_bar;
-      RankReplanMethod method = options.method == ReplanMethod::kIlp1 ? RankReplanMethod::kIlp1
-                                : options.method == ReplanMethod::kIlp2
-                                    ? RankReplanMethod::kIlp2
-                                    : (Ilp1Columns(w) <= options.ilp1_max_columns ? RankReplanMethod::kIlp1
-                                                                                  : RankReplanMethod::kIlp2);
+      RankReplanMethod method =
+          options.method == ReplanMethod::kIlp1 ? RankReplanMethod::kIlp1
+          : options.method == ReplanMethod::kIlp2
+              ? RankReplanMethod::kIlp2
+              : (Ilp1Columns(w) <= options.ilp1_max_columns ? RankReplanMethod::kIlp1
+                                                            : RankReplanMethod::kIlp2);
       const absl::Time t0 = absl::Now();
       std::vector<Rank> ranks;
       std::vector<bool> is_new;
@@ -493,9 +512,9 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
       out.plan.detail = detail;
       out.stats.kept_path_pieces = 0;
       out.stats.kept_path_m = 0;
-      const double tour_budget =
-          std::max(1e-3, budget_s - absl::ToDoubleSeconds(absl::Now() - t0));
-      ASSIGN_OR_RETURN(bool ok, TourReplan(c, prefix, ranks, is_new, options, stop, tour_budget, &out));
+      const double tour_budget = std::max(1e-3, budget_s - absl::ToDoubleSeconds(absl::Now() - t0));
+      ASSIGN_OR_RETURN(bool ok,
+                       TourReplan(c, prefix, ranks, is_new, options, stop, tour_budget, &out));
       if (!ok) {
         st.greedy_detours.push_back(k);
         continue;
@@ -504,7 +523,8 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
         // Trivial replans (nothing to repartition) would teach it nothing.
         estimator->Record(st.new_ranks, absl::ToDoubleSeconds(absl::Now() - t0));
       }
-      st.method = ReplanMethodName(options.method == ReplanMethod::kAuto ? ReplanMethod::kAuto : options.method);
+      st.method = ReplanMethodName(options.method == ReplanMethod::kAuto ? ReplanMethod::kAuto
+                                                                         : options.method);
       if (options.method == ReplanMethod::kAuto) {
         st.method = method == RankReplanMethod::kIlp1 ? "auto/ilp1" : "auto/ilp2";
       }
@@ -567,22 +587,26 @@ absl::StatusOr<ReplanResult> Resume(const RetainedPlan& old, const RobotProgress
   absl::StatusOr<CellIndex> joined = JoinCell(drive, robot, "pose");
   if (!joined.ok()) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "pose: the robot at (%.3f, %.3f) is neither in nor next to a free cell from which it can drive to "
+        "pose: the robot at (%.3f, %.3f) is neither in nor next to a free cell from which it can "
+        "drive to "
         "where it stopped (%.3f, %.3f); obstacles reported on the way may cut it off",
         robot.x, robot.y, stop.x, stop.y));
   }
   std::vector<Waypoint> path = {{robot.x, robot.y, robot.theta, SegmentKind::kStart, -1}};
-  ASSIGN_OR_RETURN(bool routed, AppendRoute(drive, {robot.x, robot.y}, Pose2{stop.x, stop.y, stop.theta},
-                                            options.stop, &path));
-  if (!routed) return absl::DeadlineExceededError("no time left to route the robot back to where it stopped");
+  ASSIGN_OR_RETURN(bool routed,
+                   AppendRoute(drive, {robot.x, robot.y}, Pose2{stop.x, stop.y, stop.theta},
+                               options.stop, &path));
+  if (!routed)
+    return absl::DeadlineExceededError("no time left to route the robot back to where it stopped");
   const Point2 reached{path.back().x, path.back().y};
   if (std::hypot(reached.x - stop.x, reached.y - stop.y) > 1e-6) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "pose: the robot at (%.3f, %.3f) cannot reach where it stopped (%.3f, %.3f)", robot.x, robot.y,
-        stop.x, stop.y));
+        "pose: the robot at (%.3f, %.3f) cannot reach where it stopped (%.3f, %.3f)", robot.x,
+        robot.y, stop.x, stop.y));
   }
   double back = 0.0;
-  for (size_t i = 1; i < path.size(); ++i) back += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
+  for (size_t i = 1; i < path.size(); ++i)
+    back += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
   if (rejoin_m != nullptr) *rejoin_m = back;
   const int offset = static_cast<int>(path.size()) - 1;
   for (size_t i = 1; i < out.plan.path.size(); ++i) path.push_back(out.plan.path[i]);

@@ -58,7 +58,7 @@ struct Observations {
 
 struct ReplanOptions {
   ReplanMethod method = ReplanMethod::kAuto;
-  StopToken stop;            // the call's deadline / cancellation
+  StopToken stop;  // the call's deadline / cancellation
   uint64_t seed = 1;
   int num_threads = 1;
   // AUTO uses ILP-1 while its variable count stays below this, else ILP-2.
@@ -71,28 +71,28 @@ struct ReplanOptions {
 };
 
 struct ReplanStats {
-  std::string method;                    // the method that produced the plan
-  int num_encounters = 0;                // entries of the remaining path into new obstacles
-  std::vector<int> greedy_detours;       // encounters (0-based) handled by greedy detour
-  int replanned_encounter = -1;          // the encounter the new tour starts at, or -1
-  double time_to_encounter_s = 0.0;      // drive time from the robot to it (its budget)
-  int64_t rank_budget = -1;              // m̄ used (-1: unlimited / not applicable)
+  std::string method;                // the method that produced the plan
+  int num_encounters = 0;            // entries of the remaining path into new obstacles
+  std::vector<int> greedy_detours;   // encounters (0-based) handled by greedy detour
+  int replanned_encounter = -1;      // the encounter the new tour starts at, or -1
+  double time_to_encounter_s = 0.0;  // drive time from the robot to it (its budget)
+  int64_t rank_budget = -1;          // m̄ used (-1: unlimited / not applicable)
   int64_t new_ranks = 0;
-  int64_t kept_ranks = 0;                // old ranks kept unchanged
-  int64_t kept_path_pieces = 0;          // maximal unchanged sections of the old path kept
-  double kept_path_m = 0.0;              // their length
+  int64_t kept_ranks = 0;        // old ranks kept unchanged
+  int64_t kept_path_pieces = 0;  // maximal unchanged sections of the old path kept
+  double kept_path_m = 0.0;      // their length
   int64_t newly_blocked_cells = 0;
-  int64_t covered_cells_before = 0;      // swept before the robot's position
-  int64_t remaining_cells = 0;           // still to cover, reachable
-  int64_t newly_unreachable_cells = 0;   // to cover but cut off by the new obstacles
-  int64_t newly_obstructed_cells = 0;    // to cover but occupied by the new obstacles
-  double remaining_free_area_m2 = 0.0;   // free area of the remaining cells
+  int64_t covered_cells_before = 0;     // swept before the robot's position
+  int64_t remaining_cells = 0;          // still to cover, reachable
+  int64_t newly_unreachable_cells = 0;  // to cover but cut off by the new obstacles
+  int64_t newly_obstructed_cells = 0;   // to cover but occupied by the new obstacles
+  double remaining_free_area_m2 = 0.0;  // free area of the remaining cells
   double rank_replan_ms = 0.0;
   double transitions_ms = 0.0;
   double tour_ms = 0.0;
   double total_ms = 0.0;
-  bool rank_lp_integral = true;          // the RANK-REPLAN relaxation was integral
-  bool end_moved = false;                // the old end was cut off: the plan ends at the nearest reachable cell
+  bool rank_lp_integral = true;  // the RANK-REPLAN relaxation was integral
+  bool end_moved = false;  // the old end was cut off: the plan ends at the nearest reachable cell
   // The robot's own cell was reported blocked: it is blocked from now on and
   // the plan leaves it first (robot_cell_blocked), or, when every cell around
   // is blocked too, it stays free so that the robot can move at all
@@ -102,9 +102,9 @@ struct ReplanStats {
 };
 
 struct ReplanResult {
-  CoveragePlan plan;                     // starts at the robot
+  CoveragePlan plan;                         // starts at the robot
   std::shared_ptr<const CoverageArea> area;  // drive/cover grids of the remainder
-  std::vector<CellIndex> unreachable;    // cells to cover cut off by the new obstacles
+  std::vector<CellIndex> unreachable;        // cells to cover cut off by the new obstacles
   ReplanStats stats;
 };
 
@@ -115,8 +115,8 @@ struct ReplanResult {
 // station legs) and the method is not kGreedyDetour. The greedy detour of a
 // battery plan drives its old legs, station legs included, around the new
 // obstacles; the result has no `cycles` and no energy figures (its energy
-// is not re-checked against the battery: the caller knows the charge). Running out of time is not an error:
-// the greedy detour answers.
+// is not re-checked against the battery: the caller knows the charge). Running out of time is not
+// an error: the greedy detour answers.
 absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress& progress,
                                     const Observations& observations, const ReplanOptions& options,
                                     ReplanEstimator* estimator);

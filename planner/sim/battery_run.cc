@@ -37,7 +37,7 @@ BatteryRun DriveBattery(const std::vector<Waypoint>& driven, const BatteryOption
     if (docked && std::hypot(b.x - a.x, b.y - a.y) > kAtStationM) {
       if (b.kind == SegmentKind::kToStation) {
         docked = false;  // a detour to the station that passed its point: still on the way
-      } else {  // leaving: recharged first
+      } else {           // leaving: recharged first
         end_cycle();
         level = battery.capacity;
       }

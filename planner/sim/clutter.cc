@@ -61,9 +61,9 @@ absl::StatusOr<OccupancyMap> AddClutter(const OccupancyMap& map, double percent,
   }
   if (!(options.min_side_m > 0.0 && options.max_side_m >= options.min_side_m &&
         std::isfinite(options.max_side_m))) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "clutter sides must satisfy 0 < min_side_m <= max_side_m, got %g and %g",
-        options.min_side_m, options.max_side_m));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("clutter sides must satisfy 0 < min_side_m <= max_side_m, got %g and %g",
+                        options.min_side_m, options.max_side_m));
   }
   GridOptions grid_options;
   grid_options.cell_size = options.keep_connected_cell_m;
@@ -77,7 +77,8 @@ absl::StatusOr<OccupancyMap> AddClutter(const OccupancyMap& map, double percent,
       if (map.IsFree(r, c)) free_pixels.push_back(static_cast<int64_t>(r) * map.width() + c);
     }
   }
-  if (free_pixels.empty()) return absl::InvalidArgumentError("the map has no free pixel to clutter");
+  if (free_pixels.empty())
+    return absl::InvalidArgumentError("the map has no free pixel to clutter");
   const int64_t free_count = static_cast<int64_t>(free_pixels.size());
   const int64_t target = static_cast<int64_t>(std::llround(percent / 100.0 * free_count));
   const int64_t slack = std::max<int64_t>(1, free_count / 400);  // 0.25 percentage points
@@ -92,15 +93,19 @@ absl::StatusOr<OccupancyMap> AddClutter(const OccupancyMap& map, double percent,
   int64_t occupied = 0;
   std::vector<int64_t> pixels;
   const int64_t cut_off = keep_connected ? CutOffCells(map, grid_options) : 0;
-  if (cut_off < 0) return absl::InvalidArgumentError("keep_connected_cell_m: the map has no grid at that cell size");
+  if (cut_off < 0)
+    return absl::InvalidArgumentError(
+        "keep_connected_cell_m: the map has no grid at that cell size");
   for (int64_t attempt = 0; occupied < target; ++attempt) {
     if (attempt > 50'000'000 || scale * options.max_side_m < res) {
       return absl::FailedPreconditionError(absl::StrFormat(
           "could not place %g %% clutter (%d of %d pixels placed)", percent, occupied, target));
     }
     const int64_t at = free_pixels[pick(rng)];
-    const double w = scale * (options.min_side_m + unit(rng) * (options.max_side_m - options.min_side_m)) / res;
-    const double h = scale * (options.min_side_m + unit(rng) * (options.max_side_m - options.min_side_m)) / res;
+    const double w =
+        scale * (options.min_side_m + unit(rng) * (options.max_side_m - options.min_side_m)) / res;
+    const double h =
+        scale * (options.min_side_m + unit(rng) * (options.max_side_m - options.min_side_m)) / res;
     const double angle = unit(rng) * M_PI;
     const int row = static_cast<int>(at / map.width()), col = static_cast<int>(at % map.width());
     if (!out.IsFree(row, col)) continue;  // already cluttered
@@ -110,7 +115,8 @@ absl::StatusOr<OccupancyMap> AddClutter(const OccupancyMap& map, double percent,
       continue;
     }
     auto set_all = [&](CellState state) {
-      for (int64_t p : pixels) out.set(static_cast<int>(p / map.width()), static_cast<int>(p % map.width()), state);
+      for (int64_t p : pixels)
+        out.set(static_cast<int>(p / map.width()), static_cast<int>(p % map.width()), state);
     };
     set_all(CellState::kOccupied);
     if (keep_connected) {

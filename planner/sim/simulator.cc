@@ -56,7 +56,9 @@ bool TraverseCells(const Grid& g, Point2 a, Point2 b, F f) {
   auto on_line = [&](double v) { return std::abs(v - std::round(v)) < kEps; };
   if ((std::abs(dx) < kEps && on_line(x0)) || (std::abs(dy) < kEps && on_line(y0))) return false;
   auto first = [&](double v, double d) {
-    return static_cast<int>(d > 0 ? std::floor(v + kEps) : d < 0 ? std::ceil(v - kEps) - 1 : std::floor(v));
+    return static_cast<int>(d > 0   ? std::floor(v + kEps)
+                            : d < 0 ? std::ceil(v - kEps) - 1
+                                    : std::floor(v));
   };
   int cx = first(x0, dx), cy = first(y0, dy);
   const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
@@ -133,16 +135,16 @@ class Simulation {
   std::vector<uint8_t> pending_flag_;  // found, not yet given to a replan
   std::vector<uint8_t> reported_;      // given to a replan
   std::vector<CellIndex> pending_;
-  bool pending_checked_ = true;        // no pending cell added since PendingOnPath() said no
+  bool pending_checked_ = true;  // no pending cell added since PendingOnPath() said no
   std::vector<uint8_t> swept_;
-  std::vector<int> sweep_of_;          // per waypoint: index into plan.sweeps or -1
-  int seg_ = 1;                        // segment path[seg_-1] -> path[seg_] being driven
-  double t_seg_ = 0.0, d_seg_ = 0.0;   // seconds / metres into it
+  std::vector<int> sweep_of_;         // per waypoint: index into plan.sweeps or -1
+  int seg_ = 1;                       // segment path[seg_-1] -> path[seg_] being driven
+  double t_seg_ = 0.0, d_seg_ = 0.0;  // seconds / metres into it
   Point2 pos_;
-  CellIndex here_;                     // the cell the robot is in (borders are ambiguous)
-  bool end_blocked_ = false;           // the plan's end pose lies in a blocked cell
-  bool junction_ = false;              // driven.back() is where a replan cut a segment
-  double drive_s_ = 0.0;               // rough drive time, for the time bound
+  CellIndex here_;            // the cell the robot is in (borders are ambiguous)
+  bool end_blocked_ = false;  // the plan's end pose lies in a blocked cell
+  bool junction_ = false;     // driven.back() is where a replan cut a segment
+  double drive_s_ = 0.0;      // rough drive time, for the time bound
   int violations_ = 0;
   SimulationResult r_;
 };
@@ -162,7 +164,8 @@ bool Simulation::Visible(Point2 from, CellIndex target) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double next_x = dx != 0 ? (sx > 0 ? cx + 1 - x0 : x0 - cx) / std::abs(dx) : kInf;
   double next_y = dy != 0 ? (sy > 0 ? cy + 1 - y0 : y0 - cy) / std::abs(dy) : kInf;
-  const double step_x = dx != 0 ? 1.0 / std::abs(dx) : kInf, step_y = dy != 0 ? 1.0 / std::abs(dy) : kInf;
+  const double step_x = dx != 0 ? 1.0 / std::abs(dx) : kInf,
+               step_y = dy != 0 ? 1.0 / std::abs(dy) : kInf;
   const int max_steps = std::abs(tx - cx) + std::abs(ty - cy) + 2;
   for (int k = 0; k < max_steps && !(cx == tx && cy == ty); ++k) {
     if (next_x < next_y) {
@@ -192,7 +195,8 @@ void Simulation::Sense() {
   const CellIndex at = grid_.CellAt(pos_);
   const int reach = static_cast<int>(std::ceil(range / s)) + 1;
   for (int r = std::max(0, at.row - reach); r <= std::min(grid_.rows() - 1, at.row + reach); ++r) {
-    for (int c = std::max(0, at.col - reach); c <= std::min(grid_.cols() - 1, at.col + reach); ++c) {
+    for (int c = std::max(0, at.col - reach); c <= std::min(grid_.cols() - 1, at.col + reach);
+         ++c) {
       const int64_t i = grid_.Index(r, c);
       if (!candidate_[i] || found_[i] || Dist(pos_, grid_.CellCenter(r, c)) > range) continue;
       if (Visible(pos_, {r, c})) Observe({r, c});
@@ -239,7 +243,8 @@ double Simulation::TimeToFirstEntry(const std::vector<uint8_t>& flags) const {
     const Point2 a = i == seg_ ? pos_ : At(path()[i - 1]);
     if (i != last_segment) {
       if (last_segment >= 0) time += robot_.StraightTime(last_d);
-      if (i != seg_ || d_seg_ <= 0.0) time += robot_.TurnTime(HeadingChange(path()[i - 1].theta, path()[i].theta));
+      if (i != seg_ || d_seg_ <= 0.0)
+        time += robot_.TurnTime(HeadingChange(path()[i - 1].theta, path()[i].theta));
       last_segment = i;
     }
     const CellIndex c = grid_.CellAt(p);
@@ -282,7 +287,8 @@ RobotProgress Simulation::Progress() const {
     const Point2 a = At(path()[at.waypoint - 1]), b = At(path()[at.waypoint]);
     const double len = Dist(a, b);
     constexpr double kBack = 1e-6;
-    if (len > 2 * kBack) at.position = Point2{pos_.x - kBack * (b.x - a.x) / len, pos_.y - kBack * (b.y - a.y) / len};
+    if (len > 2 * kBack)
+      at.position = Point2{pos_.x - kBack * (b.x - a.x) / len, pos_.y - kBack * (b.y - a.y) / len};
   }
   return at;
 }
@@ -323,9 +329,9 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
   }
   const double compute_s = absl::ToDoubleSeconds(absl::Now() - t0);
   if (!result.ok()) {
-    return absl::InternalError(absl::StrFormat(
-        "replan %d failed even as greedy detour at (%.4f, %.4f), segment %d: %s", r_.num_replans,
-        pos_.x, pos_.y, at.waypoint, result.status().ToString()));
+    return absl::InternalError(
+        absl::StrFormat("replan %d failed even as greedy detour at (%.4f, %.4f), segment %d: %s",
+                        r_.num_replans, pos_.x, pos_.y, at.waypoint, result.status().ToString()));
   }
   const ReplanStats& st = result->stats;
   // Stoppage: the compute time the robot cannot drive through.
@@ -357,8 +363,8 @@ absl::Status Simulation::DoReplan(ReplanMethod method) {
   // Every replanned path is checked whole, not only the part the robot
   // drives before the next replan.
   if (std::optional<std::string> crossing = CrossesReported(result->plan.path)) {
-    r_.problems.push_back(absl::StrFormat("the plan from replan %d (%s) %s", r_.num_replans,
-                                          st.method, *crossing));
+    r_.problems.push_back(
+        absl::StrFormat("the plan from replan %d (%s) %s", r_.num_replans, st.method, *crossing));
   }
   plan_.plan = std::move(result->plan);
   plan_.area = std::move(result->area);
@@ -382,8 +388,9 @@ std::optional<std::string> Simulation::CrossesReported(const std::vector<Waypoin
       return true;
     });
     if (hit) {
-      return absl::StrFormat("crosses cell (%d, %d), reported blocked, on segment %d (%.4f, %.4f) -> (%.4f, %.4f)",
-                             hit->row, hit->col, i, a.x, a.y, b.x, b.y);
+      return absl::StrFormat(
+          "crosses cell (%d, %d), reported blocked, on segment %d (%.4f, %.4f) -> (%.4f, %.4f)",
+          hit->row, hit->col, i, a.x, a.y, b.x, b.y);
     }
   }
   return std::nullopt;
@@ -397,7 +404,8 @@ absl::Status Simulation::HandleViolation(CellIndex cell) {
   // blocked end pose from a free neighbour), the robot cannot. Once nothing
   // is left to sweep, the run ends next to it.
   bool sweeps_left = false;
-  for (size_t i = seg_; i < path().size(); ++i) sweeps_left |= path()[i].kind == SegmentKind::kCoverage;
+  for (size_t i = seg_; i < path().size(); ++i)
+    sweeps_left |= path()[i].kind == SegmentKind::kCoverage;
   if (!sweeps_left && cell == grid_.CellAt(At(path().back()))) {
     end_blocked_ = true;
     return absl::OkStatus();
@@ -405,8 +413,8 @@ absl::Status Simulation::HandleViolation(CellIndex cell) {
   r_.problems.push_back(absl::StrFormat(
       "the plan from replan %d (%s) enters cell (%d, %d), %s, from (%.4f, %.4f) on segment %d",
       r_.num_replans, r_.replan_methods.empty() ? "initial" : r_.replan_methods.back(), cell.row,
-      cell.col, found_[Index(cell)] ? "reported blocked" : "blocked on the true grid", pos_.x, pos_.y,
-      seg_));
+      cell.col, found_[Index(cell)] ? "reported blocked" : "blocked on the true grid", pos_.x,
+      pos_.y, seg_));
   if (++violations_ > 100) {
     r_.completed = false;
     r_.termination = "stopped: more than 100 plans entered blocked cells";
@@ -494,7 +502,8 @@ absl::StatusOr<SimulationResult> Simulation::Run() {
   }
   if (end_blocked_) {
     r_.termination = absl::StrFormat(
-        "completed: the end pose (%.3f, %.3f) lies in a blocked cell; stopped next to it at (%.3f, %.3f)",
+        "completed: the end pose (%.3f, %.3f) lies in a blocked cell; stopped next to it at (%.3f, "
+        "%.3f)",
         path().back().x, path().back().y, pos_.x, pos_.y);
   } else if (r_.completed) {
     r_.termination = "completed: the end of the plan was reached";
@@ -521,7 +530,8 @@ absl::Status SimulationOptions::Validate() const {
         absl::StrFormat("sensor_range_m must be in (0, 1000] m, got %g", sensor_range_m));
   }
   if (!(step_s > 0.0 && step_s <= 60.0)) {
-    return absl::InvalidArgumentError(absl::StrFormat("step_s must be in (0, 60] s, got %g", step_s));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("step_s must be in (0, 60] s, got %g", step_s));
   }
   if (max_replans < 0) return absl::InvalidArgumentError("max_replans must be >= 0");
   if (!(replan_tour_time_limit_s > 0.0 && replan_tour_time_limit_s <= 3600.0)) {
@@ -532,7 +542,8 @@ absl::Status SimulationOptions::Validate() const {
     return absl::InvalidArgumentError("max_time_factor must be a positive number");
   }
   if (!(recharge_s >= 0.0 && std::isfinite(recharge_s))) {
-    return absl::InvalidArgumentError(absl::StrFormat("recharge_s must be a finite value >= 0 s, got %g", recharge_s));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("recharge_s must be a finite value >= 0 s, got %g", recharge_s));
   }
   if (plan.battery) RETURN_IF_ERROR(plan.battery->Validate());
   return plan.robot.Validate();
@@ -545,7 +556,8 @@ absl::Status CheckSameFrame(const OccupancyMap& known, const OccupancyMap& truth
       known.resolution() != truth.resolution() || known.origin().x != truth.origin().x ||
       known.origin().y != truth.origin().y) {
     return absl::InvalidArgumentError(absl::StrFormat(
-        "the known and the true map must have the same size, resolution and origin: known %d x %d px "
+        "the known and the true map must have the same size, resolution and origin: known %d x %d "
+        "px "
         "at %g m/px from (%g, %g), true %d x %d px at %g m/px from (%g, %g)",
         known.width(), known.height(), known.resolution(), known.origin().x, known.origin().y,
         truth.width(), truth.height(), truth.resolution(), truth.origin().x, truth.origin().y));
@@ -593,7 +605,8 @@ namespace {
 // Plans and replans in process.
 class LocalPlanSource final : public PlanSource {
  public:
-  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known, const PlanOptions& options) override {
+  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known,
+                                           const PlanOptions& options) override {
     ASSIGN_OR_RETURN(EngineResult planned, PlanCoverageWithArea(known, options));
     RetainedPlan retained;
     retained.plan_id = "simulation";
@@ -603,7 +616,8 @@ class LocalPlanSource final : public PlanSource {
     retained.area = std::move(planned.area);
     return retained;
   }
-  absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at, const Observations& seen,
+  absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at,
+                                      const Observations& seen,
                                       const ReplanOptions& options) override {
     return covplan::Replan(plan, at, seen, options, &estimator_);
   }
@@ -677,19 +691,22 @@ absl::StatusOr<OccupancyMap> CellLevelTruth(const OccupancyMap& known, const Occ
   const GridOptions go = GridOf(options);
   ASSIGN_OR_RETURN(Grid known_grid, BuildGrid(known, go));
   ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(truth, go));
-  ASSIGN_OR_RETURN(Grid true_grid, BuildGridFromFractions(truth, go, frame, CellFreeFractions(truth, frame)));
+  ASSIGN_OR_RETURN(Grid true_grid,
+                   BuildGridFromFractions(truth, go, frame, CellFreeFractions(truth, frame)));
   OccupancyMap out = known;
   for (int r = 0; r < known.height(); ++r) {
     for (int c = 0; c < known.width(); ++c) {
       const int row = static_cast<int>(std::floor((r + 0.5) / frame.px_per_cell));
       const int col = static_cast<int>(std::floor((c + 0.5) / frame.px_per_cell));
-      if (known_grid.IsFree(row, col) && !true_grid.IsFree(row, col)) out.set(r, c, CellState::kOccupied);
+      if (known_grid.IsFree(row, col) && !true_grid.IsFree(row, col))
+        out.set(r, c, CellState::kOccupied);
     }
   }
   return out;
 }
 
-absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth, const PlanOptions& options) {
+absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth,
+                                               const PlanOptions& options) {
   ASSIGN_OR_RETURN(CoveragePlan plan, PlanCoverage(truth, options));
   OfflineBound b;
   b.duration_s = plan.stats.estimated_duration_s;

@@ -12,7 +12,8 @@
 //   o.plan.robot.tool_width_m = 0.8;
 //   ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o));
 //   r.total_time_s, r.stoppage_s, r.covered_free_area_ratio, r.driven ...
-//   ASSIGN_OR_RETURN(OfflineBound lb, OfflineLowerBound(truth, o.plan));  // OARP knowing everything
+//   ASSIGN_OR_RETURN(OfflineBound lb, OfflineLowerBound(truth, o.plan));  // OARP knowing
+//   everything
 //
 // Battery plans (options.plan.battery): the plan is split into charge
 // cycles on the known map (planner/energy; station legs are ordinary path
@@ -76,23 +77,23 @@ struct SimulationOptions {
 };
 
 struct SimulationResult {
-  double total_time_s = 0.0;  // drive_time_s + stoppage_s (+ battery->recharge_time_s)
-  double drive_time_s = 0.0;  // the driven path under the robot model
-  double stoppage_s = 0.0;    // waiting for replans
-  int num_replans = 0;        // Replan calls (one per event of new obstacles on the path)
-  int num_encounters = 0;     // entries of the path into new obstacles, over all replans
-  int num_greedy_detours = 0; // encounters handled by greedy detour, over all replans
+  double total_time_s = 0.0;   // drive_time_s + stoppage_s (+ battery->recharge_time_s)
+  double drive_time_s = 0.0;   // the driven path under the robot model
+  double stoppage_s = 0.0;     // waiting for replans
+  int num_replans = 0;         // Replan calls (one per event of new obstacles on the path)
+  int num_encounters = 0;      // entries of the path into new obstacles, over all replans
+  int num_greedy_detours = 0;  // encounters handled by greedy detour, over all replans
   int num_turns = 0;
   double path_length_m = 0.0;
   // Free area of the TRUE map inside the cells actually swept, over the true
   // map's free area.
   double covered_free_area_ratio = 0.0;
-  double planned_duration_s = 0.0;  // the initial plan's estimated duration
-  std::vector<Waypoint> driven;     // the path actually driven
-  std::vector<CellIndex> obstacles_found;  // cells found blocked, in order
-  std::vector<double> replan_ms;           // compute time of each replan
-  std::vector<Point2> replan_points;       // where each replan started
-  std::vector<std::string> replan_methods; // ReplanStats::method of each
+  double planned_duration_s = 0.0;          // the initial plan's estimated duration
+  std::vector<Waypoint> driven;             // the path actually driven
+  std::vector<CellIndex> obstacles_found;   // cells found blocked, in order
+  std::vector<double> replan_ms;            // compute time of each replan
+  std::vector<Point2> replan_points;        // where each replan started
+  std::vector<std::string> replan_methods;  // ReplanStats::method of each
   // Length of the driven path inside non-free pixels of the true map. The
   // replanner takes new obstacles as blocked cells only: obstacles smaller
   // than half a cell (chair legs, clutter corners) leave their cells free,
@@ -129,12 +130,14 @@ class PlanSource {
   virtual ~PlanSource() = default;
   // The plan of the known map. Its `area` may be null (a remote plan); the
   // simulator needs the path, the sweeps and the grid.
-  virtual absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known, const PlanOptions& options) = 0;
+  virtual absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known,
+                                                   const PlanOptions& options) = 0;
   // A replan of `plan` (the one being driven). Running out of time is not an
   // error (the greedy detour answers); an error makes the simulator retry
   // with options.method = kGreedyDetour.
   virtual absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at,
-                                              const Observations& seen, const ReplanOptions& options) = 0;
+                                              const Observations& seen,
+                                              const ReplanOptions& options) = 0;
 };
 
 // InvalidArgument when the options are bad, the maps differ in size,
@@ -142,7 +145,8 @@ class PlanSource {
 // the true map; errors of the initial plan are passed on. `source`
 // (optional, not owned): where plans come from; default in process.
 absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
-                                          const SimulationOptions& options, PlanSource* source = nullptr);
+                                          const SimulationOptions& options,
+                                          PlanSource* source = nullptr);
 
 // The offline lower bound of the evaluation: the plan (options.planner, with
 // options.battery when given) of the true map, as if the robot had known it
@@ -155,7 +159,8 @@ struct OfflineBound {
   // recharge time in it; add recharge_s for each).
   int charge_cycles = 0;
 };
-absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth, const PlanOptions& options);
+absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth,
+                                               const PlanOptions& options);
 
 // The true map as the simulation sees it: `known` with every cell that is
 // free on the known grid but blocked on the true grid filled (grid of

@@ -53,7 +53,8 @@ int CoarseGrid::Neighbour(int id, int side) const {
 }
 
 CellIndex CoarseGrid::SubCell(int id, int pos) const {
-  return {2 * (id / cols_) - offset_.row + kPosRow[pos], 2 * (id % cols_) - offset_.col + kPosCol[pos]};
+  return {2 * (id / cols_) - offset_.row + kPosRow[pos],
+          2 * (id % cols_) - offset_.col + kPosCol[pos]};
 }
 
 int CoarseGrid::CoarseOf(CellIndex cell) const {
@@ -82,7 +83,8 @@ bool CoarseGrid::CanLink(int id, int side) const {
   auto walled = [&](int pos) {
     const CellIndex a = SubCell(id, pos);
     const CellIndex b{a.row + kSideRow[side], a.col + kSideCol[side]};
-    return drive_->IsFree(a) && drive_->IsFree(b) && !drive_->Passable(a.row, a.col, kSideRow[side], kSideCol[side]);
+    return drive_->IsFree(a) && drive_->IsFree(b) &&
+           !drive_->Passable(a.row, a.col, kSideRow[side], kSideCol[side]);
   };
   return (first || second) && !walled(side) && !walled((side + 1) % 4);
 }

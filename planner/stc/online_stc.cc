@@ -35,13 +35,15 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
   const CellIndex start = robot->at();
   const StcRoot root{world.CoarseOf(start), world.PositionOf(start)};
   if (!world.IsNode(root.cell)) {
-    return absl::InvalidArgumentError("on-line STC: the robot starts outside the coarse cells STC covers");
+    return absl::InvalidArgumentError(
+        "on-line STC: the robot starts outside the coarse cells STC covers");
   }
   OnlineStcStats stats;
   // The robot's memory: the tree, the coarse cells sensed, the sub-cells known free.
   StcTree tree;
   tree.sides.assign(world.size(), 0);
-  std::vector<uint8_t> seen(world.size(), 0), sensed(world.size(), 0), sensed_around(world.size(), 0);
+  std::vector<uint8_t> seen(world.size(), 0), sensed(world.size(), 0),
+      sensed_around(world.size(), 0);
   std::vector<uint8_t> known_free(truth.size(), 0);
   std::vector<CellIndex> known_cells;
   auto sense_around = [&](int id) {
@@ -62,7 +64,9 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
     }
   };
   StcWalker::World w;
-  w.may_enter = [&](CellIndex c) { return truth.InBounds(c.row, c.col) && known_free[truth.Index(c.row, c.col)]; };
+  w.may_enter = [&](CellIndex c) {
+    return truth.InBounds(c.row, c.col) && known_free[truth.Index(c.row, c.col)];
+  };
   // The sensor saw both cells, so it saw whether a wall stands between them.
   w.passable = [&](CellIndex c, int dr, int dc) { return truth.Passable(c.row, c.col, dr, dc); };
   w.to_cover = [&](CellIndex c) {
@@ -122,11 +126,13 @@ absl::StatusOr<OnlineStcStats> RunOnlineStc(SubCellRobot* robot, PartialCells pa
     }
     if (pending.empty()) break;
     const absl::Status swept = walker.SweepRemaining(pending, never);
-    if (absl::IsNotFound(swept)) return absl::InternalError("on-line STC: a sensed cell cannot be reached");
+    if (absl::IsNotFound(swept))
+      return absl::InternalError("on-line STC: a sensed cell cannot be reached");
     RETURN_IF_ERROR(swept);
   }
   const absl::Status back = walker.GoTo(start);
-  if (absl::IsNotFound(back)) return absl::InternalError("on-line STC: no known way back to the start");
+  if (absl::IsNotFound(back))
+    return absl::InternalError("on-line STC: no known way back to the start");
   RETURN_IF_ERROR(back);
   return stats;
 }
@@ -140,7 +146,8 @@ absl::StatusOr<OnlineStcStats> RunAntStc(SubCellRobot* robot) {
   const int s = world.CoarseOf(start);
   const int k0 = world.PositionOf(start);
   if (!world.IsNode(s)) {
-    return absl::InvalidArgumentError("ant-like STC: the robot must start in a wholly free coarse cell");
+    return absl::InvalidArgumentError(
+        "ant-like STC: the robot must start in a wholly free coarse cell");
   }
   int x = s, pos = k0, entry_side = (k0 + 3) % 4;
   OnlineStcStats stats;

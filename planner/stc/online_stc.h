@@ -56,7 +56,9 @@ class SubCellRobot {
 
   // Markers (ant-like STC): left in the cell the robot stands in.
   void MarkHere() { marked_[truth_.Index(at_.row, at_.col)] = 1; }
-  bool Marked(CellIndex c) const { return truth_.IsFree(c) && marked_[truth_.Index(c.row, c.col)] != 0; }
+  bool Marked(CellIndex c) const {
+    return truth_.IsFree(c) && marked_[truth_.Index(c.row, c.col)] != 0;
+  }
 
   const Grid& truth() const { return truth_; }
 
@@ -70,7 +72,7 @@ class SubCellRobot {
 
 struct OnlineStcStats {
   int64_t steps = 0;
-  int64_t tree_edges = 0;      // on-line: edges stored; ant-like: edges crossed into new cells
+  int64_t tree_edges = 0;        // on-line: edges stored; ant-like: edges crossed into new cells
   int64_t max_stored_cells = 0;  // on-line: sensed coarse cells kept; ant-like: 0
   // On-line: sub-cells reached only after the walk, because every known way
   // in led through cells not sensed yet.

@@ -65,8 +65,9 @@ StcTree BuildDfsTree(const CoarseGrid& coarse, StcRoot root) {
 }
 
 StcTree BuildPrimTree(const CoarseGrid& coarse, StcRoot root, SweepDirection direction) {
-  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, boost::no_property,
-                                      boost::property<boost::edge_weight_t, double>>;
+  using Graph =
+      boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, boost::no_property,
+                            boost::property<boost::edge_weight_t, double>>;
   return GrowForest(coarse, root, [&](StcRoot r, std::vector<uint8_t>* seen, StcTree* tree) {
     // The component of r (BFS), numbered locally.
     std::vector<int> cells = {r.cell};
@@ -88,7 +89,8 @@ StcTree BuildPrimTree(const CoarseGrid& coarse, StcRoot root, SweepDirection dir
       for (int side : {1, 2}) {  // east and north: each edge once
         if (!coarse.CanLink(cell, side)) continue;
         const bool along = (side == 1) == (direction == SweepDirection::kHorizontal);
-        const bool clean = coarse.Crossable(cell, side, side) && coarse.Crossable(cell, side, (side + 1) % 4);
+        const bool clean =
+            coarse.Crossable(cell, side, side) && coarse.Crossable(cell, side, (side + 1) % 4);
         boost::add_edge(local[cell], local[coarse.Neighbour(cell, side)],
                         (along ? 1.0 : 2.0) + (clean ? 0.0 : 2.0), g);
       }
@@ -105,7 +107,8 @@ StcTree BuildPrimTree(const CoarseGrid& coarse, StcRoot root, SweepDirection dir
   });
 }
 
-std::vector<std::vector<CellIndex>> CircumnavigateEach(const CoarseGrid& coarse, const StcTree& tree) {
+std::vector<std::vector<CellIndex>> CircumnavigateEach(const CoarseGrid& coarse,
+                                                       const StcTree& tree) {
   std::vector<std::vector<CellIndex>> rings;
   for (const StcRoot& root : tree.roots) {
     std::vector<CellIndex>& ring = rings.emplace_back();

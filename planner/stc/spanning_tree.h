@@ -46,7 +46,8 @@ StcTree BuildPrimTree(const CoarseGrid& coarse, StcRoot root, SweepDirection dir
 // circumnavigation of each tree visits them, starting at its root.
 std::vector<CellIndex> Circumnavigate(const CoarseGrid& coarse, const StcTree& tree);
 // The same, one ring per tree (roots[i] -> ring i).
-std::vector<std::vector<CellIndex>> CircumnavigateEach(const CoarseGrid& coarse, const StcTree& tree);
+std::vector<std::vector<CellIndex>> CircumnavigateEach(const CoarseGrid& coarse,
+                                                       const StcTree& tree);
 
 // The next (cell, position) of the circumnavigation after (cell, position).
 inline StcRoot NextOnRing(const CoarseGrid& coarse, const StcTree& tree, StcRoot at) {

@@ -20,8 +20,10 @@ absl::Status StcOptions::Validate() const {
   if (tree != StcTreeMethod::kDfs && tree != StcTreeMethod::kPrim) {
     return absl::InvalidArgumentError("stc.tree: unknown tree method (DFS or PRIM)");
   }
-  if (sweep_direction != SweepDirection::kHorizontal && sweep_direction != SweepDirection::kVertical) {
-    return absl::InvalidArgumentError("stc.sweep_direction: unknown direction (HORIZONTAL or VERTICAL)");
+  if (sweep_direction != SweepDirection::kHorizontal &&
+      sweep_direction != SweepDirection::kVertical) {
+    return absl::InvalidArgumentError(
+        "stc.sweep_direction: unknown direction (HORIZONTAL or VERTICAL)");
   }
   if (partial_cells != PartialCells::kCover && partial_cells != PartialCells::kDiscard) {
     return absl::InvalidArgumentError("stc.partial_cells: unknown mode (COVER or DISCARD)");
@@ -40,8 +42,9 @@ absl::StatusOr<CellIndex> DefaultStartCell(const Grid& drive, const Grid& cover)
   return absl::NotFoundError("no cell to cover");
 }
 
-absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover, const StcOptions& options,
-                                         CellIndex start_cell, CellIndex end_cell, const StopToken& stop) {
+absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover,
+                                         const StcOptions& options, CellIndex start_cell,
+                                         CellIndex end_cell, const StopToken& stop) {
   RETURN_IF_ERROR(options.Validate());
   std::vector<CellIndex> offsets = {{0, 0}};
   if (options.search_offset) offsets = {{0, 0}, {0, 1}, {1, 0}, {1, 1}};
@@ -64,15 +67,15 @@ absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover, c
         orphan[i] = cover.free_flags()[i] && coarse.IsOrphan(c);
       }
     }
-    ASSIGN_OR_RETURN(StcWalk walk,
-                     WalkForest(drive, cover, CircumnavigateEach(coarse, tree), orphan, start_cell, end_cell, stop));
+    ASSIGN_OR_RETURN(StcWalk walk, WalkForest(drive, cover, CircumnavigateEach(coarse, tree),
+                                              orphan, start_cell, end_cell, stop));
     // Most cells covered (differs only when partial cells are discarded),
     // then fewest moves, then fewest partly free coarse cells.
     const int64_t partial = tree.num_nodes - coarse.num_full_nodes();
-    const bool better =
-        best.detail == nullptr ||
-        std::make_tuple(-walk.covered_cells, walk.steps.size(), partial) <
-            std::make_tuple(-best.walk.covered_cells, best.walk.steps.size(), best.detail->partial_coarse_cells);
+    const bool better = best.detail == nullptr ||
+                        std::make_tuple(-walk.covered_cells, walk.steps.size(), partial) <
+                            std::make_tuple(-best.walk.covered_cells, best.walk.steps.size(),
+                                            best.detail->partial_coarse_cells);
     if (!better) continue;
     auto d = std::make_shared<StcDetail>();
     d->tree = options.tree;
@@ -88,7 +91,8 @@ absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover, c
     d->extra_moves = walk.extra_moves;
     d->subcells_covered_twice = walk.cells_covered_twice;
     int64_t to_cover = 0;
-    for (int64_t i = 0; i < drive.size(); ++i) to_cover += drive.free_flags()[i] && cover.free_flags()[i];
+    for (int64_t i = 0; i < drive.size(); ++i)
+      to_cover += drive.free_flags()[i] && cover.free_flags()[i];
     d->discarded_cells = to_cover - walk.covered_cells;
     best.walk = std::move(walk);
     best.detail = std::move(d);
@@ -125,19 +129,25 @@ absl::StatusOr<CoveragePlan> StcPlanner::Plan(const PlanContext& ctx) const {
   if (robot.end) {
     ASSIGN_OR_RETURN(end_cell, JoinCell(drive, *robot.end, "end"));
   }
-  ASSIGN_OR_RETURN(StcOutcome outcome, RunOfflineStc(drive, cover, options, start_cell, end_cell, common.stop));
+  ASSIGN_OR_RETURN(StcOutcome outcome,
+                   RunOfflineStc(drive, cover, options, start_cell, end_cell, common.stop));
 
   CoveragePlan plan;
   plan.grid = ctx.area->drive;
   const CellIndex offset = outcome.detail->offset;
   const int coarse_cols = (drive.cols() + offset.col + 1) / 2;
   const std::optional<Pose2> end_pose = robot.end ? robot.end : robot.start;
-  AppendWalk(drive, outcome.walk, robot.start, end_pose,
-             [&](CellIndex c) { return ((c.row + offset.row) / 2) * coarse_cols + (c.col + offset.col) / 2; },
-             &plan);
+  AppendWalk(
+      drive, outcome.walk, robot.start, end_pose,
+      [&](CellIndex c) {
+        return ((c.row + offset.row) / 2) * coarse_cols + (c.col + offset.col) / 2;
+      },
+      &plan);
   if (outcome.stopped) {
-    const TerminationLimit limit = common.stop.cancelled() ? TerminationLimit::kCancelled : TerminationLimit::kDeadline;
-    plan.termination = Termination::LimitReached(limit, "stopped before every coarse-grid offset was tried");
+    const TerminationLimit limit =
+        common.stop.cancelled() ? TerminationLimit::kCancelled : TerminationLimit::kDeadline;
+    plan.termination =
+        Termination::LimitReached(limit, "stopped before every coarse-grid offset was tried");
   } else {
     plan.termination = Termination::Converged();
   }

@@ -50,16 +50,16 @@ class StcDetail final : public PlannerDetail {
   StcTreeMethod tree = StcTreeMethod::kDfs;
   SweepDirection sweep_direction = SweepDirection::kHorizontal;
   PartialCells partial_cells = PartialCells::kCover;
-  CellIndex offset;             // of the coarse grid (0 or 1 per axis)
-  int64_t coarse_cells = 0;     // tree nodes
+  CellIndex offset;                  // of the coarse grid (0 or 1 per axis)
+  int64_t coarse_cells = 0;          // tree nodes
   int64_t full_coarse_cells = 0;     // nodes whose four sub-cells are free
   int64_t partial_coarse_cells = 0;  // nodes with 1-3 free sub-cells
-  int64_t orphan_cells = 0;     // free sub-cells outside every node, swept by excursions
+  int64_t orphan_cells = 0;          // free sub-cells outside every node, swept by excursions
   int64_t tree_edges = 0;
-  int64_t trees = 0;            // components (1 unless partial cells are discarded)
-  int64_t extra_moves = 0;      // moves that cover nothing new before the last new cell
+  int64_t trees = 0;                   // components (1 unless partial cells are discarded)
+  int64_t extra_moves = 0;             // moves that cover nothing new before the last new cell
   int64_t subcells_covered_twice = 0;  // sub-cells entered more than once while covering
-  int64_t discarded_cells = 0;  // cells to cover never swept (PartialCells::kDiscard)
+  int64_t discarded_cells = 0;         // cells to cover never swept (PartialCells::kDiscard)
   size_t MemoryBytes() const override { return sizeof(*this); }
 };
 
@@ -71,8 +71,9 @@ struct StcOutcome {
   std::shared_ptr<StcDetail> detail;
   bool stopped = false;  // the stop token ended the offset search early
 };
-absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover, const StcOptions& options,
-                                         CellIndex start_cell, CellIndex end_cell, const StopToken& stop);
+absl::StatusOr<StcOutcome> RunOfflineStc(const Grid& drive, const Grid& cover,
+                                         const StcOptions& options, CellIndex start_cell,
+                                         CellIndex end_cell, const StopToken& stop);
 
 // The cell an STC tour starts at without a start pose: the first cell to
 // cover in row-major order. NotFound when there is none.

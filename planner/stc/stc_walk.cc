@@ -53,7 +53,9 @@ std::vector<CellIndex> StcWalker::Path(CellIndex from, CellIndex to) {
     const CellIndex c = shape_.FromIndex(queue_[head]);
     for (int d = 0; d < 4; ++d) {
       const CellIndex n{c.row + kDr[d], c.col + kDc[d]};
-      if (!shape_.InBounds(n.row, n.col) || !world_.may_enter(n) || !world_.passable(c, kDr[d], kDc[d])) continue;
+      if (!shape_.InBounds(n.row, n.col) || !world_.may_enter(n) ||
+          !world_.passable(c, kDr[d], kDc[d]))
+        continue;
       const int64_t ni = shape_.Index(n.row, n.col);
       if (stamp_[ni] == round_) continue;
       stamp_[ni] = round_;
@@ -142,12 +144,14 @@ absl::Status StcWalker::Visit(CellIndex next, const StopToken& stop) {
   return absl::OkStatus();
 }
 
-absl::Status StcWalker::SweepRemaining(const std::vector<CellIndex>& pending, const StopToken& stop) {
+absl::Status StcWalker::SweepRemaining(const std::vector<CellIndex>& pending,
+                                       const StopToken& stop) {
   // Nearest first: one BFS from the robot to the closest unswept pending cell.
   std::vector<uint8_t> want(shape_.size(), 0);
   for (const CellIndex& c : pending) want[shape_.Index(c.row, c.col)] = 1;
   while (true) {
-    if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while sweeping the last STC cells");
+    if (stop.ShouldStop())
+      return absl::DeadlineExceededError("stopped while sweeping the last STC cells");
     ++round_;
     const int64_t src = shape_.Index(at_.row, at_.col);
     queue_.clear();
@@ -158,7 +162,9 @@ absl::Status StcWalker::SweepRemaining(const std::vector<CellIndex>& pending, co
       const CellIndex c = shape_.FromIndex(queue_[head]);
       for (int d = 0; d < 4 && found < 0; ++d) {
         const CellIndex n{c.row + kDr[d], c.col + kDc[d]};
-        if (!shape_.InBounds(n.row, n.col) || !world_.may_enter(n) || !world_.passable(c, kDr[d], kDc[d])) continue;
+        if (!shape_.InBounds(n.row, n.col) || !world_.may_enter(n) ||
+            !world_.passable(c, kDr[d], kDc[d]))
+          continue;
         const int64_t ni = shape_.Index(n.row, n.col);
         if (stamp_[ni] == round_) continue;
         stamp_[ni] = round_;
@@ -204,15 +210,20 @@ StcWalk StcWalker::Finish() const {
 
 absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
                                    const std::vector<std::vector<CellIndex>>& rings,
-                                   const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
-                                   const StopToken& stop) {
-  if (!drive.IsFree(start) || !drive.IsFree(end)) return absl::InternalError("STC walk outside the drive grid");
+                                   const std::vector<uint8_t>& orphan, CellIndex start,
+                                   CellIndex end, const StopToken& stop) {
+  if (!drive.IsFree(start) || !drive.IsFree(end))
+    return absl::InternalError("STC walk outside the drive grid");
   auto to_cover = [&](CellIndex c) { return drive.IsFree(c) && cover.IsFree(c); };
   StcWalker::World world;
   world.may_enter = [&](CellIndex c) { return drive.IsFree(c); };
-  world.passable = [&](CellIndex c, int dr, int dc) { return drive.Passable(c.row, c.col, dr, dc); };
+  world.passable = [&](CellIndex c, int dr, int dc) {
+    return drive.Passable(c.row, c.col, dr, dc);
+  };
   world.to_cover = to_cover;
-  world.orphan = [&](CellIndex c) { return !orphan.empty() && orphan[drive.Index(c.row, c.col)] != 0; };
+  world.orphan = [&](CellIndex c) {
+    return !orphan.empty() && orphan[drive.Index(c.row, c.col)] != 0;
+  };
   StcWalker walker(drive, std::move(world), start);
   auto internal = [](const absl::Status& s) {
     return absl::IsNotFound(s) ? absl::InternalError(absl::StrCat("STC: ", s.message())) : s;
@@ -278,7 +289,8 @@ absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
   std::vector<uint32_t> seen(drive.size(), 0);
   std::vector<int64_t> queue;
   for (uint32_t round = 1;; ++round) {
-    if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while walking the STC forest");
+    if (stop.ShouldStop())
+      return absl::DeadlineExceededError("stopped while walking the STC forest");
     queue.assign(1, drive.Index(walker.at().row, walker.at().col));
     seen[queue[0]] = round;
     int64_t found = -1;
@@ -318,9 +330,9 @@ void AppendWalk(const Grid& drive, const StcWalk& walk, const std::optional<Pose
   auto heading_to = [](Point2 a, Point2 b, double fallback) {
     return (a.x == b.x && a.y == b.y) ? fallback : std::atan2(b.y - a.y, b.x - a.x);
   };
-  const double first_heading =
-      walk.steps.empty() ? (start_pose ? start_pose->theta : 0.0)
-                         : heading_to(s, drive.CellCenter(walk.steps[0]), 0.0);
+  const double first_heading = walk.steps.empty()
+                                   ? (start_pose ? start_pose->theta : 0.0)
+                                   : heading_to(s, drive.CellCenter(walk.steps[0]), 0.0);
   if (start_pose) {
     path.push_back({start_pose->x, start_pose->y, start_pose->theta, SegmentKind::kStart, -1});
     if (start_pose->x != s.x || start_pose->y != s.y) {
@@ -346,7 +358,8 @@ void AppendWalk(const Grid& drive, const StcWalk& walk, const std::optional<Pose
     CoverageSweep sweep;
     if (covers && i == 0 && start_fresh) sweep.cells.push_back(walk.start);
     size_t j = i;
-    while (j < walk.steps.size() && walk.steps[j].row - (j == 0 ? walk.start : walk.steps[j - 1]).row == dr &&
+    while (j < walk.steps.size() &&
+           walk.steps[j].row - (j == 0 ? walk.start : walk.steps[j - 1]).row == dr &&
            walk.steps[j].col - (j == 0 ? walk.start : walk.steps[j - 1]).col == dc &&
            (walk.covers[j] || (j == 0 && start_fresh)) == covers) {
       if (walk.covers[j]) sweep.cells.push_back(walk.steps[j]);
@@ -366,7 +379,8 @@ void AppendWalk(const Grid& drive, const StcWalk& walk, const std::optional<Pose
   if (end_pose) {
     const Point2 e = drive.CellCenter(prev);
     if (end_pose->x != e.x || end_pose->y != e.y) {
-      path.push_back({end_pose->x, end_pose->y, heading_to(e, {end_pose->x, end_pose->y}, path.back().theta),
+      path.push_back({end_pose->x, end_pose->y,
+                      heading_to(e, {end_pose->x, end_pose->y}, path.back().theta),
                       SegmentKind::kTransition, -1});
     }
   }

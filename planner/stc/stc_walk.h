@@ -39,9 +39,9 @@ struct StcWalk {
   // Steps up to and including the last covering one (the rest is the leg
   // back to the start or on to the end).
   int64_t coverage_steps = 0;
-  int64_t covered_cells = 0;          // distinct cells to cover visited (start included)
-  int64_t extra_moves = 0;            // coverage steps that cover nothing new
-  int64_t cells_covered_twice = 0;    // drive cells entered more than once within the coverage steps
+  int64_t covered_cells = 0;        // distinct cells to cover visited (start included)
+  int64_t extra_moves = 0;          // coverage steps that cover nothing new
+  int64_t cells_covered_twice = 0;  // drive cells entered more than once within the coverage steps
 };
 
 // The robot's walk over the tool-width grid, one unit move at a time, over
@@ -53,7 +53,7 @@ struct StcWalk {
 class StcWalker {
  public:
   struct World {
-    std::function<bool(CellIndex)> may_enter;  // free and known to the robot
+    std::function<bool(CellIndex)> may_enter;           // free and known to the robot
     std::function<bool(CellIndex, int, int)> passable;  // (cell, dr, dc)
     std::function<bool(CellIndex)> to_cover;            // a cell to cover
     std::function<bool(CellIndex)> orphan;              // to cover, outside the tree
@@ -100,8 +100,8 @@ class StcWalker {
 // Orphans (`orphan`, per drive cell, may be empty) are swept on the way.
 absl::StatusOr<StcWalk> WalkForest(const Grid& drive, const Grid& cover,
                                    const std::vector<std::vector<CellIndex>>& rings,
-                                   const std::vector<uint8_t>& orphan, CellIndex start, CellIndex end,
-                                   const StopToken& stop);
+                                   const std::vector<uint8_t>& orphan, CellIndex start,
+                                   CellIndex end, const StopToken& stop);
 
 // Appends the walk to plan->path and plan->sweeps, merging straight runs of
 // moves of one kind into one segment. The first waypoint is `start_pose`

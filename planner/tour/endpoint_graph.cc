@@ -13,12 +13,13 @@ int EndpointGraph::component(CellIndex c) const {
 }
 
 absl::StatusOr<std::shared_ptr<const EndpointGraph>> EndpointGraph::Build(
-    const Grid& grid, std::vector<CellIndex> endpoints, const Options& options, const StopToken& stop,
-    int num_threads) {
+    const Grid& grid, std::vector<CellIndex> endpoints, const Options& options,
+    const StopToken& stop, int num_threads) {
   auto g = std::make_shared<EndpointGraph>();
   const int count = static_cast<int>(endpoints.size());
   for (const CellIndex& c : endpoints) {
-    if (!grid.IsFree(c)) return absl::InvalidArgumentError("transition endpoint lies on a blocked cell");
+    if (!grid.IsFree(c))
+      return absl::InvalidArgumentError("transition endpoint lies on a blocked cell");
   }
   g->rows_ = grid.rows();
   g->cols_ = grid.cols();
@@ -111,7 +112,8 @@ absl::StatusOr<std::shared_ptr<const EndpointGraph>> EndpointGraph::Build(
     // Each endpoint once (the forward entry, found first, wins).
     std::vector<Found> unique;
     for (Found& f : list) {
-      if (std::none_of(unique.begin(), unique.end(), [&](const Found& u) { return u.endpoint == f.endpoint; })) {
+      if (std::none_of(unique.begin(), unique.end(),
+                       [&](const Found& u) { return u.endpoint == f.endpoint; })) {
         unique.push_back(std::move(f));
       }
     }
@@ -126,27 +128,32 @@ absl::StatusOr<std::shared_ptr<const EndpointGraph>> EndpointGraph::Build(
   return std::shared_ptr<const EndpointGraph>(std::move(g));
 }
 
-void EndpointGraph::AppendPath(int e, const EndpointCandidate& c, std::vector<CellIndex>* out) const {
+void EndpointGraph::AppendPath(int e, const EndpointCandidate& c,
+                               std::vector<CellIndex>* out) const {
   out->push_back(endpoints_[e]);
   for (uint32_t i = 0; i < c.corner_count; ++i) out->push_back(corners_[c.corner_offset + i]);
   if (endpoints_[c.endpoint] != endpoints_[e]) out->push_back(endpoints_[c.endpoint]);
 }
 
 size_t EndpointGraph::MemoryBytes() const {
-  return sizeof(*this) + endpoints_.capacity() * sizeof(CellIndex) + comp_.capacity() * sizeof(int32_t) +
-         endpoint_component_.capacity() * sizeof(int32_t) + head_.capacity() * sizeof(int32_t) +
-         next_.capacity() * sizeof(int32_t) + offsets_.capacity() * sizeof(int64_t) +
-         cands_.capacity() * sizeof(EndpointCandidate) + corners_.capacity() * sizeof(CellIndex);
+  return sizeof(*this) + endpoints_.capacity() * sizeof(CellIndex) +
+         comp_.capacity() * sizeof(int32_t) + endpoint_component_.capacity() * sizeof(int32_t) +
+         head_.capacity() * sizeof(int32_t) + next_.capacity() * sizeof(int32_t) +
+         offsets_.capacity() * sizeof(int64_t) + cands_.capacity() * sizeof(EndpointCandidate) +
+         corners_.capacity() * sizeof(CellIndex);
 }
 
-int64_t EndpointGraph::EstimateBytes(int64_t cells, int64_t endpoints, int neighbours, int num_threads) {
+int64_t EndpointGraph::EstimateBytes(int64_t cells, int64_t endpoints, int neighbours,
+                                     int num_threads) {
   // Forward and symmetrised lists while building (each entry a small vector
   // of ~8 corners), the final CSR and its corners.
   const int64_t per_candidate = sizeof(EndpointCandidate) + 48 + 8 * sizeof(CellIndex);
   const int64_t per_endpoint = sizeof(CellIndex) + 2 * sizeof(int32_t) + sizeof(int64_t) +
                                4 * static_cast<int64_t>(neighbours) * per_candidate;
-  return cells * 3 * static_cast<int64_t>(sizeof(int32_t)) +  // components, cell -> endpoint, labelling
-         std::max(1, num_threads) * cells * AnyAngleSearch::kBytesPerCell + endpoints * per_endpoint;
+  return cells * 3 *
+             static_cast<int64_t>(sizeof(int32_t)) +  // components, cell -> endpoint, labelling
+         std::max(1, num_threads) * cells * AnyAngleSearch::kBytesPerCell +
+         endpoints * per_endpoint;
 }
 
 }  // namespace covplan

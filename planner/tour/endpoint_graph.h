@@ -43,7 +43,7 @@ inline float EuclidCells(CellIndex a, CellIndex b) {
 
 struct EndpointCandidate {
   int32_t endpoint;
-  float length_cells;     // any-angle path length
+  float length_cells;      // any-angle path length
   uint32_t corner_offset;  // intermediate corners, in order from the list's owner
   uint32_t corner_count;
 };
@@ -51,15 +51,14 @@ struct EndpointCandidate {
 class EndpointGraph {
  public:
   struct Options {
-    int neighbours = 10;       // nearest endpoints kept per endpoint (before symmetrising)
-    int64_t max_settled = 0;   // per search; 0 = max(20000, 64 * free cells / endpoints)
+    int neighbours = 10;      // nearest endpoints kept per endpoint (before symmetrising)
+    int64_t max_settled = 0;  // per search; 0 = max(20000, 64 * free cells / endpoints)
   };
   // Endpoints 2k and 2k + 1 are the two ends of rank k: e ^ 1 (e's own
   // rank) is never in e's list. InvalidArgument if an endpoint is blocked.
-  static absl::StatusOr<std::shared_ptr<const EndpointGraph>> Build(const Grid& grid,
-                                                                   std::vector<CellIndex> endpoints,
-                                                                   const Options& options,
-                                                                   const StopToken& stop, int num_threads);
+  static absl::StatusOr<std::shared_ptr<const EndpointGraph>> Build(
+      const Grid& grid, std::vector<CellIndex> endpoints, const Options& options,
+      const StopToken& stop, int num_threads);
 
   int num_endpoints() const { return static_cast<int>(endpoints_.size()); }
   CellIndex endpoint(int e) const { return endpoints_[e]; }

@@ -1,10 +1,10 @@
 #include "planner/tour/grid_paths.h"
 
 #include <algorithm>
-#include <limits>
-#include <optional>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <optional>
 #include <queue>
 #include <utility>
 
@@ -86,7 +86,8 @@ uint8_t DriveMoveMask(const Grid& g, CellIndex c) {
     } else {
       open = g.Passable(c.row, c.col, 0, dc) && g.Passable(c.row, c.col + dc, dr, 0) &&
              g.Passable(c.row, c.col, dr, 0) && g.Passable(c.row + dr, c.col, 0, dc) &&
-             (g.obstacle_pixels() == nullptr || !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc));
+             (g.obstacle_pixels() == nullptr ||
+              !g.obstacle_pixels()->DiagonalBlocked(c.row, c.col, dr, dc));
     }
     mask |= static_cast<uint8_t>(open) << k;
   }
@@ -254,8 +255,8 @@ void AnyAngleSearch::Reset() {
   touched_.clear();
 }
 
-bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& stop, int64_t max_expansions,
-                           float* bound) {
+bool AnyAngleSearch::RunTo(CellIndex source, CellIndex target, const StopToken& stop,
+                           int64_t max_expansions, float* bound) {
   // Ties (frequent in open areas) go to the cell nearer the goal.
   auto h = [&](CellIndex c) { return Euclid(c, target) * (1.0f + 1e-5f); };
   using Entry = std::pair<float, int32_t>;  // (g + h, cell)
@@ -348,7 +349,8 @@ std::vector<CellIndex> AnyAngleSearch::PathTo(CellIndex target) const {
   return path;
 }
 
-bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed) {
+bool SegmentTouches(const Grid& frame, Point2 a, Point2 b,
+                    const std::function<bool(int, int)>& closed) {
   const double s = frame.cell_size();
   const double ax = (a.x - frame.origin().x) / s, ay = (a.y - frame.origin().y) / s;
   const double bx = (b.x - frame.origin().x) / s, by = (b.y - frame.origin().y) / s;
@@ -361,7 +363,8 @@ bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<b
   double tx = dx != 0 ? ((sx > 0 ? cx + 1 : cx) - ax) / dx : inf;
   double ty = dy != 0 ? ((sy > 0 ? cy + 1 : cy) - ay) / dy : inf;
   const double dtx = dx != 0 ? sx / dx : inf, dty = dy != 0 ? sy / dy : inf;
-  for (int guard = std::abs(ex - cx) + std::abs(ey - cy) + 2; guard > 0 && (cx != ex || cy != ey); --guard) {
+  for (int guard = std::abs(ex - cx) + std::abs(ey - cy) + 2; guard > 0 && (cx != ex || cy != ey);
+       --guard) {
     if (std::abs(tx - ty) <= 1e-12) {
       if (tx > 1.0) break;
       // Exactly through a grid corner: all four cells around it are touched.

@@ -36,13 +36,15 @@ namespace covplan {
 bool LineOfSight(const Grid& grid, CellIndex a, CellIndex b);
 
 // Connected components of free cells under 4-connectivity through passable
-// boundaries (the moves the line-of-sight rule allows). Returns per-cell component id, -1 for blocked.
+// boundaries (the moves the line-of-sight rule allows). Returns per-cell component id, -1 for
+// blocked.
 std::vector<int32_t> FreeComponents(const Grid& grid, int32_t* num_components);
 
 // True when the straight segment a-b (map frame) touches a cell for which
 // closed(row, col) holds: cells entered, clipped, or met at an exact grid
 // corner (all four cells around it count, as in LineOfSight).
-bool SegmentTouches(const Grid& frame, Point2 a, Point2 b, const std::function<bool(int, int)>& closed);
+bool SegmentTouches(const Grid& frame, Point2 a, Point2 b,
+                    const std::function<bool(int, int)>& closed);
 
 // The free cell where a robot at `pose` joins the grid: its own cell, or,
 // when that cell is blocked (a dock against a wall stands in a cell that is
@@ -124,9 +126,9 @@ class AnyAngleSearch {
   std::vector<uint8_t> closed_;
   std::vector<uint16_t> moves_;
   std::vector<std::pair<float, int32_t>> open_;  // RunTo's heap (g + h, cell)
-  int64_t expansions_ = 0;                        // RunTo's, kept to resume
+  int64_t expansions_ = 0;                       // RunTo's, kept to resume
   int64_t goal_ = -1;
-  bool resumable_ = false;  // the last RunTo stopped at its max_expansions
+  bool resumable_ = false;        // the last RunTo stopped at its max_expansions
   std::vector<int32_t> touched_;  // cells written by the last RunTo
   bool all_dirty_ = false;        // Run wrote the whole grid
   int64_t source_ = -1;

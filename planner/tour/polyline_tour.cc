@@ -28,7 +28,8 @@ std::vector<Point2> Reversed(std::vector<Point2> pts) {
   return pts;
 }
 
-std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose, const std::vector<CellIndex>& cells) {
+std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose,
+                             const std::vector<CellIndex>& cells) {
   std::vector<Point2> pts = {{pose.x, pose.y}};
   for (const CellIndex& c : cells) pts.push_back(grid.CellCenter(c));
   return pts;
@@ -44,7 +45,8 @@ PolylineElement RankElement(const Grid& grid, CellIndex first, CellIndex last, i
   std::vector<CellIndex> cells;
   const bool h = first.row == last.row;
   const int n = h ? last.col - first.col + 1 : last.row - first.row + 1;
-  for (int k = 0; k < n; ++k) cells.push_back(h ? CellIndex{first.row, first.col + k} : CellIndex{first.row + k, first.col});
+  for (int k = 0; k < n; ++k)
+    cells.push_back(h ? CellIndex{first.row, first.col + k} : CellIndex{first.row + k, first.col});
   e.sweeps = {std::move(cells)};
   e.tags = {tag};
   e.first_cell = first;
@@ -88,7 +90,8 @@ absl::StatusOr<PolylineTourModel> PolylineTourModel::Create(
   for (int e = 0; e < m.num_elements(); ++e) {
     const std::vector<Point2>& fwd = m.elements_[e].points;
     const std::vector<Point2> bwd = Reversed(fwd);
-    const double axis = m.elements_[e].first_cell.row == m.elements_[e].last_cell.row ? 0.0 : M_PI / 2;
+    const double axis =
+        m.elements_[e].first_cell.row == m.elements_[e].last_cell.row ? 0.0 : M_PI / 2;
     m.heading_in_[2 * e] = FirstHeading(fwd, axis);
     m.heading_out_[2 * e] = std::fmod(FirstHeading(bwd, axis + M_PI) + M_PI, 2 * M_PI);
     m.heading_in_[2 * e + 1] = FirstHeading(bwd, axis + M_PI);
@@ -101,7 +104,8 @@ absl::StatusOr<PolylineTourModel> PolylineTourModel::Create(
   absl::StatusOr<CellIndex> end_cell = JoinCell(drive, m.end_, "end");
   if (!end_cell.ok()) return end_cell.status();
   AnyAngleSearch search(drive);
-  if (!search.Run(*start_cell, stop)) return absl::DeadlineExceededError("stopped while routing from the start");
+  if (!search.Run(*start_cell, stop))
+    return absl::DeadlineExceededError("stopped while routing from the start");
   m.start_paths_.resize(n);
   m.from_start_.resize(n);
   for (int v = 0; v < n; ++v) {
@@ -111,7 +115,8 @@ absl::StatusOr<PolylineTourModel> PolylineTourModel::Create(
           absl::StrFormat("tour element %d cannot be reached from the start", v / 2));
     }
     m.start_paths_[v] = PosePath(drive, m.start_, search.PathTo(entry));
-    m.from_start_[v] = m.motion_->Polyline(m.start_paths_[v], m.start_.theta, m.heading_in_[v]) + m.traverse_[v];
+    m.from_start_[v] =
+        m.motion_->Polyline(m.start_paths_[v], m.start_.theta, m.heading_in_[v]) + m.traverse_[v];
   }
   if (m.has_end_ && !search.Run(*end_cell, stop)) {
     return absl::DeadlineExceededError("stopped while routing to the end");
@@ -143,7 +148,8 @@ void PolylineTourModel::TransitionPoints(int u, int v, std::vector<Point2>* pts)
 
 double PolylineTourModel::Between(int u, int v) const {
   if (u / 2 == v / 2) return std::numeric_limits<double>::infinity();
-  if (!table_->Reachable(ExitEndpoint(u), EntryEndpoint(v))) return std::numeric_limits<double>::infinity();
+  if (!table_->Reachable(ExitEndpoint(u), EntryEndpoint(v)))
+    return std::numeric_limits<double>::infinity();
   thread_local std::vector<Point2> pts;
   TransitionPoints(u, v, &pts);
   return motion_->Polyline(pts, HeadingOut(u), HeadingIn(v)) + traverse_[v];

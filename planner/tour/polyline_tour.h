@@ -8,7 +8,8 @@
 //
 //   std::vector<PolylineElement> elements = ...;
 //   ASSIGN_OR_RETURN(PolylineTourModel model,
-//                    PolylineTourModel::Create(drive, std::move(elements), start, end, motion, stop, 2));
+//                    PolylineTourModel::Create(drive, std::move(elements), start, end, motion,
+//                    stop, 2));
 //   ASSIGN_OR_RETURN(TourOrder order, GtspOrderer(opts).Order(model, stop));
 //   model.BuildPath(order.vertices, &path, &sweeps);
 //
@@ -96,7 +97,8 @@ class PolylineTourModel final : public TourModel {
 // and sweeps). Shared by the tour models whose elements are polylines.
 class PolylinePathWriter {
  public:
-  PolylinePathWriter(const Pose2& start, std::vector<Waypoint>* path, std::vector<CoverageSweep>* sweeps);
+  PolylinePathWriter(const Pose2& start, std::vector<Waypoint>* path,
+                     std::vector<CoverageSweep>* sweeps);
   // Drives pts[1..] as transition segments (pts[0] is where the robot is).
   void Transit(const std::vector<Point2>& pts);
   // Drives `el` from the end it is entered at, heading `heading_in` there.

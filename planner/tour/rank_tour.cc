@@ -14,7 +14,8 @@ namespace covplan {
 namespace {
 
 // Points from `pose` to the centre of its cell, then along `cells`.
-std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose, const std::vector<CellIndex>& cells) {
+std::vector<Point2> PosePath(const Grid& grid, const Pose2& pose,
+                             const std::vector<CellIndex>& cells) {
   std::vector<Point2> pts = {{pose.x, pose.y}};
   for (const CellIndex& c : cells) pts.push_back(grid.CellCenter(c));
   return pts;
@@ -41,7 +42,8 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   cost.grid_ = &grid;
   cost.ranks_ = &ranks;
   cost.table_ = &table;
-  cost.motion_ = motion != nullptr ? std::move(motion) : std::make_shared<const TravelTimeCost>(robot);
+  cost.motion_ =
+      motion != nullptr ? std::move(motion) : std::make_shared<const TravelTimeCost>(robot);
   cost.IndexVertices();
   if (robot.start) {
     cost.start_ = *robot.start;
@@ -72,9 +74,9 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   for (int v = 0; v < n; ++v) {
     const CellIndex entry = table.endpoint(cost.EntryEndpoint(v));
     if (!search.Reached(entry)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "rank %d cannot be reached from the start pose (%.3f, %.3f)", v / 2, cost.start_.x,
-          cost.start_.y));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("rank %d cannot be reached from the start pose (%.3f, %.3f)", v / 2,
+                          cost.start_.x, cost.start_.y));
     }
     cost.start_paths_[v] = PosePath(grid, cost.start_, search.PathTo(entry));
     cost.from_start_[v] =
@@ -88,7 +90,8 @@ absl::StatusOr<RankTourCost> RankTourCost::Create(const Grid& grid, const std::v
   cost.to_end_.resize(n);
   for (int u = 0; u < n; ++u) {
     // Any-angle paths are symmetric: reverse end -> exit.
-    std::vector<Point2> pts = PosePath(grid, cost.end_, search.PathTo(table.endpoint(cost.ExitEndpoint(u))));
+    std::vector<Point2> pts =
+        PosePath(grid, cost.end_, search.PathTo(table.endpoint(cost.ExitEndpoint(u))));
     std::reverse(pts.begin(), pts.end());
     cost.end_paths_[u] = std::move(pts);
     cost.to_end_[u] = cost.motion_->Polyline(cost.end_paths_[u], cost.Heading(u), std::nullopt);
@@ -106,7 +109,8 @@ void RankTourCost::TransitionPoints(int u, int v, std::vector<Point2>* pts) cons
 
 double RankTourCost::Between(int u, int v) const {
   if (u / 2 == v / 2) return std::numeric_limits<double>::infinity();
-  if (!table_->Reachable(ExitEndpoint(u), EntryEndpoint(v))) return std::numeric_limits<double>::infinity();
+  if (!table_->Reachable(ExitEndpoint(u), EntryEndpoint(v)))
+    return std::numeric_limits<double>::infinity();
   thread_local std::vector<Point2> pts;
   TransitionPoints(u, v, &pts);
   return motion_->Polyline(pts, Heading(u), Heading(v)) + rank_cost_[v / 2];

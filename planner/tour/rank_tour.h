@@ -38,8 +38,8 @@ class RankTourCost final : public TourModel {
   // cells. Runs one any-angle search from the start (and end) cell. Moves
   // are priced by `motion` (default: travel time under `robot`).
   static absl::StatusOr<RankTourCost> Create(const Grid& grid, const std::vector<Rank>& ranks,
-                                             const TransitionTable& table,
-                                             const RobotModel& robot, const StopToken& stop,
+                                             const TransitionTable& table, const RobotModel& robot,
+                                             const StopToken& stop,
                                              std::shared_ptr<const MotionCost> motion = nullptr);
 
   int num_elements() const override { return num_ranks(); }

@@ -43,7 +43,7 @@ double RobotModel::StraightTime(double length_m) const {
   // Distance needed to reach top speed and stop again.
   const double ramp = v * v / a;
   if (length_m <= ramp) return 2.0 * std::sqrt(length_m / a);  // triangular profile
-  return 2.0 * v / a + (length_m - ramp) / v;                   // trapezoidal profile
+  return 2.0 * v / a + (length_m - ramp) / v;                  // trapezoidal profile
 }
 
 double RobotModel::TurnTime(double angle_rad) const {

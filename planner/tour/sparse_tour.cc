@@ -249,7 +249,8 @@ class Problem {
   // the other endpoints the search closed harvested.
   double PriceSearched(int x, int y, uint64_t key, Shard& shard, const AnyAngleSearch& search) {
     const std::vector<CellIndex> cells = search.PathTo(cells_[y]);
-    const double c = cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
+    const double c =
+        cells.empty() ? std::numeric_limits<double>::infinity() : PathCost(x, y, cells);
     searches_.fetch_add(1, std::memory_order_relaxed);
     Store(shard, key, {c, true});
     Harvest(x, y, search);
@@ -294,8 +295,8 @@ thread_local std::vector<CellIndex> Problem::harvest_cells_;
 // mates matching the order, and the cost the sum of its transition costs.
 // Checked on every thread's tour and the shared incumbent before a tour is
 // returned.
-absl::Status AuditTour(int n, const std::vector<int>& t, const std::vector<int>& pos, const std::vector<int>& mate,
-                       const std::vector<double>& lc, double cost) {
+absl::Status AuditTour(int n, const std::vector<int>& t, const std::vector<int>& pos,
+                       const std::vector<int>& mate, const std::vector<double>& lc, double cost) {
   const int nodes = 2 * n + 2;
   if (static_cast<int>(t.size()) != nodes || t.front() != 2 * n || t.back() != 2 * n + 1) {
     return absl::InternalError("sparse tour: the tour does not run from the start to the end");
@@ -304,29 +305,33 @@ absl::Status AuditTour(int n, const std::vector<int>& t, const std::vector<int>&
   for (int i = 0; i < nodes; ++i) {
     const int v = t[i];
     if (v < 0 || v >= nodes || seen[v]) {
-      return absl::InternalError(absl::StrFormat("sparse tour: node %d visited twice or out of range", v));
+      return absl::InternalError(
+          absl::StrFormat("sparse tour: node %d visited twice or out of range", v));
     }
     seen[v] = 1;
     if (pos[v] != i) {
-      return absl::InternalError(absl::StrFormat("sparse tour: node %d is at %d, its position says %d", v, i, pos[v]));
+      return absl::InternalError(
+          absl::StrFormat("sparse tour: node %d is at %d, its position says %d", v, i, pos[v]));
     }
   }
   for (int i = 1; i + 1 < nodes; i += 2) {
     if (t[i + 1] != (t[i] ^ 1)) {
-      return absl::InternalError(absl::StrFormat("sparse tour: rank %d is not driven in one piece", t[i] / 2));
+      return absl::InternalError(
+          absl::StrFormat("sparse tour: rank %d is not driven in one piece", t[i] / 2));
     }
   }
   double sum = 0.0;
   for (int i = 0; i < nodes; i += 2) {
     const int a = t[i], b = t[i + 1];
     if (mate[a] != b || mate[b] != a || lc[a] != lc[b]) {
-      return absl::InternalError(absl::StrFormat("sparse tour: transition %d -> %d is not linked", a, b));
+      return absl::InternalError(
+          absl::StrFormat("sparse tour: transition %d -> %d is not linked", a, b));
     }
     sum += lc[a];
   }
   if (!(std::abs(sum - cost) <= 1e-6 * std::max(1.0, std::abs(sum)))) {
-    return absl::InternalError(
-        absl::StrFormat("sparse tour: cost %.6f s is not the sum of its transitions, %.6f s", cost, sum));
+    return absl::InternalError(absl::StrFormat(
+        "sparse tour: cost %.6f s is not the sum of its transitions, %.6f s", cost, sum));
   }
   return absl::OkStatus();
 }
@@ -370,12 +375,14 @@ class Run {
   // Returns true if it converged (not stopped by the budget). With a
   // `shared` incumbent the run kicks its latest tour, publishes gains to it
   // and converges on its global count of kicks without gain.
-  bool Iterate(const StopToken& stop, int64_t converge_after, bool until_limit, Incumbent* shared = nullptr);
+  bool Iterate(const StopToken& stop, int64_t converge_after, bool until_limit,
+               Incumbent* shared = nullptr);
   // Makes this run's tour the incumbent's if it is cheaper; true if it did.
   bool Publish(Incumbent* shared) {
     std::lock_guard<std::mutex> lock(shared->mu);
     if (!(cost_ < shared->cost - kEps)) return false;
-    shared->t = t_, shared->pos = pos_, shared->mate = mate_, shared->lc = lc_, shared->cost = cost_;
+    shared->t = t_, shared->pos = pos_, shared->mate = mate_, shared->lc = lc_,
+    shared->cost = cost_;
     version_ = shared->version.load(std::memory_order_relaxed) + 1;
     shared->version.store(version_, std::memory_order_release);
     return true;
@@ -385,7 +392,8 @@ class Run {
   void Sync(Incumbent* shared) {
     if (shared->version.load(std::memory_order_acquire) == version_) return;
     std::lock_guard<std::mutex> lock(shared->mu);
-    t_ = shared->t, pos_ = shared->pos, mate_ = shared->mate, lc_ = shared->lc, cost_ = shared->cost;
+    t_ = shared->t, pos_ = shared->pos, mate_ = shared->mate, lc_ = shared->lc,
+    cost_ = shared->cost;
     version_ = shared->version.load(std::memory_order_relaxed);
   }
   double cost() const { return cost_; }
@@ -428,10 +436,18 @@ class Run {
   void Rollback() {
     for (auto it = log_.rbegin(); it != log_.rend(); ++it) {
       switch (it->what) {
-        case kT: t_[it->idx] = static_cast<int>(it->old); break;
-        case kPos: pos_[it->idx] = static_cast<int>(it->old); break;
-        case kMate: mate_[it->idx] = static_cast<int>(it->old); break;
-        case kLc: lc_[it->idx] = it->old; break;
+        case kT:
+          t_[it->idx] = static_cast<int>(it->old);
+          break;
+        case kPos:
+          pos_[it->idx] = static_cast<int>(it->old);
+          break;
+        case kMate:
+          mate_[it->idx] = static_cast<int>(it->old);
+          break;
+        case kLc:
+          lc_[it->idx] = it->old;
+          break;
       }
     }
     log_.clear();
@@ -487,7 +503,8 @@ absl::Status Run::Construct(const StopToken& stop) {
   const Grid& grid = p_.grid();
   // Bucket grid of unvisited endpoints for the fallback when every
   // candidate of the current endpoint is already visited.
-  const int side = std::max(4, static_cast<int>(std::sqrt(static_cast<double>(grid.size()) / std::max(1, 2 * n))));
+  const int side = std::max(
+      4, static_cast<int>(std::sqrt(static_cast<double>(grid.size()) / std::max(1, 2 * n))));
   const int brows = grid.rows() / side + 1, bcols = grid.cols() / side + 1;
   std::vector<std::vector<int>> buckets(static_cast<size_t>(brows) * bcols);
   for (int e = 0; e < 2 * n; ++e) {
@@ -500,7 +517,8 @@ absl::Status Run::Construct(const StopToken& stop) {
   int cur = p_.S();
   std::vector<std::pair<double, int>> near;
   for (int step = 0; step < n; ++step) {
-    if ((step & 255) == 255 && stop.cancelled()) return absl::CancelledError("tour construction cancelled");
+    if ((step & 255) == 255 && stop.cancelled())
+      return absl::CancelledError("tour construction cancelled");
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity();
     const absl::Span<const EndpointCandidate> cands = p_.candidates(cur);
@@ -743,11 +761,15 @@ bool Run::Improve(int x) {
         bool reversed;
         if (end == 0) {
           // (y, first): after an exit y forwards; before an entry y reversed.
-          if ((q & 1) == 0) k = q / 2, reversed = false;
-          else k = (q - 1) / 2, reversed = true;
+          if ((q & 1) == 0)
+            k = q / 2, reversed = false;
+          else
+            k = (q - 1) / 2, reversed = true;
         } else {
-          if (q & 1) k = (q - 1) / 2, reversed = false;
-          else k = q / 2, reversed = true;
+          if (q & 1)
+            k = (q - 1) / 2, reversed = false;
+          else
+            k = q / 2, reversed = true;
         }
         if (TryOrOpt(a, b, k, reversed)) return true;
       }
@@ -786,7 +808,8 @@ void Run::DoubleBridge(int i, int j, int k) {
   for (int v : {a, b1, b2, c1, c2, d}) Push(v);
 }
 
-bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limit, Incumbent* shared) {
+bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limit,
+                  Incumbent* shared) {
   const int n = p_.n();
   if (n < 4) return true;
   std::atomic<int64_t> own_stale{0};
@@ -802,7 +825,8 @@ bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limi
     const int x = static_cast<int>(rng_.UniformInt(2 * n));
     auto pick = [&](int from) {
       absl::Span<const EndpointCandidate> c = p_.candidates(from);
-      return c.empty() ? static_cast<int>(rng_.UniformInt(2 * n)) : c[rng_.UniformInt(static_cast<int>(c.size()))].endpoint;
+      return c.empty() ? static_cast<int>(rng_.UniformInt(2 * n))
+                       : c[rng_.UniformInt(static_cast<int>(c.size()))].endpoint;
     };
     const int i0 = pos_[x] & ~1;  // left end of x's transition edge
     int i = -1, j = -1, k = -1;
@@ -850,7 +874,8 @@ bool Run::Iterate(const StopToken& stop, int64_t converge_after, bool until_limi
 }
 
 // Appends the centres of `cells`.
-void AppendCentres(const Grid& grid, const std::vector<CellIndex>& cells, std::vector<Point2>* pts) {
+void AppendCentres(const Grid& grid, const std::vector<CellIndex>& cells,
+                   std::vector<Point2>* pts) {
   for (const CellIndex& c : cells) pts->push_back(grid.CellCenter(c));
 }
 
@@ -858,7 +883,8 @@ void AppendCentres(const Grid& grid, const std::vector<CellIndex>& cells, std::v
 
 absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vector<Rank>& ranks,
                                               const EndpointGraph& graph, const RobotModel& robot,
-                                              const SparseTourOptions& options, const StopToken& stop) {
+                                              const SparseTourOptions& options,
+                                              const StopToken& stop) {
   if (ranks.empty()) return absl::InvalidArgumentError("no ranks to order");
   if (graph.num_endpoints() != static_cast<int>(2 * ranks.size())) {
     return absl::InvalidArgumentError("endpoint graph does not match the ranks");
@@ -884,8 +910,8 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     }
   }
   if (graph.component(*end_cell) != start_comp) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("the end pose (%.3f, %.3f) cannot be reached from the start pose", end.x, end.y));
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "the end pose (%.3f, %.3f) cannot be reached from the start pose", end.x, end.y));
   }
 
   Problem problem(drive, ranks, graph, robot, options.max_cached_pairs);
@@ -938,7 +964,8 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
       // its descent first kicks its own until the other's beats it, and
       // kicks without gain count again from the better one.
       if (shared != nullptr && r.Publish(shared)) shared->stale = 0;
-      out.converged = !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit, shared);
+      out.converged =
+          !budget.ShouldStop() && r.Iterate(budget, converge_after, options.until_limit, shared);
     } else if (options.local_search) {
       out.converged = !budget.ShouldStop();  // the descent ran to its end
     }
@@ -960,7 +987,8 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
   // A thread's last tour may trail the incumbent (its last gain lost to a
   // better one published meanwhile).
   if (kicks && threads > 1 && incumbent.cost < outcomes[best].cost - kEps) {
-    RETURN_IF_ERROR(AuditTour(n, incumbent.t, incumbent.pos, incumbent.mate, incumbent.lc, incumbent.cost));
+    RETURN_IF_ERROR(
+        AuditTour(n, incumbent.t, incumbent.pos, incumbent.mate, incumbent.lc, incumbent.cost));
     outcomes[best].tour = incumbent.t, outcomes[best].cost = incumbent.cost;
   }
   const std::vector<int>& t = outcomes[best].tour;
@@ -993,7 +1021,8 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     for (auto& th : pool) th.join();
   }
   if (failed) {
-    if (stop.ShouldStop()) return absl::DeadlineExceededError("stopped while computing the tour's transition paths");
+    if (stop.ShouldStop())
+      return absl::DeadlineExceededError("stopped while computing the tour's transition paths");
     return absl::InternalError("a tour transition has no any-angle path");
   }
 
@@ -1038,7 +1067,7 @@ absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vect
     tour.termination = Termination::Converged(
         !options.local_search ? "nearest-neighbour tour (no search)"
         : kicks               ? "sparse tour search converged"
-                              : "sparse warm start: the remembered tour, cut for this start, locally optimised");
+                : "sparse warm start: the remembered tour, cut for this start, locally optimised");
   } else if (stop.cancelled()) {
     tour.termination = Termination::LimitReached(TerminationLimit::kCancelled,
                                                  "sparse tour search cancelled; best tour kept");

@@ -56,8 +56,8 @@ struct SparseTourOptions {
   double time_limit_s = 1.0;  // search budget (construction and paths excluded)
   uint64_t seed = 1;
   int num_threads = 1;
-  bool local_search = true;     // false: nearest-neighbour tour only
-  bool until_limit = false;     // true: keep kicking until the budget is spent
+  bool local_search = true;  // false: nearest-neighbour tour only
+  bool until_limit = false;  // true: keep kicking until the budget is spent
   // Kicks without improvement, summed over all threads, after which the
   // kick phase counts as converged: max(min_kicks, kicks_per_rank * ranks).
   int64_t min_kicks = 500;
@@ -74,8 +74,8 @@ struct SparseTourOptions {
 };
 
 struct SparseTour {
-  std::vector<int> vertices;   // rank-tour vertices 2k + d, as RankTourCost
-  std::vector<Waypoint> path;  // start, transitions, coverage, return
+  std::vector<int> vertices;    // rank-tour vertices 2k + d, as RankTourCost
+  std::vector<Waypoint> path;   // start, transitions, coverage, return
   double surrogate_cost = 0.0;  // the search's objective (seconds), for tests and logs
   bool stopped_early = false;
   Termination termination;
@@ -88,7 +88,8 @@ struct SparseTour {
 // complete tour exists.
 absl::StatusOr<SparseTour> PlanSparseRankTour(const Grid& drive, const std::vector<Rank>& ranks,
                                               const EndpointGraph& graph, const RobotModel& robot,
-                                              const SparseTourOptions& options, const StopToken& stop);
+                                              const SparseTourOptions& options,
+                                              const StopToken& stop);
 
 }  // namespace covplan
 

@@ -13,8 +13,9 @@ namespace {
 Termination OrderTermination(bool stopped_early, const StopToken& stop, const char* solver) {
   if (!stopped_early) return Termination::Converged(absl::StrFormat("%s search converged", solver));
   if (stop.cancelled()) {
-    return Termination::LimitReached(TerminationLimit::kCancelled,
-                                     absl::StrFormat("%s search cancelled; best tour kept", solver));
+    return Termination::LimitReached(
+        TerminationLimit::kCancelled,
+        absl::StrFormat("%s search cancelled; best tour kept", solver));
   }
   if (stop.ShouldStop()) {
     return Termination::LimitReached(TerminationLimit::kDeadline,
@@ -52,13 +53,15 @@ double TourModel::TourCost(const std::vector<int>& vertices) const {
   return t + ToEnd(vertices.back());
 }
 
-absl::StatusOr<TourOrder> GreedyOrderer::Order(const TourModel& model, const StopToken& stop) const {
+absl::StatusOr<TourOrder> GreedyOrderer::Order(const TourModel& model,
+                                               const StopToken& stop) const {
   const int n = model.num_vertices();
   std::vector<bool> used(model.num_elements(), false);
   TourOrder tour;
   int current = -1;
   for (int step = 0; step < model.num_elements(); ++step) {
-    if ((step & 63) == 63 && stop.cancelled()) return absl::CancelledError("greedy ordering cancelled");
+    if ((step & 63) == 63 && stop.cancelled())
+      return absl::CancelledError("greedy ordering cancelled");
     int best = -1;
     double best_cost = std::numeric_limits<double>::infinity();
     for (int v = 0; v < n; ++v) {
@@ -167,7 +170,8 @@ absl::StatusOr<TourOrder> GtspOrderer::Order(const TourModel& model, const StopT
   const int n = model.num_vertices();
   if (model.num_elements() <= 1) return greedy;
 
-  const StopToken budget = stop.WithEarlierDeadline(absl::Now() + absl::Seconds(options_.time_limit_s));
+  const StopToken budget =
+      stop.WithEarlierDeadline(absl::Now() + absl::Seconds(options_.time_limit_s));
   GtspInstance inst;
   if (!BuildGtspInstance(model, budget, &inst)) {
     greedy->stopped_early = true;
@@ -182,8 +186,8 @@ absl::StatusOr<TourOrder> GtspOrderer::Order(const TourModel& model, const StopT
   opt.stop = budget;
   if (warm) {  // all trials warm: SolveGtsp skips cold trials when given an initial tour
     opt.max_trials = options_.warm_trials == OrdererOptions::kEffortTrials ? 0
-                     : options_.warm_trials == 0                         ? GtspOptions::kLocalStepOnly
-                                                                         : options_.warm_trials;
+                     : options_.warm_trials == 0 ? GtspOptions::kLocalStepOnly
+                                                 : options_.warm_trials;
   }
   opt.initial_tour.push_back(start);
   for (int v : greedy->vertices) opt.initial_tour.push_back(v);

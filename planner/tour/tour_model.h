@@ -84,14 +84,14 @@ class TourModel {
   void IndexVertices();
 
  private:
-  std::vector<int> first_;      // per element, plus the total
+  std::vector<int> first_;  // per element, plus the total
   std::vector<int> element_of_;
 };
 
 struct TourOrder {
-  std::vector<int> vertices;  // one vertex per element, visiting order
-  double cost = 0.0;          // TourModel::TourCost(vertices)
-  bool stopped_early = false; // a limit (time limit or request stop) ended the search
+  std::vector<int> vertices;   // one vertex per element, visiting order
+  double cost = 0.0;           // TourModel::TourCost(vertices)
+  bool stopped_early = false;  // a limit (time limit or request stop) ended the search
   Termination termination;
 };
 

@@ -26,7 +26,8 @@ absl::StatusOr<std::shared_ptr<const TransitionTable>> TransitionTable::BuildFor
   const int e_count = static_cast<int>(endpoints.size());
   table->num_endpoints_ = e_count;
   for (const CellIndex& c : endpoints) {
-    if (!grid.IsFree(c)) return absl::InvalidArgumentError("transition endpoint lies on a blocked cell");
+    if (!grid.IsFree(c))
+      return absl::InvalidArgumentError("transition endpoint lies on a blocked cell");
   }
   table->endpoints_ = std::move(endpoints);
   table->pairs_.assign(static_cast<size_t>(e_count) * e_count, PairInfo{});

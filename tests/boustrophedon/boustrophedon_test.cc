@@ -32,21 +32,24 @@ std::string CheckPartition(const Grid& g, const BoustrophedonDecomposition& d) {
       const RowInterval iv = cell.columns[k];
       for (int r = iv.lo; r <= iv.hi; ++r) {
         if (!g.IsFree(r, c)) return absl::StrFormat("cell %d holds blocked (%d, %d)", i, r, c);
-        if (r > iv.lo && !g.Passable(r - 1, c, 1, 0)) return absl::StrFormat("cell %d column %d is not linked", i, c);
+        if (r > iv.lo && !g.Passable(r - 1, c, 1, 0))
+          return absl::StrFormat("cell %d column %d is not linked", i, c);
         ++count[g.Index(r, c)];
         if (d.cell_of[g.Index(r, c)] != static_cast<int>(i)) return "cell_of disagrees";
       }
       if (k > 0) {
         const RowInterval p = cell.columns[k - 1];
         bool linked = false;
-        for (int r = std::max(p.lo, iv.lo); r <= std::min(p.hi, iv.hi); ++r) linked |= g.Passable(r, c - 1, 0, 1);
+        for (int r = std::max(p.lo, iv.lo); r <= std::min(p.hi, iv.hi); ++r)
+          linked |= g.Passable(r, c - 1, 0, 1);
         if (!linked) return absl::StrFormat("cell %d: columns %d and %d not linked", i, c - 1, c);
       }
     }
   }
   for (int64_t i = 0; i < g.size(); ++i) {
     const CellIndex c = g.FromIndex(i);
-    if (count[i] != (g.IsFree(c) ? 1 : 0)) return absl::StrFormat("grid cell (%d, %d) in %d cells", c.row, c.col, count[i]);
+    if (count[i] != (g.IsFree(c) ? 1 : 0))
+      return absl::StrFormat("grid cell (%d, %d) in %d cells", c.row, c.col, count[i]);
   }
   return "";
 }
@@ -56,21 +59,26 @@ std::string CheckPartition(const Grid& g, const BoustrophedonDecomposition& d) {
 std::string CheckOxPlow(const Grid& g, const BcdCell& cell, const PolylineElement& e) {
   std::set<std::pair<int, int>> want, got;
   for (size_t k = 0; k < cell.columns.size(); ++k) {
-    for (int r = cell.columns[k].lo; r <= cell.columns[k].hi; ++r) want.insert({r, cell.first_col + static_cast<int>(k)});
+    for (int r = cell.columns[k].lo; r <= cell.columns[k].hi; ++r)
+      want.insert({r, cell.first_col + static_cast<int>(k)});
   }
   for (size_t s = 0; s < e.kinds.size(); ++s) {
     const CellIndex a = g.CellAt(e.points[s]), b = g.CellAt(e.points[s + 1]);
     if (a.row != b.row && a.col != b.col) return absl::StrFormat("segment %d is diagonal", s);
     const int dr = (b.row > a.row) - (b.row < a.row), dc = (b.col > a.col) - (b.col < a.col);
     for (CellIndex c = a; c != b; c = {c.row + dr, c.col + dc}) {
-      if (!g.Passable(c.row, c.col, dr, dc)) return absl::StrFormat("segment %d crosses a closed link", s);
-      if (!want.count({c.row + dr, c.col + dc})) return absl::StrFormat("segment %d leaves the cell", s);
+      if (!g.Passable(c.row, c.col, dr, dc))
+        return absl::StrFormat("segment %d crosses a closed link", s);
+      if (!want.count({c.row + dr, c.col + dc}))
+        return absl::StrFormat("segment %d leaves the cell", s);
     }
     for (const CellIndex& c : e.sweeps[s]) {
-      if (!got.insert({c.row, c.col}).second) return absl::StrFormat("(%d, %d) swept twice", c.row, c.col);
+      if (!got.insert({c.row, c.col}).second)
+        return absl::StrFormat("(%d, %d) swept twice", c.row, c.col);
     }
-    if (e.kinds[s] == SegmentKind::kCoverage && e.sweeps[s].size() !=
-        static_cast<size_t>(std::abs(b.row - a.row) + std::abs(b.col - a.col) + 1)) {
+    if (e.kinds[s] == SegmentKind::kCoverage &&
+        e.sweeps[s].size() !=
+            static_cast<size_t>(std::abs(b.row - a.row) + std::abs(b.col - a.col) + 1)) {
       return absl::StrFormat("coverage segment %d does not sweep the cells it drives over", s);
     }
   }
@@ -182,7 +190,8 @@ MapSource SourceOf(const OccupancyMap& map, const std::string& id) {
 
 TEST(BoustrophedonPlanner, SweepsEveryCellToCoverAndKeepsCellsWhole) {
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  for (const std::string name : {"small_rooms.yaml", "sample_office.yaml", "sample_office_furnished.yaml"}) {
+  for (const std::string name :
+       {"small_rooms.yaml", "sample_office.yaml", "sample_office_furnished.yaml"}) {
     SCOPED_TRACE(name);
     const OccupancyMap map = testing::LoadShippedMap(name);
     LocalArtifactCache cache;
@@ -200,7 +209,8 @@ TEST(BoustrophedonPlanner, SweepsEveryCellToCoverAndKeepsCellsWhole) {
     ASSERT_NE(detail, nullptr);
     ASSERT_EQ(detail->cell_order.size(), detail->cells.size());
     ASSERT_EQ(detail->cell_mirrored.size(), detail->cells.size());
-    EXPECT_EQ(std::set<int>(detail->cell_order.begin(), detail->cell_order.end()).size(), detail->cells.size());
+    EXPECT_EQ(std::set<int>(detail->cell_order.begin(), detail->cell_order.end()).size(),
+              detail->cells.size());
     // The coverage segments of a cell form one contiguous run, in tour order.
     std::vector<int> runs;
     for (const Waypoint& w : plan.path) {
@@ -256,7 +266,8 @@ TEST(BoustrophedonPlanner, RefusesForeignOptions) {
   EXPECT_EQ(p->CheckOptions(OarpOptions()).code(), absl::StatusCode::kInvalidArgument);
   BoustrophedonOptions bad;
   bad.sweep_axis = static_cast<BoustrophedonAxis>(7);
-  EXPECT_THAT(std::string(p->CheckOptions(bad).message()), ::testing::HasSubstr("boustrophedon.sweep_axis"));
+  EXPECT_THAT(std::string(p->CheckOptions(bad).message()),
+              ::testing::HasSubstr("boustrophedon.sweep_axis"));
 }
 
 }  // namespace

@@ -37,7 +37,9 @@ MapSource SourceOf(const OccupancyMap& map, const std::string& id) {
 
 class BatteryPlans : public ::testing::Test {
  protected:
-  BatteryPlans() : map_(testing::LoadShippedMap("small_rooms.yaml")), engine_(&registry_, &cache_, EngineLimits{}) {}
+  BatteryPlans()
+      : map_(testing::LoadShippedMap("small_rooms.yaml")),
+        engine_(&registry_, &cache_, EngineLimits{}) {}
 
   PlanRequest Request(const std::string& planner) const {
     PlanRequest r;
@@ -48,7 +50,8 @@ class BatteryPlans : public ::testing::Test {
   }
   // The centre of a free drive cell near the map's lower left.
   Pose2 FreeStation() {
-    absl::StatusOr<std::shared_ptr<const CoverageArea>> area = engine_.AreaFor(SourceOf(map_, "m"), Request("oarp"));
+    absl::StatusOr<std::shared_ptr<const CoverageArea>> area =
+        engine_.AreaFor(SourceOf(map_, "m"), Request("oarp"));
     EXPECT_TRUE(area.ok());
     const Grid& g = *(*area)->drive;
     for (int64_t i = 0; i < g.size(); ++i) {
@@ -60,7 +63,9 @@ class BatteryPlans : public ::testing::Test {
     }
     return {};
   }
-  absl::StatusOr<EngineResult> Plan(const PlanRequest& r) { return engine_.Plan(SourceOf(map_, "m"), r); }
+  absl::StatusOr<EngineResult> Plan(const PlanRequest& r) {
+    return engine_.Plan(SourceOf(map_, "m"), r);
+  }
 
   OccupancyMap map_;
   PlannerRegistry registry_ = PlannerRegistry::WithBuiltins();
@@ -71,7 +76,8 @@ class BatteryPlans : public ::testing::Test {
 // Distance energy of path[lo..hi], independently of planner/energy.
 double Distance(const std::vector<Waypoint>& path, int lo, int hi) {
   double d = 0.0;
-  for (int i = lo + 1; i <= hi; ++i) d += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
+  for (int i = lo + 1; i <= hi; ++i)
+    d += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
   return d;
 }
 
@@ -89,10 +95,12 @@ TEST_F(BatteryPlans, CyclesFitStartAndEndAtTheStationAndCoverWhatThePlanCovers) 
     const PlanRequest plain = Request(planner);
     absl::StatusOr<EngineResult> unconstrained = Plan(plain);
     ASSERT_TRUE(unconstrained.ok()) << unconstrained.status();
-    const double total = unconstrained->plan.stats.coverage_length_m + unconstrained->plan.stats.transition_length_m;
+    const double total =
+        unconstrained->plan.stats.coverage_length_m + unconstrained->plan.stats.transition_length_m;
     for (double share : {0.5, 0.35}) {
       for (bool interruptible : {false, true}) {
-        SCOPED_TRACE(planner + " share " + std::to_string(share) + (interruptible ? " interruptible" : " atomic"));
+        SCOPED_TRACE(planner + " share " + std::to_string(share) +
+                     (interruptible ? " interruptible" : " atomic"));
         PlanRequest r = plain;
         BatteryOptions b;
         b.capacity = total * share + 10.0;
@@ -124,7 +132,8 @@ TEST_F(BatteryPlans, CyclesFitStartAndEndAtTheStationAndCoverWhatThePlanCovers) 
           EXPECT_LE(cy.first_waypoint, cy.resume_waypoint);
           EXPECT_LT(cy.resume_waypoint, cy.leave_waypoint);
           EXPECT_LT(cy.leave_waypoint, cy.last_waypoint);
-          EXPECT_NEAR(cy.energy_at_leave, Distance(plan.path, cy.first_waypoint, cy.leave_waypoint), 1e-6);
+          EXPECT_NEAR(cy.energy_at_leave, Distance(plan.path, cy.first_waypoint, cy.leave_waypoint),
+                      1e-6);
           // Legs to and from the station, work in between.
           for (int w = cy.first_waypoint + 1; w <= cy.resume_waypoint; ++w) {
             EXPECT_EQ(plan.path[w].kind, SegmentKind::kFromStation);
@@ -150,7 +159,8 @@ TEST_F(BatteryPlans, CyclesFitStartAndEndAtTheStationAndCoverWhatThePlanCovers) 
           std::map<int, size_t> cycle_of_unit;  // unit number -> cycle
           int unit = -1, last_tag = -2;
           for (size_t c = 0; c < plan.cycles.size(); ++c) {
-            for (int w = plan.cycles[c].resume_waypoint + 1; w <= plan.cycles[c].leave_waypoint; ++w) {
+            for (int w = plan.cycles[c].resume_waypoint + 1; w <= plan.cycles[c].leave_waypoint;
+                 ++w) {
               if (plan.path[w].kind != SegmentKind::kCoverage) continue;
               if (plan.path[w].rank < 0 || plan.path[w].rank != last_tag) ++unit;
               last_tag = plan.path[w].rank;
@@ -174,7 +184,9 @@ TEST_F(BatteryPlans, InterruptibleCellsResumeWhereTheRobotLeft) {
   b.station = station;
   r.battery = b;
   // The least capacity with which atomic cells work (feasibility is monotone).
-  double lo = 0.0, hi = 2.0 * (plain->plan.stats.coverage_length_m + plain->plan.stats.transition_length_m) + 50;
+  double lo = 0.0,
+         hi = 2.0 * (plain->plan.stats.coverage_length_m + plain->plan.stats.transition_length_m) +
+              50;
   for (int it = 0; it < 14; ++it) {
     r.battery->capacity = 0.5 * (lo + hi);
     (Plan(r).ok() ? hi : lo) = r.battery->capacity;
@@ -273,7 +285,8 @@ TEST_F(BatteryPlans, BadBatteryInputIsRefusedWithAReason) {
           for (int dc = -1; dc <= 1; ++dc) all = all && !map_.IsFree(r + dr, c + dc);
         }
         if (!all) continue;
-        b.station = {map_.origin().x + (c + 0.5) * map_.resolution(), map_.origin().y + (r + 0.5) * map_.resolution(), 0};
+        b.station = {map_.origin().x + (c + 0.5) * map_.resolution(),
+                     map_.origin().y + (r + 0.5) * map_.resolution(), 0};
         found = true;
       }
     }
@@ -320,7 +333,8 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   RobotProgress at;
   at.distance_m = 5.0;
   Observations seen;
-  seen.points = {{res->plan.path[res->plan.path.size() / 2].x, res->plan.path[res->plan.path.size() / 2].y}};
+  seen.points = {
+      {res->plan.path[res->plan.path.size() / 2].x, res->plan.path[res->plan.path.size() / 2].y}};
   absl::StatusOr<ReplanResult> replanned = Replan(retained, at, seen, ReplanOptions(), nullptr);
   EXPECT_EQ(replanned.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(replanned.status().message()), HasSubstr("battery plan"));
@@ -333,10 +347,12 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   size_t hit = res->plan.path.size() / 2;
   while (hit + 1 < res->plan.path.size() &&
          (res->plan.path[hit].kind != SegmentKind::kCoverage ||
-          std::hypot(res->plan.path[hit].x - b.station.x, res->plan.path[hit].y - b.station.y) < 2.0)) {
+          std::hypot(res->plan.path[hit].x - b.station.x, res->plan.path[hit].y - b.station.y) <
+              2.0)) {
     ++hit;
   }
-  seen.points = {{res->plan.path[hit].x, res->plan.path[hit].y}};  // a swept cell away from the station
+  seen.points = {
+      {res->plan.path[hit].x, res->plan.path[hit].y}};  // a swept cell away from the station
   absl::StatusOr<ReplanResult> detoured = Replan(retained, at, seen, greedy, nullptr);
   ASSERT_TRUE(detoured.ok()) << detoured.status();
   auto station_visits = [&](const std::vector<Waypoint>& path, size_t from) {
@@ -360,7 +376,8 @@ TEST_F(BatteryPlans, ReplanningABatteryPlanIsRefusedCleanly) {
   EXPECT_EQ(detoured->stats.method, "greedy_detour");
   // A replan of the replan is a battery plan too: its station legs survive only the greedy detour.
   RetainedPlan again{"q", "m", detoured->plan, r, detoured->area};
-  EXPECT_EQ(Replan(again, at, seen, ReplanOptions(), nullptr).status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(Replan(again, at, seen, ReplanOptions(), nullptr).status().code(),
+            absl::StatusCode::kFailedPrecondition);
 }
 
 TEST_F(BatteryPlans, TheSvgColoursEachCycle) {

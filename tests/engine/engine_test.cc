@@ -9,8 +9,8 @@
 #include "planner/engine/engine.h"
 #include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
-#include "tests/testing/shipped_maps.h"
 #include "tests/testing/plan_conformance.h"
+#include "tests/testing/shipped_maps.h"
 
 namespace covplan {
 namespace {
@@ -57,7 +57,9 @@ TEST_P(EveryPlanner, ConformsOnShippedMapsWithAndWithoutZones) {
         absl::StatusOr<EngineResult> result = engine.Plan(SourceOf(map, map_name), r);
         ASSERT_TRUE(result.ok()) << result.status();
         EXPECT_EQ(result->plan.planner, GetParam());
-        EXPECT_EQ(testing::CheckPlanConformance(result->plan, *result->area, r.common.robot, r.no_go), "");
+        EXPECT_EQ(
+            testing::CheckPlanConformance(result->plan, *result->area, r.common.robot, r.no_go),
+            "");
         EXPECT_GT(result->plan.stats.covered_cells, 0);
       }
     }

@@ -40,7 +40,8 @@ class PlanMemoryTest : public ::testing::Test {
     r.common.seed = 3;
     return r;
   }
-  EngineResult MustPlan(const PlanningEngine& engine, const PlanRequest& r, const std::string& id = "office") {
+  EngineResult MustPlan(const PlanningEngine& engine, const PlanRequest& r,
+                        const std::string& id = "office") {
     absl::StatusOr<EngineResult> result = engine.Plan(Source(id), r);
     EXPECT_TRUE(result.ok()) << result.status();
     return result.ok() ? *std::move(result) : EngineResult{};
@@ -159,7 +160,8 @@ TEST_F(PlanMemoryTest, ColdPlansStayDeterministicForASeed) {
   const EngineResult rb = MustPlan(b, Request());
   const EngineResult r1 = MustPlan(without, Request());
   const EngineResult r2 = MustPlan(without, Request());
-  for (const EngineResult* r : {&ra, &rb, &r1, &r2}) EXPECT_EQ(r->plan.stats.plan_source, PlanOrigin::kCold);
+  for (const EngineResult* r : {&ra, &rb, &r1, &r2})
+    EXPECT_EQ(r->plan.stats.plan_source, PlanOrigin::kCold);
   ExpectSamePath(ra.plan, rb.plan);
   ExpectSamePath(ra.plan, r1.plan);
   ExpectSamePath(ra.plan, r2.plan);
@@ -261,7 +263,10 @@ TEST_F(PlanMemoryTest, RecallFindsExactlyWhatPlanAnswersAtOnce) {
   PlanningEngine engine(&registry_, &cache, EngineLimits{});
   int loads = 0;
   MapSource counted = Source();
-  counted.load = [&, load = counted.load] { ++loads; return load(); };
+  counted.load = [&, load = counted.load] {
+    ++loads;
+    return load();
+  };
 
   absl::StatusOr<std::optional<Recalled>> none = engine.Recall(counted, Request());
   ASSERT_TRUE(none.ok()) << none.status();

@@ -23,8 +23,8 @@ constexpr double kRes = 0.05;
 // stub as holes, plus a detached shed (its own polygon).
 std::vector<PolygonInput> Site() {
   PolygonInput main;
-  main.outer = {{0.13, 0.07}, {20.02, 0.07}, {20.02, 8.11}, {12.04, 8.11}, {12.04, 14.03},
-                {0.13, 14.03}, {0.13, 0.07}};
+  main.outer = {{0.13, 0.07},   {20.02, 0.07}, {20.02, 8.11}, {12.04, 8.11},
+                {12.04, 14.03}, {0.13, 14.03}, {0.13, 0.07}};
   main.holes = {
       {{4.0, 4.0}, {5.0, 4.0}, {5.0, 5.0}, {4.0, 5.0}, {4.0, 4.0}},
       {{14.0, 2.0}, {17.0, 2.5}, {15.0, 5.5}, {14.0, 2.0}},
@@ -105,7 +105,9 @@ TEST(PolygonMap, PlansConformAndDriveLinesStayInTheFreeSpace) {
   PlanningEngine engine(&registry, &cache, EngineLimits{});
   MapSource source;
   source.map_id = "site";
-  source.load = []() { return SiteFromPolygons(std::make_shared<const Area>(SiteArea()), kRes, 64'000'000); };
+  source.load = []() {
+    return SiteFromPolygons(std::make_shared<const Area>(SiteArea()), kRes, 64'000'000);
+  };
   PlanRequest r;
   r.common.robot.tool_width_m = 0.6;
   r.common.time_limit_s = 0.3;

@@ -79,7 +79,8 @@ TEST(NoGoZones, DoorwayCorridorAndOpenRoomZonesAreNeverEntered) {
       for (const CellIndex& c : s.cells) {
         const Point2 p = r->plan.grid->CellCenter(c);
         const double h = 0.4;
-        ASSERT_LE(zone->BoxOverlapM2(p.x - h, p.y - h, p.x + h, p.y + h), 0.0) << c.row << "," << c.col;
+        ASSERT_LE(zone->BoxOverlapM2(p.x - h, p.y - h, p.x + h, p.y + h), 0.0)
+            << c.row << "," << c.col;
       }
     }
   }
@@ -97,7 +98,8 @@ TEST(NoGoZones, AZoneAcrossTheOnlyDoorLeavesTheRoomUnreachableNotCrossed) {
   EXPECT_EQ(testing::CheckOarpConformance(*closed, o.robot, o.no_go), "");
   EXPECT_FALSE(AnySweepInside(*closed, 5.6, 10.6, 9.9, 18.4));
   // Office 2 (~4.5 m x 8 m) is reported: tens of cells more than without the zone.
-  EXPECT_GT(closed->plan.stats.unreachable_free_cells, open->plan.stats.unreachable_free_cells + 30);
+  EXPECT_GT(closed->plan.stats.unreachable_free_cells,
+            open->plan.stats.unreachable_free_cells + 30);
   EXPECT_LT(closed->plan.stats.free_cells, open->plan.stats.free_cells);
 }
 
@@ -149,7 +151,8 @@ TEST(Regions, RegionsAndNoGoTogether) {
   const OccupancyMap map = Office();
   PlanOptions o = Options();
   o.regions = {Box(-0.2, 0.6, 11.0, 8.4)};
-  o.no_go = {Box(3.3, 3.3, 5.1, 5.05), Box(9.03, 8.0, 10.3, 8.9)};  // the second blocks the double door
+  o.no_go = {Box(3.3, 3.3, 5.1, 5.05),
+             Box(9.03, 8.0, 10.3, 8.9)};  // the second blocks the double door
   absl::StatusOr<EngineResult> r = PlanCoverageWithArea(map, o);
   ASSERT_TRUE(r.ok()) << r.status();
   EXPECT_EQ(testing::CheckOarpConformance(*r, o.robot, o.no_go), "");
@@ -169,7 +172,8 @@ TEST(Zones, ShareTheMapsGridAndAZonelessRequestStillHitsTheCache) {
   absl::StatusOr<CoveragePlan> z = PlanCoverage(map, zoned, &cache, "office");
   ASSERT_TRUE(z.ok()) << z.status();
   EXPECT_FALSE(z->stats.decomposition_cached);
-  EXPECT_EQ(cache.size(), after_plain + 4);  // the grid is shared; area, partition, transitions, plan are new
+  EXPECT_EQ(cache.size(),
+            after_plain + 4);  // the grid is shared; area, partition, transitions, plan are new
   absl::StatusOr<CoveragePlan> again = PlanCoverage(map, plain, &cache, "office");
   ASSERT_TRUE(again.ok());
   EXPECT_TRUE(again->stats.decomposition_cached);
@@ -194,16 +198,20 @@ TEST(Zones, BadAreasAreInvalidArgumentNamingTheRingOrVertex) {
   };
   const double nan = std::nan("");
   const std::vector<Case> cases = {
-      {{}, {{{{1, 1}, {3, 1}, {1, 3}, {3, 3}, {1, 1}}, {}}}, "no_go[0].outer"},        // bow tie
-      {{}, {{{{1, 1}, {3, 1}, {3, 3}, {1, 3}}, {}}}, "not closed"},                     // open ring
-      {{}, {{{{1, 1}, {3, 1}, {1, 1}}, {}}}, "at least 3"},                              // 2 points
-      {{Box(1, 1, 3, 3), {{{1, 1}, {nan, 1}, {3, 3}, {1, 1}}, {}}}, {}, "regions[1].outer vertex 1"},
+      {{}, {{{{1, 1}, {3, 1}, {1, 3}, {3, 3}, {1, 1}}, {}}}, "no_go[0].outer"},  // bow tie
+      {{}, {{{{1, 1}, {3, 1}, {3, 3}, {1, 3}}, {}}}, "not closed"},              // open ring
+      {{}, {{{{1, 1}, {3, 1}, {1, 1}}, {}}}, "at least 3"},                      // 2 points
+      {{Box(1, 1, 3, 3), {{{1, 1}, {nan, 1}, {3, 3}, {1, 1}}, {}}},
+       {},
+       "regions[1].outer vertex 1"},
       {{}, {{{{1, 1}, {INFINITY, 1}, {3, 3}, {1, 1}}, {}}}, "no_go[0].outer vertex 1"},
       {{}, {Box(100, 100, 101, 101)}, "no_go[0] lies outside the map"},
       {{Box(-30, -30, -20, -20)}, {}, "regions[0] lies outside the map"},
       {{Box(23.5, 1.5, 28.5, 5.5)}, {Box(23, 1, 29, 6)}, "regions: no free"},  // region all no-go
-      {{Box(25.0, 12.0, 25.3, 12.3)}, {}, "regions: no free"},                    // smaller than a cell
-      {{}, {{Box(1, 1, 5, 5).outer, {{{2, 2}, {6, 2}, {6, 3}, {2, 3}, {2, 2}}}}}, "no_go[0].holes[0]"},
+      {{Box(25.0, 12.0, 25.3, 12.3)}, {}, "regions: no free"},  // smaller than a cell
+      {{},
+       {{Box(1, 1, 5, 5).outer, {{{2, 2}, {6, 2}, {6, 3}, {2, 3}, {2, 2}}}}},
+       "no_go[0].holes[0]"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
     PlanOptions o = Options();
@@ -217,7 +225,8 @@ TEST(Zones, BadAreasAreInvalidArgumentNamingTheRingOrVertex) {
   PlanOptions o = Options();
   PolygonInput circle;
   for (int k = 0; k < 200; ++k) {
-    circle.outer.push_back({12 + 2 * std::cos(k * 2 * M_PI / 200), 4 + 2 * std::sin(k * 2 * M_PI / 200)});
+    circle.outer.push_back(
+        {12 + 2 * std::cos(k * 2 * M_PI / 200), 4 + 2 * std::sin(k * 2 * M_PI / 200)});
   }
   circle.outer.push_back(circle.outer.front());
   o.no_go = {circle};

@@ -110,9 +110,9 @@ TEST(AreaValidationTest, TooFineForExtent) {
   unlimited.max_extent_m = 1e10;
   ExpectInvalid(far, "z", "z[0] and 1 other polygon(s) overlapping it: too fine for their extent",
                 unlimited);
-  ExpectInvalid({{{{0, 0}, {1, 0}, {2, 2}, {0, 2}, {0, 0}}, {}},
-                 {{{1, 1}, {3, 1}, {388888, 3}, {1, 1}}, {}}},
-                "z", "z[0] and 1 other polygon(s) overlapping it: too fine for their extent");
+  ExpectInvalid(
+      {{{{0, 0}, {1, 0}, {2, 2}, {0, 2}, {0, 0}}, {}}, {{{1, 1}, {3, 1}, {388888, 3}, {1, 1}}, {}}},
+      "z", "z[0] and 1 other polygon(s) overlapping it: too fine for their extent");
   // Far apart but not overlapping: nothing to union, nothing lost.
   Area apart = MustCreate({{Box(0, 0, 1, 1), {}}, {Box(9e5, 0, 9e5 + 1, 1), {}}});
   EXPECT_NEAR(apart.AreaM2(), 2.0, 1e-6);

@@ -91,8 +91,7 @@ TEST(ParseMapYaml, OverrideResolution) {
 
 TEST(ParseMapYaml, Errors) {
   const auto bad = [](const std::string& yaml, const char* substring) {
-    EXPECT_THAT(ParseMapYaml(yaml, MapLoadOptions{}),
-                StatusIs(Code::kInvalidArgument, substring))
+    EXPECT_THAT(ParseMapYaml(yaml, MapLoadOptions{}), StatusIs(Code::kInvalidArgument, substring))
         << "yaml: " << yaml;
   };
   bad("resolution: 0.05\n", "missing the required key 'image'");
@@ -131,8 +130,8 @@ TEST(DecodeMapYaml, LoadsTheNamedImage) {
     if (it == files.end()) return absl::NotFoundError(absl::StrCat("no file ", name));
     return it->second;
   };
-  auto map = DecodeMapYaml("image: a.pgm\nresolution: 0.5\norigin: [1, 2, 0]\nnegate: 1\n",
-                           loader, MapLoadOptions{});
+  auto map = DecodeMapYaml("image: a.pgm\nresolution: 0.5\norigin: [1, 2, 0]\nnegate: 1\n", loader,
+                           MapLoadOptions{});
   ASSERT_TRUE(map.ok()) << map.status();
   EXPECT_THAT(TopDown(*map), ElementsAre(".##", "##."));  // negated
   EXPECT_DOUBLE_EQ(map->resolution(), 0.5);
@@ -219,9 +218,9 @@ TEST_F(MapFileTest, Errors) {
   const std::string big_yaml = Write("maps/big.yaml", "image: big.pgm\nresolution: 0.05\n");
   MapLoadOptions o;
   o.max_file_bytes = 40;  // the YAML fits, the image does not
-  EXPECT_THAT(LoadMapFile(big_yaml, o),
-              StatusIs(Code::kInvalidArgument, "big.pgm is 64 bytes, above the limit "
-                                               "max_file_bytes = 40"));
+  EXPECT_THAT(LoadMapFile(big_yaml, o), StatusIs(Code::kInvalidArgument,
+                                                 "big.pgm is 64 bytes, above the limit "
+                                                 "max_file_bytes = 40"));
 }
 
 bool SameMap(const OccupancyMap& a, const OccupancyMap& b) {
@@ -305,8 +304,8 @@ TEST(SampleMaps, OfficeLoadsWithExpectedShape) {
 }
 
 TEST(SampleMaps, SmallRoomsPng) {
-  auto map = LoadMapFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml"),
-                         MapLoadOptions{});
+  auto map =
+      LoadMapFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml"), MapLoadOptions{});
   ASSERT_TRUE(map.ok()) << map.status();
   EXPECT_EQ(map->width(), 200);
   EXPECT_EQ(map->height(), 150);

@@ -81,8 +81,9 @@ TEST(DecodePgm, CustomThresholds) {
 }
 
 TEST(DecodePgm, ImageTopRowIsLargestY) {
-  auto map = DecodeMapImage(P5(3, 2, 255, {0, 254, 254,  //
-                                           254, 254, 205}),
+  auto map = DecodeMapImage(P5(3, 2, 255,
+                               {0, 254, 254,  //
+                                254, 254, 205}),
                             Opt());
   ASSERT_TRUE(map.ok()) << map.status();
   EXPECT_EQ(map->at(1, 0), CellState::kOccupied);  // top-left pixel
@@ -111,8 +112,7 @@ TEST(DecodePgm, BinaryCommentBeforeRasterAndTrailingBytes) {
 
 TEST(DecodePgm, SixteenBitBigEndianScaledTo8Bit) {
   // k * 257 scales to exactly k.
-  auto map = DecodeMapImage(
-      P5(5, 1, 65535, {0, 89 * 257, 205 * 257, 206 * 257, 65535}), Opt());
+  auto map = DecodeMapImage(P5(5, 1, 65535, {0, 89 * 257, 205 * 257, 206 * 257, 65535}), Opt());
   ASSERT_TRUE(map.ok()) << map.status();
   EXPECT_THAT(TopDown(*map), ElementsAre("##?.."));
 }
@@ -191,8 +191,9 @@ TEST(DecodePng, GreyEveryBitDepth) {
 TEST(DecodePng, GreyAlphaIgnoresAlpha) {
   for (int depth : {8, 16}) {
     const uint16_t max = depth == 8 ? 255 : 65535;
-    PngSpec s{3, 1, PNG_COLOR_TYPE_GRAY_ALPHA, depth, false,
-              {0, 0, max, 0, static_cast<uint16_t>(205 * (max / 255)), max}, {}, {}};
+    PngSpec s{3,     1,     PNG_COLOR_TYPE_GRAY_ALPHA,
+              depth, false, {0, 0, max, 0, static_cast<uint16_t>(205 * (max / 255)), max},
+              {},    {}};
     EXPECT_THAT(DecodePngRows(s), ElementsAre("#.?")) << "bit depth " << depth;
   }
 }
@@ -286,8 +287,9 @@ TEST(DecodePng, Errors) {
 
   // Dimensions are checked from the header before any pixel buffer exists.
   EXPECT_THAT(DecodeMapImage(WithDimensions(good, 200000, 100000), Opt()),
-              StatusIs(Code::kInvalidArgument, "PNG image is 200000 x 100000 pixels, above "
-                                               "the limit max_pixels = 100000000"));
+              StatusIs(Code::kInvalidArgument,
+                       "PNG image is 200000 x 100000 pixels, above "
+                       "the limit max_pixels = 100000000"));
   EXPECT_THAT(DecodeMapImage(WithDimensions(good, 9000, 9000), Opt()),
               StatusIs(Code::kInvalidArgument, "PNG is truncated or corrupt: 9000 x 9000"));
   EXPECT_THAT(DecodeMapImage(WithDimensions(good, 0, 64), Opt()),

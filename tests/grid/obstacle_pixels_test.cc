@@ -17,7 +17,8 @@ namespace {
 bool BruteForceBlocked(const OccupancyMap& map, double x0, double y0, double x1, double y1,
                        double margin) {
   auto meets = [&](int i, int j) {
-    const double lo_x = i - margin, hi_x = i + 1.0 + margin, lo_y = j - margin, hi_y = j + 1.0 + margin;
+    const double lo_x = i - margin, hi_x = i + 1.0 + margin, lo_y = j - margin,
+                 hi_y = j + 1.0 + margin;
     if (std::max(x0, x1) < lo_x || std::min(x0, x1) > hi_x) return false;
     if (std::max(y0, y1) < lo_y || std::min(y0, y1) > hi_y) return false;
     // The box's corners must not all lie strictly on one side of the line.
@@ -69,11 +70,13 @@ TEST(ObstaclePixels, SegmentBlockedMatchesBruteForceOnRandomMaps) {
         if (!near) return !got;
         return true;
       };
-      ASSERT_TRUE(check(px.SegmentBlocked(a, b))) << a.x << "," << a.y << " -> " << b.x << "," << b.y;
+      ASSERT_TRUE(check(px.SegmentBlocked(a, b)))
+          << a.x << "," << a.y << " -> " << b.x << "," << b.y;
       // ... and, cell by cell, the per-cell check agrees with the whole.
       bool any = false;
       for (int r = 0; r < rows; ++r) {
-        for (int c = 0; c < cols; ++c) any |= px.CellDirty(r, c) && px.SegmentBlockedInCell(r, c, a, b);
+        for (int c = 0; c < cols; ++c)
+          any |= px.CellDirty(r, c) && px.SegmentBlockedInCell(r, c, a, b);
       }
       ASSERT_TRUE(check(any)) << a.x << "," << a.y << " -> " << b.x << "," << b.y;
       checked_enters += enters;

@@ -1,8 +1,8 @@
 // The `gtsp` CLI subcommand: JSON output, flag forms, exit codes.
+#include <unistd.h>
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "client/gtsp_command.h"
 #include "gmock/gmock.h"
@@ -43,8 +43,9 @@ class GtspCommandTest : public ::testing::Test {
 TEST_F(GtspCommandTest, PrintsOneJsonObject) {
   std::string out, err;
   ASSERT_EQ(Run({path_, "--seed", "3", "--threads=2"}, out, err), 0) << err;
-  EXPECT_THAT(out, MatchesRegex("\\{\"instance\":\"square\",\"cost\":40,\"tour\":\\[[1357,]+\\],"
-                                "\"time_s\":[0-9.e-]+,\"iterations\":[0-9]+,\"stopped_early\":false\\}\n"));
+  EXPECT_THAT(
+      out, MatchesRegex("\\{\"instance\":\"square\",\"cost\":40,\"tour\":\\[[1357,]+\\],"
+                        "\"time_s\":[0-9.e-]+,\"iterations\":[0-9]+,\"stopped_early\":false\\}\n"));
   EXPECT_TRUE(err.empty()) << err;
 }
 
@@ -74,7 +75,8 @@ TEST_F(GtspCommandTest, UsageErrorsExitWithTwo) {
 }
 
 TEST_F(GtspCommandTest, MalformedInstanceExitsWithTwo) {
-  std::ofstream(path_) << "DIMENSION : 3\nGTSP_SETS : 1\nEDGE_WEIGHT_TYPE : EUC_2D\nNODE_COORD_SECTION\n1 0 0\n";
+  std::ofstream(path_)
+      << "DIMENSION : 3\nGTSP_SETS : 1\nEDGE_WEIGHT_TYPE : EUC_2D\nNODE_COORD_SECTION\n1 0 0\n";
   std::string out, err;
   EXPECT_EQ(Run({path_}, out, err), 2);
   EXPECT_THAT(err, HasSubstr("line 5"));

@@ -84,7 +84,8 @@ TEST(MemeticTest, CrossoverKeepsAFragmentOfOneParentAndTheOrderOfTheOther) {
       }
       matched = expected == child.seq;
     }
-    EXPECT_TRUE(matched) << "seed " << seed << ": the child is no fragment of a followed by b's order";
+    EXPECT_TRUE(matched) << "seed " << seed
+                         << ": the child is no fragment of a followed by b's order";
   }
 }
 
@@ -113,7 +114,8 @@ TEST(MemeticTest, ThoroughDeadlineSolveFindsTheHeldKarpOptimum) {
   for (unsigned seed = 1; seed <= 10; ++seed) {
     // 2 and 3 sets, then 3..10.
     const int num_sets = seed <= 2 ? 1 + static_cast<int>(seed) : 3 + static_cast<int>(seed % 8);
-    const GtspInstance inst = RandomInstance(seed, num_sets, 3, seed % 2 ? kAsymmetric : kEuclidean, 2);
+    const GtspInstance inst =
+        RandomInstance(seed, num_sets, 3, seed % 2 ? kAsymmetric : kEuclidean, 2);
     const double opt = HeldKarpOptimum(inst);
     for (int threads : {1, 2}) {
       GtspOptions options;
@@ -124,8 +126,8 @@ TEST(MemeticTest, ThoroughDeadlineSolveFindsTheHeldKarpOptimum) {
       absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
       ASSERT_TRUE(r.ok()) << r.status();
       ASSERT_TRUE(ValidateTour(inst, r->tour).ok());
-      EXPECT_NEAR(r->cost, opt, 1e-6) << "seed " << seed << ", " << num_sets << " sets, " << threads
-                                      << " threads";
+      EXPECT_NEAR(r->cost, opt, 1e-6)
+          << "seed " << seed << ", " << num_sets << " sets, " << threads << " threads";
       if (num_sets > 2) {
         EXPECT_GT(r->iterations, 0);  // children were evolved, not only the greedy step
       }

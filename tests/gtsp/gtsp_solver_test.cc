@@ -78,9 +78,9 @@ TEST(GtspSolverTest, TwoSetsAsymmetric) {
   // Sets {0,1} and {2,3}; the cheapest round trip is 1 -> 3 -> 1 (cost 2+3).
   GtspInstance inst;
   inst.num_vertices = 4;
-  inst.costs = {0, 9, 4, 8,   //
-                9, 0, 6, 2,   //
-                4, 9, 0, 9,   //
+  inst.costs = {0, 9, 4, 8,  //
+                9, 0, 6, 2,  //
+                4, 9, 0, 9,  //
                 9, 3, 9, 0};
   inst.sets = {{0, 1}, {2, 3}};
   absl::StatusOr<GtspResult> r = SolveGtsp(inst, {});

@@ -12,8 +12,8 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::string Coords(const std::string& type, const std::string& nodes, int n, const std::string& sets,
-                   int m) {
+std::string Coords(const std::string& type, const std::string& nodes, int n,
+                   const std::string& sets, int m) {
   return "NAME : tiny\nTYPE : GTSP\nCOMMENT : test\nDIMENSION : " + std::to_string(n) +
          "\nGTSP_SETS : " + std::to_string(m) + "\nEDGE_WEIGHT_TYPE : " + type +
          "\nNODE_COORD_SECTION\n" + nodes + "GTSP_SET_SECTION\n" + sets + "EOF\n";
@@ -35,11 +35,11 @@ TEST(GtspLibTest, Euc2dRoundsToNearest) {
   const GtspInstance& g = f->instance;
   EXPECT_EQ(g.num_vertices, 4);
   EXPECT_EQ(g.sets, (std::vector<std::vector<int>>{{0, 2}, {1, 3}}));
-  EXPECT_EQ(g.cost(0, 1), 5);   // 3-4-5
-  EXPECT_EQ(g.cost(0, 2), 1);   // sqrt 2 = 1.41
-  EXPECT_EQ(g.cost(1, 2), 4);   // sqrt 13 = 3.61
-  EXPECT_EQ(g.cost(1, 3), 8);   // sqrt 65 = 8.06
-  EXPECT_EQ(g.cost(2, 3), 9);   // sqrt 82 = 9.06
+  EXPECT_EQ(g.cost(0, 1), 5);  // 3-4-5
+  EXPECT_EQ(g.cost(0, 2), 1);  // sqrt 2 = 1.41
+  EXPECT_EQ(g.cost(1, 2), 4);  // sqrt 13 = 3.61
+  EXPECT_EQ(g.cost(1, 3), 8);  // sqrt 65 = 8.06
+  EXPECT_EQ(g.cost(2, 3), 9);  // sqrt 82 = 9.06
   EXPECT_EQ(g.cost(3, 0), 10);
   EXPECT_EQ(g.cost(2, 2), 0);
 }
@@ -54,15 +54,17 @@ TEST(GtspLibTest, Ceil2dRoundsUp) {
 }
 
 TEST(GtspLibTest, AttPseudoEuclidean) {
-  const GtspInstance g = MustParse(Coords("ATT", "1 0 0\n2 10 0\n3 0 30\n", 3, "1 1 -1\n2 2 3 -1\n", 2));
+  const GtspInstance g =
+      MustParse(Coords("ATT", "1 0 0\n2 10 0\n3 0 30\n", 3, "1 1 -1\n2 2 3 -1\n", 2));
   EXPECT_EQ(g.cost(0, 1), 4);   // sqrt(10) = 3.16 -> nint 3 < 3.16 -> 4
   EXPECT_EQ(g.cost(0, 2), 10);  // sqrt(90) = 9.49 -> 9 < 9.49 -> 10
   EXPECT_EQ(g.cost(1, 2), 10);  // sqrt(100) = 10 exactly
 }
 
 TEST(GtspLibTest, GeoUsesDegreesMinutesAndEarthRadius) {
-  const GtspInstance g = MustParse(
-      Coords("GEO", "1 0.00 0.00\n2 0.00 1.00\n3 0.30 0.00\n4 45.30 -10.45\n", 4, "1 1 2 -1\n2 3 4 -1\n", 2));
+  const GtspInstance g =
+      MustParse(Coords("GEO", "1 0.00 0.00\n2 0.00 1.00\n3 0.30 0.00\n4 45.30 -10.45\n", 4,
+                       "1 1 2 -1\n2 3 4 -1\n", 2));
   EXPECT_EQ(g.cost(0, 1), 112);  // 1 degree of longitude on the equator: 111.3 km, +1 truncated
   EXPECT_EQ(g.cost(0, 2), 56);   // 0.30 = 30 minutes of latitude: 55.7 km
   EXPECT_EQ(g.cost(1, 2), 125);
@@ -72,12 +74,14 @@ TEST(GtspLibTest, GeoUsesDegreesMinutesAndEarthRadius) {
 
 std::string Explicit(const std::string& format, const std::string& weights) {
   return "NAME: e\nTYPE: AGTSP\nDIMENSION: 4\nGTSP_SETS: 2\nEDGE_WEIGHT_TYPE: EXPLICIT\n"
-         "EDGE_WEIGHT_FORMAT: " + format + "\nEDGE_WEIGHT_SECTION\n" + weights +
+         "EDGE_WEIGHT_FORMAT: " +
+         format + "\nEDGE_WEIGHT_SECTION\n" + weights +
          "\nGTSP_SET_SECTION:\n1 1 2 -1\n2 3 4 -1\nEOF\n";
 }
 
 TEST(GtspLibTest, ExplicitFullMatrixIsAsymmetric) {
-  const GtspInstance g = MustParse(Explicit("FULL_MATRIX", "0 1 2 3\n4 0 5 6\n7 8 0 9\n10 11 12 0"));
+  const GtspInstance g =
+      MustParse(Explicit("FULL_MATRIX", "0 1 2 3\n4 0 5 6\n7 8 0 9\n10 11 12 0"));
   EXPECT_EQ(g.cost(0, 3), 3);
   EXPECT_EQ(g.cost(3, 0), 10);
   EXPECT_EQ(g.cost(1, 2), 5);
@@ -106,7 +110,8 @@ TEST(GtspLibTest, ExplicitTriangularFormats) {
 TEST(GtspLibTest, SetsMaySpanLinesAndSkipsDisplayData) {
   const std::string text =
       "NAME:x\nDIMENSION:3\nGTSP_SETS:2\nEDGE_WEIGHT_TYPE:EUC_2D\nNODE_COORD_SECTION\n"
-      "1 0 0\n2 0 3\n3 4 0\nDISPLAY_DATA_SECTION\n1 5 5\nGTSP_SET_SECTION\n2 3\n-1 1 1 2\n-1\nEOF\n";
+      "1 0 0\n2 0 3\n3 4 0\nDISPLAY_DATA_SECTION\n1 5 5\nGTSP_SET_SECTION\n2 3\n-1 1 1 "
+      "2\n-1\nEOF\n";
   const GtspInstance g = MustParse(text);
   EXPECT_EQ(g.sets, (std::vector<std::vector<int>>{{0, 1}, {2}}));
   EXPECT_EQ(g.cost(1, 2), 5);
@@ -123,7 +128,8 @@ TEST(GtspLibTest, MalformedFilesAreRejectedWithLineInfo) {
   const std::string ok = Coords("EUC_2D", kFourNodes, 4, kTwoSets, 2);
   ASSERT_TRUE(ParseGtspLib(ok).ok());
   ExpectParseError("", "missing DIMENSION");
-  ExpectParseError(Coords("EUC_2D", "1 0 0\n2 3 4\n3 1 1\n", 4, kTwoSets, 2), "expected 3 per node");
+  ExpectParseError(Coords("EUC_2D", "1 0 0\n2 3 4\n3 1 1\n", 4, kTwoSets, 2),
+                   "expected 3 per node");
   ExpectParseError(Coords("EUC_2D", "1 0 0\n2 3 x\n3 1 1\n4 10 0\n", 4, kTwoSets, 2),
                    "line 9: expected a number, got 'x'");
   ExpectParseError(Coords("EUC_2D", "1 0 0\n2 3 4\n2 1 1\n4 10 0\n", 4, kTwoSets, 2), "repeated");
@@ -138,15 +144,20 @@ TEST(GtspLibTest, MalformedFilesAreRejectedWithLineInfo) {
                    "line 14: vertex 3 is in set 1 and in set 2; sets must be disjoint");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 2 3 4 -1\n2 -1\n", 2), "set 2 is empty");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n", 2), "ends after 1 of 2 sets");
-  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 4 -1\n3 -1\n", 2), "unexpected data");
-  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, kTwoSets, 3), "GTSP_SET_SECTION ends after 2 of 3");
+  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, "1 1 3 -1\n2 2 4 -1\n3 -1\n", 2),
+                   "unexpected data");
+  ExpectParseError(Coords("EUC_2D", kFourNodes, 4, kTwoSets, 3),
+                   "GTSP_SET_SECTION ends after 2 of 3");
   ExpectParseError(Coords("EUC_2D", kFourNodes, 4, kTwoSets, 7), "exceeds DIMENSION");
   ExpectParseError("DIMENSION : -3\n", "line 1: DIMENSION must be in [1, 10000]");
   ExpectParseError("DIMENSION : many\n", "line 1: expected an integer");
   ExpectParseError("1 2 3\n", "line 1: data outside of any section");
-  ExpectParseError("DIMENSION: 4\nGTSP_SETS: 2\nEDGE_WEIGHT_TYPE: EUC_2D\nGTSP_SET_SECTION\n1 1 3 -1\n2 2 4 -1\n",
-                   "missing NODE_COORD_SECTION");
-  ExpectParseError(Explicit("FULL_MATRIX", "0 1 2 3\n4 0 5 6\n7 8 0 9\n10 11 12"), "has 15 numbers, expected 16");
+  ExpectParseError(
+      "DIMENSION: 4\nGTSP_SETS: 2\nEDGE_WEIGHT_TYPE: EUC_2D\nGTSP_SET_SECTION\n1 1 3 -1\n2 2 4 "
+      "-1\n",
+      "missing NODE_COORD_SECTION");
+  ExpectParseError(Explicit("FULL_MATRIX", "0 1 2 3\n4 0 5 6\n7 8 0 9\n10 11 12"),
+                   "has 15 numbers, expected 16");
   ExpectParseError(Explicit("UPPER_ROW", "1 2 3\n4 -5\n6"), "line 9: negative edge weight");
   ExpectParseError(Explicit("FUNCTION", "1"), "unsupported EDGE_WEIGHT_FORMAT");
 }

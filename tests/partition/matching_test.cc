@@ -21,19 +21,21 @@ using ::covplan::testing::CheckExactCover;
 using ::covplan::testing::RandomGrid;
 
 constexpr MatchingAlgorithm kAlgorithms[] = {MatchingAlgorithm::kMultiSourceBfs,
-                                             MatchingAlgorithm::kHopcroftKarp, MatchingAlgorithm::kPothenFan};
+                                             MatchingAlgorithm::kHopcroftKarp,
+                                             MatchingAlgorithm::kPothenFan};
 
 // Every variant (each algorithm, with and without the greedy start) on `g`:
 // an exact cover whose rank count is `expected`. Returns "" or the first failure.
 std::string CheckAllVariants(const Grid& g, int64_t expected) {
   for (MatchingAlgorithm algorithm : kAlgorithms) {
     for (bool greedy : {true, false}) {
-      const std::string variant =
-          "algorithm " + std::to_string(static_cast<int>(algorithm)) + (greedy ? " greedy" : " no greedy");
+      const std::string variant = "algorithm " + std::to_string(static_cast<int>(algorithm)) +
+                                  (greedy ? " greedy" : " no greedy");
       auto p = MatchingPartitioner(algorithm, greedy).Partition(g, StopToken());
       if (!p.ok()) return variant + ": " + std::string(p.status().ToString());
       if (static_cast<int64_t>(p->ranks.size()) != expected) {
-        return variant + ": " + std::to_string(p->ranks.size()) + " ranks, expected " + std::to_string(expected);
+        return variant + ": " + std::to_string(p->ranks.size()) + " ranks, expected " +
+               std::to_string(expected);
       }
       if (p->objective != static_cast<double>(expected)) return variant + ": objective differs";
       if (CountRankStarts(g, p->orientation) != expected) return variant + ": rank starts differ";
@@ -69,7 +71,8 @@ TEST(MatchingPartitioner, RanksNeverCrossBarriers) {
   EXPECT_EQ(CheckAllVariants(column, 2), "");
   auto p = MatchingPartitioner().Partition(column, StopToken());
   ASSERT_TRUE(p.ok());
-  for (const Rank& r : p->ranks) EXPECT_FALSE(r.first.row <= 1 && r.last.row >= 2) << "rank crosses the wall";
+  for (const Rank& r : p->ranks)
+    EXPECT_FALSE(r.first.row <= 1 && r.last.row >= 2) << "rank crosses the wall";
 }
 
 TEST(MatchingPartitioner, MatchesBruteForceOnTinyGrids) {
@@ -102,7 +105,8 @@ TEST(MatchingPartitioner, EqualsMinCutAndLpWithRandomBarriers) {
     std::mt19937 rng(seed);
     std::vector<uint8_t> walls(base.size());
     for (auto& w : walls) {
-      w = static_cast<uint8_t>((rng() % 5 == 0 ? Grid::kWallRight : 0) | (rng() % 5 == 0 ? Grid::kWallUp : 0));
+      w = static_cast<uint8_t>((rng() % 5 == 0 ? Grid::kWallRight : 0) |
+                               (rng() % 5 == 0 ? Grid::kWallUp : 0));
     }
     Grid g(base.rows(), base.cols(), 1.0, {0, 0}, base.free_flags(), walls);
     if (g.CountFree() == 0) continue;
@@ -122,7 +126,8 @@ TEST(MatchingPartitioner, EqualsMinCutOnOpenFields) {
     std::mt19937 rng(seed);
     std::vector<uint8_t> walls(base.size(), 0);
     if (seed % 2 == 1) {
-      for (auto& w : walls) w = rng() % 50 == 0 ? Grid::kWallRight : (rng() % 50 == 0 ? Grid::kWallUp : 0);
+      for (auto& w : walls)
+        w = rng() % 50 == 0 ? Grid::kWallRight : (rng() % 50 == 0 ? Grid::kWallUp : 0);
     }
     Grid g(base.rows(), base.cols(), 1.0, {0, 0}, base.free_flags(), walls);
     auto cut = MinCutPartitioner().Partition(g, StopToken());

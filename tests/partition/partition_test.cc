@@ -1,6 +1,6 @@
 #include <algorithm>
-#include <random>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "gmock/gmock.h"
@@ -95,7 +95,8 @@ TEST(Partitioners, MinCutEqualsLpWithRandomBarriers) {
     Grid base = RandomGrid(4 + seed % 9, 4 + (seed * 5) % 11, 0.85, 7000 + seed);
     std::mt19937 rng(seed);
     std::vector<uint8_t> walls(base.size());
-    for (auto& w : walls) w = rng() % 5 == 0 ? Grid::kWallRight : (rng() % 5 == 0 ? Grid::kWallUp : 0);
+    for (auto& w : walls)
+      w = rng() % 5 == 0 ? Grid::kWallRight : (rng() % 5 == 0 ? Grid::kWallUp : 0);
     Grid g(base.rows(), base.cols(), 1.0, {0, 0}, base.free_flags(), walls);
     if (g.CountFree() == 0) continue;
     auto cut = MinCutPartitioner().Partition(g, StopToken());

@@ -32,7 +32,8 @@ std::string CheckPushRelabel(const Grid& g, int64_t expected) {
     return std::to_string(p->ranks.size()) + " ranks, expected " + std::to_string(expected);
   }
   if (p->objective != static_cast<double>(expected)) return "objective differs";
-  if (CountRankStarts(g, p->orientation) != expected) return "rank starts of the orientation differ";
+  if (CountRankStarts(g, p->orientation) != expected)
+    return "rank starts of the orientation differ";
   return CheckExactCover(g, p->ranks);
 }
 
@@ -69,7 +70,8 @@ TEST(PushRelabelPartitioner, RanksNeverCrossBarriers) {
   EXPECT_EQ(CheckPushRelabel(column, 2), "");
   auto p = PushRelabelPartitioner().Partition(column, StopToken());
   ASSERT_TRUE(p.ok());
-  for (const Rank& r : p->ranks) EXPECT_FALSE(r.first.row <= 1 && r.last.row >= 2) << "rank crosses the wall";
+  for (const Rank& r : p->ranks)
+    EXPECT_FALSE(r.first.row <= 1 && r.last.row >= 2) << "rank crosses the wall";
 }
 
 TEST(PushRelabelPartitioner, MatchesBruteForceOnTinyGrids) {
@@ -121,7 +123,8 @@ TEST(PushRelabelPartitioner, EqualsBoykovKolmogorovAndMatchingOnOpenFields) {
 // served along forward arcs, so the greedy start is a maximum flow and is
 // kept; one post breaks that and the greedy flow is undone.
 TEST(PushRelabelPartitioner, OpenRectanglesWithAndWithoutAPost) {
-  for (const auto& [rows, cols] : std::vector<std::pair<int, int>>{{1, 9}, {9, 1}, {2, 2}, {7, 30}, {30, 7}, {64, 64}, {120, 45}}) {
+  for (const auto& [rows, cols] : std::vector<std::pair<int, int>>{
+           {1, 9}, {9, 1}, {2, 2}, {7, 30}, {30, 7}, {64, 64}, {120, 45}}) {
     Grid lawn = RandomGrid(rows, cols, 1.0, 1);
     EXPECT_EQ(CheckPushRelabel(lawn, std::min(rows, cols)), "") << rows << " x " << cols;
     std::vector<uint8_t> free = lawn.free_flags();
@@ -130,7 +133,8 @@ TEST(PushRelabelPartitioner, OpenRectanglesWithAndWithoutAPost) {
     if (post.CountFree() == 0) continue;
     auto bk = MinCutPartitioner().Partition(post, StopToken());
     ASSERT_TRUE(bk.ok());
-    EXPECT_EQ(CheckPushRelabel(post, static_cast<int64_t>(bk->ranks.size())), "") << rows << " x " << cols << " with a post";
+    EXPECT_EQ(CheckPushRelabel(post, static_cast<int64_t>(bk->ranks.size())), "")
+        << rows << " x " << cols << " with a post";
   }
 }
 
@@ -138,9 +142,11 @@ TEST(PushRelabelPartitioner, StopsWhenCancelledOrPastTheDeadline) {
   Grid g = RandomGrid(50, 50, 0.9, 3);
   StopToken cancelled;
   cancelled.Cancel();
-  EXPECT_EQ(PushRelabelPartitioner().Partition(g, cancelled).status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(PushRelabelPartitioner().Partition(g, cancelled).status().code(),
+            absl::StatusCode::kDeadlineExceeded);
   const StopToken late = StopToken::WithDeadline(absl::Now() - absl::Seconds(1));
-  EXPECT_EQ(PushRelabelPartitioner().Partition(g, late).status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(PushRelabelPartitioner().Partition(g, late).status().code(),
+            absl::StatusCode::kDeadlineExceeded);
 }
 
 TEST(PushRelabelPartitioner, StopsWhenCancelledWhileRunning) {
@@ -162,7 +168,8 @@ TEST(PushRelabelPartitioner, StopsOnAShortDeadline) {
   // milliseconds; a 1 ms deadline passes during the pushes or a relabelling.
   Grid g = RandomGrid(1000, 1000, 0.99, 5);
   const StopToken soon = StopToken::WithTimeout(absl::Milliseconds(1));
-  EXPECT_EQ(PushRelabelPartitioner().Partition(g, soon).status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(PushRelabelPartitioner().Partition(g, soon).status().code(),
+            absl::StatusCode::kDeadlineExceeded);
 }
 
 TEST(PushRelabelPartitioner, RejectsGridsWithoutFreeCells) {

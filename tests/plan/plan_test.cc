@@ -32,7 +32,8 @@ TEST(BuildGrid, MoreThanHalfFreeRule) {
   // 4x4 pixels, cell = 2 px: top-left cell has exactly 2 of 4 free (not free),
   // bottom-right has 3 of 4 (free).
   OccupancyMap m(4, 4, 0.5, {0, 0});
-  for (int r = 0; r < 4; ++r) for (int c = 0; c < 4; ++c) m.set(r, c, CellState::kOccupied);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m.set(r, c, CellState::kOccupied);
   m.set(3, 0, CellState::kFree);
   m.set(3, 1, CellState::kFree);
   m.set(0, 2, CellState::kFree);
@@ -51,7 +52,8 @@ TEST(BuildGrid, MoreThanHalfFreeRule) {
 
 TEST(BuildGrid, NonIntegerCellSizeUsesFractionalOverlap) {
   OccupancyMap m(10, 10, 0.1, {0, 0});
-  for (int r = 0; r < 10; ++r) for (int c = 0; c < 10; ++c) m.set(r, c, CellState::kFree);
+  for (int r = 0; r < 10; ++r)
+    for (int c = 0; c < 10; ++c) m.set(r, c, CellState::kFree);
   GridOptions opt;
   opt.cell_size = 0.3;  // 3 px; 4th column cell is 1/3 inside the map
   auto g = BuildGrid(m, opt);
@@ -108,8 +110,9 @@ TEST(PlanCoverage, BadInputIsInvalidArgument) {
     double tool;
     const char* message;
   };
-  for (const Case& c : {Case{NAN, "robot.tool_width_m"}, Case{0.0, "robot.tool_width_m"}, Case{-0.8, "robot.tool_width_m"},
-                        Case{0.01, "narrower than one map pixel"}, Case{20.0, "wider than the map"}}) {
+  for (const Case& c : {Case{NAN, "robot.tool_width_m"}, Case{0.0, "robot.tool_width_m"},
+                        Case{-0.8, "robot.tool_width_m"}, Case{0.01, "narrower than one map pixel"},
+                        Case{20.0, "wider than the map"}}) {
     PlanOptions opt;
     opt.robot.tool_width_m = c.tool;
     auto plan = PlanCoverage(OfficeMap(), opt);
@@ -128,7 +131,8 @@ TEST(PlanCoverage, BadInputIsInvalidArgument) {
 TEST(PlanCoverage, DisconnectedAreasAreReportedNotPlanned) {
   OccupancyMap m = OfficeMap();
   // A 1.6 m thick wall splits the map: the smaller side becomes unreachable.
-  for (int r = 0; r < 160; ++r) for (int c = 150; c < 182; ++c) m.set(r, c, CellState::kOccupied);
+  for (int r = 0; r < 160; ++r)
+    for (int c = 150; c < 182; ++c) m.set(r, c, CellState::kOccupied);
   PlanOptions opt;
   opt.tour_solver = TourSolver::kGreedy;
   auto plan = PlanCoverageWithArea(m, opt);
@@ -148,7 +152,8 @@ TEST(BuildGrid, ThinWallBecomesBarrier) {
   // only in the top 0.4 m: the wall is far thinner than a 0.8 m cell.
   OccupancyMap m(80, 40, 0.05, {0, 0});
   for (int r = 0; r < 40; ++r)
-    for (int c = 0; c < 80; ++c) m.set(r, c, (c == 39 || c == 40) && r < 32 ? CellState::kOccupied : CellState::kFree);
+    for (int c = 0; c < 80; ++c)
+      m.set(r, c, (c == 39 || c == 40) && r < 32 ? CellState::kOccupied : CellState::kFree);
   GridOptions opt;
   opt.cell_size = 0.8;
   auto g = BuildGrid(m, opt);

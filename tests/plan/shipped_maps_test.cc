@@ -4,11 +4,11 @@
 #include <string>
 
 #include "gtest/gtest.h"
+#include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/matching_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
-#include "planner/engine/plan_coverage.h"
 #include "tests/testing/plan_conformance.h"
 
 namespace covplan {

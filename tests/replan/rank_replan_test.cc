@@ -132,8 +132,8 @@ TEST(RankReplan, Ilp1UnlimitedMatchesMinCutOnRandomGrids) {
   for (uint32_t seed = 1; seed <= 120; ++seed) {
     std::mt19937 rng(seed);
     const int rows = 2 + rng() % 14, cols = 2 + rng() % 19;
-    const Grid g = RandomWalledGrid(rows, cols, 0.6 + 0.35 * (rng() % 8) / 7.0,
-                                    seed % 2 ? 0.15 : 0.0, seed);
+    const Grid g =
+        RandomWalledGrid(rows, cols, 0.6 + 0.35 * (rng() % 8) / 7.0, seed % 2 ? 0.15 : 0.0, seed);
     const std::vector<Rank> old = MinCutRanks(g);
     std::bernoulli_distribution hit(0.08);
     const Grid w = Blocked(g, [&](int, int) { return hit(rng); });
@@ -285,14 +285,13 @@ TEST(RankReplan, MatchesBruteForceOnTinyGrids) {
     const std::vector<Rank> old = MinCutRanks(g);
     std::uniform_int_distribution<int64_t> cell(0, g.size() - 1);
     const int64_t a = cell(rng), b = cell(rng);
-    const Grid w = Blocked(g, [&](int row, int col) {
-      return g.Index(row, col) == a || g.Index(row, col) == b;
-    });
+    const Grid w = Blocked(
+        g, [&](int row, int col) { return g.Index(row, col) == a || g.Index(row, col) == b; });
     if (w.CountFree() == 0 || w.CountFree() > 14) continue;
     for (RankReplanMethod method : {kIlp1, kIlp2}) {
       for (int64_t budget : {int64_t{0}, int64_t{1}, int64_t{2}, int64_t{3}, kUnlimited}) {
         SCOPED_TRACE(::testing::Message() << "seed " << seed << " ILP-" << (method == kIlp1 ? 1 : 2)
-                                        << " budget " << budget);
+                                          << " budget " << budget);
         const auto [best_m, best_s] = BruteForce(w, old, budget, method);
         absl::StatusOr<RankReplanResult> r = Replan(w, old, budget, method);
         if (best_m < 0) {
@@ -389,10 +388,10 @@ TEST(RankReplan, BadInputIsInvalidArgument) {
   in.budget = 3;
   const Rank h{Orientation::kHorizontal, {0, 0}, {0, 2}};
   for (const std::vector<Rank>& old : std::vector<std::vector<Rank>>{
-           {h, {Orientation::kVertical, {0, 1}, {1, 1}}},       // overlap
-           {{Orientation::kHorizontal, {0, 1}, {0, 3}}},         // leaves the grid
-           {{Orientation::kHorizontal, {0, 2}, {0, 0}}},         // first > last
-           {{Orientation::kVertical, {0, 0}, {1, 1}}}}) {        // not straight
+           {h, {Orientation::kVertical, {0, 1}, {1, 1}}},  // overlap
+           {{Orientation::kHorizontal, {0, 1}, {0, 3}}},   // leaves the grid
+           {{Orientation::kHorizontal, {0, 2}, {0, 0}}},   // first > last
+           {{Orientation::kVertical, {0, 0}, {1, 1}}}}) {  // not straight
     in.old_ranks = old;
     EXPECT_TRUE(absl::IsInvalidArgument(RankReplan(in, kIlp1, StopToken()).status()));
   }

@@ -15,8 +15,8 @@
 #include "gtest/gtest.h"
 #include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
-#include "tests/testing/shipped_maps.h"
 #include "tests/testing/plan_conformance.h"
+#include "tests/testing/shipped_maps.h"
 
 namespace covplan {
 namespace {
@@ -97,7 +97,8 @@ void ExpectGoodReplan(const ReplanResult& r, const RetainedPlan& old, const Robo
   for (const CellIndex& c : seen.cells) EXPECT_FALSE(r.area->drive->IsFree(c));
   // A robot standing in a cell reported blocked first leaves it (see
   // TheRobotsOwnCellReportedBlockedIsLeftAndNeverEnteredAgain).
-  EXPECT_EQ(testing::CheckPathStaysFree(*r.area->drive, r.plan.path, r.stats.robot_cell_blocked), "");
+  EXPECT_EQ(testing::CheckPathStaysFree(*r.area->drive, r.plan.path, r.stats.robot_cell_blocked),
+            "");
   // Honest accounting: swept + remaining + unreachable add up.
   EXPECT_EQ(r.plan.stats.covered_cells, r.stats.remaining_cells);
   EXPECT_EQ(static_cast<int64_t>(r.unreachable.size()), r.stats.newly_unreachable_cells);
@@ -113,14 +114,16 @@ TEST_P(EveryMethod, FurnitureOfTheFurnishedOfficeIsReplannedAroundAndEverythingL
   options.method = GetParam();
   absl::StatusOr<ReplanResult> r = Replan(m.plan, at, m.furniture, options, &estimator);
   ASSERT_TRUE(r.ok()) << r.status();
-  std::printf("method %s: encounters %d, detours %zu, replanned at %d (tau %.1f s), budget %lld, "
-              "new %lld, kept %lld, pieces %lld; rank %.1f ms, transitions %.1f ms, tour %.1f ms, "
-              "total %.1f ms\n",
-              r->stats.method.c_str(), r->stats.num_encounters, r->stats.greedy_detours.size(),
-              r->stats.replanned_encounter, r->stats.time_to_encounter_s,
-              static_cast<long long>(r->stats.rank_budget), static_cast<long long>(r->stats.new_ranks),
-              static_cast<long long>(r->stats.kept_ranks), static_cast<long long>(r->stats.kept_path_pieces),
-              r->stats.rank_replan_ms, r->stats.transitions_ms, r->stats.tour_ms, r->stats.total_ms);
+  std::printf(
+      "method %s: encounters %d, detours %zu, replanned at %d (tau %.1f s), budget %lld, "
+      "new %lld, kept %lld, pieces %lld; rank %.1f ms, transitions %.1f ms, tour %.1f ms, "
+      "total %.1f ms\n",
+      r->stats.method.c_str(), r->stats.num_encounters, r->stats.greedy_detours.size(),
+      r->stats.replanned_encounter, r->stats.time_to_encounter_s,
+      static_cast<long long>(r->stats.rank_budget), static_cast<long long>(r->stats.new_ranks),
+      static_cast<long long>(r->stats.kept_ranks),
+      static_cast<long long>(r->stats.kept_path_pieces), r->stats.rank_replan_ms,
+      r->stats.transitions_ms, r->stats.tour_ms, r->stats.total_ms);
   ExpectGoodReplan(*r, m.plan, at, m.furniture);
   EXPECT_GT(r->stats.num_encounters, 0);
   EXPECT_GT(r->stats.newly_blocked_cells, 0);
@@ -150,8 +153,10 @@ TEST(Replan, AReplannedPlanCanBeReplannedAgain) {
   RobotProgress at = Early(m.plan.plan);
   ReplanEstimator estimator;
   Observations first, second;
-  first.cells.assign(m.furniture.cells.begin(), m.furniture.cells.begin() + m.furniture.cells.size() / 2);
-  second.cells.assign(m.furniture.cells.begin() + m.furniture.cells.size() / 2, m.furniture.cells.end());
+  first.cells.assign(m.furniture.cells.begin(),
+                     m.furniture.cells.begin() + m.furniture.cells.size() / 2);
+  second.cells.assign(m.furniture.cells.begin() + m.furniture.cells.size() / 2,
+                      m.furniture.cells.end());
   absl::StatusOr<ReplanResult> r1 = Replan(m.plan, at, first, ReplanOptions(), &estimator);
   ASSERT_TRUE(r1.ok()) << r1.status();
   RetainedPlan next = m.plan;
@@ -185,7 +190,8 @@ TEST(Replan, ObstaclesBehindTheRobotChangeNothing) {
         const Waypoint& b = m.plan.plan.path[i + 1];
         for (int k = 0; k <= 50; ++k) {
           const double t = k / 50.0;
-          nearest = std::min(nearest, std::hypot(a.x + t * (b.x - a.x) - p.x, a.y + t * (b.y - a.y) - p.y));
+          nearest = std::min(nearest,
+                             std::hypot(a.x + t * (b.x - a.x) - p.x, a.y + t * (b.y - a.y) - p.y));
         }
       }
       if (nearest > 2 * g.cell_size()) {
@@ -249,7 +255,8 @@ TEST(Replan, ABlockedEndMovesTheEndInsteadOfFailing) {
   const Waypoint& end = m.plan.plan.path.back();
   Observations seen;
   seen.points = {{end.x, end.y}};
-  for (ReplanMethod method : {ReplanMethod::kAuto, ReplanMethod::kGreedyDetour, ReplanMethod::kFull}) {
+  for (ReplanMethod method :
+       {ReplanMethod::kAuto, ReplanMethod::kGreedyDetour, ReplanMethod::kFull}) {
     ReplanOptions options;
     options.method = method;
     absl::StatusOr<ReplanResult> r = Replan(m.plan, at, seen, options, nullptr);
@@ -301,7 +308,8 @@ TEST(Replan, MalformedProgressAndObstaclesAreInvalidArgument) {
       {Early(m.plan.plan), bad_polygon, "obstacles.polygons[0].outer"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
-    absl::StatusOr<ReplanResult> r = Replan(m.plan, cases[i].at, cases[i].seen, ReplanOptions(), nullptr);
+    absl::StatusOr<ReplanResult> r =
+        Replan(m.plan, cases[i].at, cases[i].seen, ReplanOptions(), nullptr);
     EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument) << i << ": " << r.status();
     EXPECT_THAT(std::string(r.status().message()), HasSubstr(cases[i].message)) << i;
   }
@@ -351,7 +359,8 @@ TEST(Resume, DrivesBackToTheStopPointAndCoversTheRest) {
   o.stop = StopToken::WithTimeout(absl::Seconds(30));
   ReplanEstimator estimator;
   double rejoin_m = -1.0;
-  absl::StatusOr<ReplanResult> r = Resume(m.plan, stopped, dock, m.furniture, o, &estimator, &rejoin_m);
+  absl::StatusOr<ReplanResult> r =
+      Resume(m.plan, stopped, dock, m.furniture, o, &estimator, &rejoin_m);
   ASSERT_TRUE(r.ok()) << r.status();
   EXPECT_EQ(testing::CheckPlanConformance(r->plan, *r->area, m.plan.request.common.robot), "");
   EXPECT_EQ(testing::CheckPathStaysFree(*r->area->drive, r->plan.path), "");
@@ -365,8 +374,8 @@ TEST(Resume, DrivesBackToTheStopPointAndCoversTheRest) {
   }
   EXPECT_TRUE(passes_stop);
   EXPECT_EQ(r->plan.stats.covered_cells, r->stats.remaining_cells);
-  EXPECT_EQ(r->plan.stats.mission_covered_cells + r->stats.remaining_cells + r->plan.stats.mission_cut_off_cells +
-                r->plan.stats.mission_obstructed_cells,
+  EXPECT_EQ(r->plan.stats.mission_covered_cells + r->stats.remaining_cells +
+                r->plan.stats.mission_cut_off_cells + r->plan.stats.mission_obstructed_cells,
             m.plan.plan.stats.free_cells);
   // A pose off the grid names the pose.
   absl::StatusOr<ReplanResult> off = Resume(m.plan, stopped, Pose2{-50, -50, 0}, {}, o, &estimator);
@@ -402,7 +411,8 @@ TEST(Resume, APoseCutOffFromWhereTheRobotStoppedIsRefused) {
   ASSERT_EQ(door.size(), 1u) << picture;
   // Stopped inside a room, not in the doorway.
   RobotProgress stopped;
-  for (int w = static_cast<int>(old.plan.path.size()) / 6; w < static_cast<int>(old.plan.path.size()); ++w) {
+  for (int w = static_cast<int>(old.plan.path.size()) / 6;
+       w < static_cast<int>(old.plan.path.size()); ++w) {
     const Waypoint& a = old.plan.path[w - 1];
     const Waypoint& b = old.plan.path[w];
     const Point2 mid{(a.x + b.x) / 2, (a.y + b.y) / 2};
@@ -420,13 +430,15 @@ TEST(Resume, APoseCutOffFromWhereTheRobotStoppedIsRefused) {
   door_blocked.cells = door;
   ReplanOptions options;
   options.stop = StopToken::WithTimeout(absl::Seconds(30));
-  absl::StatusOr<ReplanResult> cut_off = Resume(old, stopped, other_room, door_blocked, options, nullptr);
+  absl::StatusOr<ReplanResult> cut_off =
+      Resume(old, stopped, other_room, door_blocked, options, nullptr);
   EXPECT_EQ(cut_off.status().code(), absl::StatusCode::kInvalidArgument) << cut_off.status();
   EXPECT_THAT(std::string(cut_off.status().message()), HasSubstr("can drive to where it stopped"));
   // The same door open, or a pose in the robot's room: resumed.
   absl::StatusOr<ReplanResult> open = Resume(old, stopped, other_room, {}, options, nullptr);
   ASSERT_TRUE(open.ok()) << open.status();
-  absl::StatusOr<ReplanResult> same = Resume(old, stopped, same_room, door_blocked, options, nullptr);
+  absl::StatusOr<ReplanResult> same =
+      Resume(old, stopped, same_room, door_blocked, options, nullptr);
   ASSERT_TRUE(same.ok()) << same.status();
   EXPECT_EQ(testing::CheckPathStaysFree(*same->area->drive, same->plan.path), "");
 }
@@ -503,13 +515,15 @@ TEST(Replan, TheRobotsOwnCellReportedBlockedIsLeftAndNeverEnteredAgain) {
     for (size_t i = 1; i < path.size(); ++i) {
       const Waypoint& p = path[i - 1];
       const Waypoint& q = path[i];
-      const int steps = std::max(1, static_cast<int>(std::ceil(std::hypot(q.x - p.x, q.y - p.y) / 0.01)));
+      const int steps =
+          std::max(1, static_cast<int>(std::ceil(std::hypot(q.x - p.x, q.y - p.y) / 0.01)));
       for (int k = 0; k <= steps; ++k) {
         const double t = static_cast<double>(k) / steps;
         const CellIndex c = drive.CellAt({p.x + t * (q.x - p.x), p.y + t * (q.y - p.y)});
         if (!left && c == robot_cell) continue;
         left = true;
-        ASSERT_TRUE(drive.IsFree(c)) << "segment " << i << " enters (" << c.row << ", " << c.col << ")";
+        ASSERT_TRUE(drive.IsFree(c))
+            << "segment " << i << " enters (" << c.row << ", " << c.col << ")";
       }
     }
     EXPECT_TRUE(left);
@@ -519,7 +533,8 @@ TEST(Replan, TheRobotsOwnCellReportedBlockedIsLeftAndNeverEnteredAgain) {
     next.area = r->area;
     RobotProgress later;
     later.waypoint = static_cast<int>(next.plan.path.size()) / 2;
-    later.position = Point2{next.plan.path[later.waypoint - 1].x, next.plan.path[later.waypoint - 1].y};
+    later.position =
+        Point2{next.plan.path[later.waypoint - 1].x, next.plan.path[later.waypoint - 1].y};
     Observations other;
     other.cells = {m.furniture.cells.back()};
     absl::StatusOr<ReplanResult> r2 = Replan(next, later, other, options, nullptr);

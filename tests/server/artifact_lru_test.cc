@@ -43,13 +43,15 @@ TEST(SharedLruCacheTest, HitsMissesAndLruEvictionWithinBudget) {
   EXPECT_EQ(stats.evictions, 1);
   EXPECT_EQ(stats.hits, 1);
   EXPECT_EQ(stats.misses, 3);
-  absl::StatusOr<std::shared_ptr<const Blob>> a = cache.GetOrBuild("a", StopToken(), Make(40, 99), &hit);
+  absl::StatusOr<std::shared_ptr<const Blob>> a =
+      cache.GetOrBuild("a", StopToken(), Make(40, 99), &hit);
   EXPECT_TRUE(hit);
   EXPECT_EQ((*a)->id, 1);
   cache.GetOrBuild("b", StopToken(), Make(40, 4), &hit).IgnoreError();
   EXPECT_FALSE(hit);  // b had been evicted
   // Larger than the whole budget: returned, not kept.
-  absl::StatusOr<std::shared_ptr<const Blob>> big = cache.GetOrBuild("big", StopToken(), Make(500, 5), &hit);
+  absl::StatusOr<std::shared_ptr<const Blob>> big =
+      cache.GetOrBuild("big", StopToken(), Make(500, 5), &hit);
   ASSERT_TRUE(big.ok());
   EXPECT_EQ((*big)->id, 5);
   EXPECT_LE(cache.stats().bytes, 100u);
@@ -71,7 +73,8 @@ TEST(SharedLruCacheTest, ConcurrentCallersBuildOnce) {
   for (int i = 0; i < 8; ++i) {
     threads.emplace_back([&] {
       bool hit = false;
-      absl::StatusOr<std::shared_ptr<const Blob>> v = cache.GetOrBuild("k", StopToken(), slow, &hit);
+      absl::StatusOr<std::shared_ptr<const Blob>> v =
+          cache.GetOrBuild("k", StopToken(), slow, &hit);
       EXPECT_TRUE(v.ok());
       EXPECT_EQ((*v)->id, 7);
       hits += hit;
@@ -99,12 +102,14 @@ TEST(SharedLruCacheTest, FailuresAreNotCachedAndWaitersRespectTheirDeadline) {
   absl::Notification release;
   std::thread leader([&] {
     bool h = false;
-    cache.GetOrBuild("slow", StopToken(),
-                     [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const Blob>> {
-                       release.WaitForNotificationWithTimeout(absl::Seconds(5));
-                       return std::make_shared<const Blob>(Blob{10, 2});
-                     },
-                     &h)
+    cache
+        .GetOrBuild(
+            "slow", StopToken(),
+            [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const Blob>> {
+              release.WaitForNotificationWithTimeout(absl::Seconds(5));
+              return std::make_shared<const Blob>(Blob{10, 2});
+            },
+            &h)
         .IgnoreError();
   });
   absl::SleepFor(absl::Milliseconds(20));
@@ -157,14 +162,16 @@ TEST(SharedLruCacheTest, FenceWindowOverflowRefusesOldBuilds) {
   absl::Notification started, release;
   std::thread builder([&] {
     bool hit = false;
-    cache.GetOrBuild(
-        "keep/grid", StopToken(),
-        [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const Blob>> {
-          started.Notify();
-          release.WaitForNotification();
-          return std::make_shared<const Blob>(Blob{10, 1});
-        },
-        &hit).IgnoreError();
+    cache
+        .GetOrBuild(
+            "keep/grid", StopToken(),
+            [&](const StopToken&) -> absl::StatusOr<std::shared_ptr<const Blob>> {
+              started.Notify();
+              release.WaitForNotification();
+              return std::make_shared<const Blob>(Blob{10, 1});
+            },
+            &hit)
+        .IgnoreError();
   });
   started.WaitForNotification();
   for (int i = 0; i < 300; ++i) cache.EraseWithPrefix(absl::StrCat("other", i, "/"));

@@ -73,9 +73,9 @@ TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
     EXPECT_GT(local->stats().num_ranks(), 0);
     EXPECT_GT(local->stats().covered_free_area_ratio(), 0.5);
 
-    std::string store = (std::filesystem::temp_directory_path() /
-                         absl::StrCat("covplan_client_plan_", ::getpid()))
-                            .string();
+    std::string store =
+        (std::filesystem::temp_directory_path() / absl::StrCat("covplan_client_plan_", ::getpid()))
+            .string();
     ServerConfig config;
     config.port = 0;
     config.metrics_port = -1;
@@ -145,9 +145,9 @@ TEST(ClientPlanTest, PartitionFlagSelectsTheSolverAndTheDefaultIsPushRelabel) {
 
 TEST(ClientPlanTest, StartAndEndPoseFlagsReachThePlanAndUnreachableCellsAreReported) {
   const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
-  const std::string out = (std::filesystem::temp_directory_path() /
-                           absl::StrCat("covplan_pose_", ::getpid(), ".json"))
-                              .string();
+  const std::string out =
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_pose_", ::getpid(), ".json"))
+          .string();
   ASSERT_EQ(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--out", out}), 0);
   auto read = [&]() {
     std::ifstream in(out);
@@ -180,15 +180,16 @@ TEST(ClientPlanTest, StartAndEndPoseFlagsReachThePlanAndUnreachableCellsAreRepor
   for (const char* bad : {"1", "1,x", "1,2,3,4", "nan,2", ""}) {
     EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--start", bad}), 0) << bad;
   }
-  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--start", "-100,-100"}), 0);
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--tour", "greedy", "--start", "-100,-100"}),
+            0);
 }
 
 TEST(ClientPlanTest, RegionAndNoGoFlagsTakeRingsAndGeoJsonFiles) {
   const std::string yard = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_yard.geojson");
   const std::string zones = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_yard_no_go.geojson");
-  const std::string dir = (std::filesystem::temp_directory_path() /
-                           absl::StrCat("covplan_zones_", ::getpid()))
-                              .string();
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_zones_", ::getpid()))
+          .string();
   std::filesystem::create_directories(dir);
   const std::string out = dir + "/plan.json", svg = dir + "/plan.svg";
   ASSERT_EQ(RunPlanCommand({"--map", yard, "--local", "--tool-width", "0.6", "--tour", "greedy",
@@ -222,9 +223,9 @@ TEST(ClientPlanTest, RegionAndNoGoFlagsTakeRingsAndGeoJsonFiles) {
 // through a server; bad STC options are INVALID_ARGUMENT naming the field.
 TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
   const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml");
-  const std::string dir = (std::filesystem::temp_directory_path() /
-                           absl::StrCat("covplan_client_stc_", ::getpid()))
-                              .string();
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_client_stc_", ::getpid()))
+          .string();
   std::filesystem::create_directories(dir);
   ServerConfig config;
   config.port = 0;
@@ -237,8 +238,8 @@ TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
   ASSERT_EQ(RunPlanCommand({"--map", map, "--local", "--algorithm", "stc", "--stc-tree", "prim",
                             "--sweep-direction", "vertical", "--out", local}),
             0);
-  ASSERT_EQ(RunPlanCommand({"--map", map, "--server", address, "--planner", "stc", "--stc-tree", "prim",
-                            "--sweep-direction", "vertical", "--out", remote}),
+  ASSERT_EQ(RunPlanCommand({"--map", map, "--server", address, "--planner", "stc", "--stc-tree",
+                            "prim", "--sweep-direction", "vertical", "--out", remote}),
             0);
   auto read = [](const std::string& path) {
     std::ifstream in(path);
@@ -260,7 +261,8 @@ TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
   EXPECT_EQ(*PlanToJson(a), *PlanToJson(b));
 
   // Through the RPC: a bad tree value and STC options for OARP.
-  auto stub = v1::CoveragePlanner::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  auto stub = v1::CoveragePlanner::NewStub(
+      grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
   absl::StatusOr<v1::Map> proto_map = MapProtoFromFile(map, MapFileOverrides(), InputLimits());
   ASSERT_TRUE(proto_map.ok());
   v1::PlanRequest request;
@@ -282,9 +284,12 @@ TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
     const grpc::Status status = stub->Plan(&context, request, &reply);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   }
-  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--planner", "oarp", "--algorithm", "stc"}), 0);
-  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--stc-tree", "prim"}), 0);  // not the stc planner
-  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--algorithm", "stc", "--stc-tree", "bfs"}), 0);
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--planner", "oarp", "--algorithm", "stc"}),
+            0);
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--stc-tree", "prim"}),
+            0);  // not the stc planner
+  EXPECT_NE(RunPlanCommand({"--map", map, "--local", "--algorithm", "stc", "--stc-tree", "bfs"}),
+            0);
   server->reset();
   std::filesystem::remove_all(dir);
 }

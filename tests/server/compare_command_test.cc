@@ -37,8 +37,8 @@ TEST(CompareCommand, RowsAgreeWithTheEnginesPlans) {
   PlanRequest request;
   request.common.robot.tool_width_m = 0.8;
   request.common.time_limit_s = 30;  // OARP's default effort converges long before
-  absl::StatusOr<std::vector<ComparisonRow>> rows =
-      ComparePlanners(registry, ShippedSource("sample_office.yaml"), {"stc", "oarp"}, request, EngineLimits{});
+  absl::StatusOr<std::vector<ComparisonRow>> rows = ComparePlanners(
+      registry, ShippedSource("sample_office.yaml"), {"stc", "oarp"}, request, EngineLimits{});
   ASSERT_TRUE(rows.ok()) << rows.status();
   ASSERT_EQ(rows->size(), 2u);
   EXPECT_EQ((*rows)[0].planner, "stc");
@@ -89,17 +89,22 @@ TEST(CompareCommand, RedundantCellsCountCellsEnteredTwice) {
 TEST(CompareCommand, UnknownAlgorithmsListTheRegisteredOnes) {
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
   absl::StatusOr<std::vector<ComparisonRow>> rows =
-      ComparePlanners(registry, ShippedSource("small_rooms.yaml"), {"oarp", "spiral"}, PlanRequest(), EngineLimits{});
+      ComparePlanners(registry, ShippedSource("small_rooms.yaml"), {"oarp", "spiral"},
+                      PlanRequest(), EngineLimits{});
   EXPECT_EQ(rows.status().code(), absl::StatusCode::kInvalidArgument);
   // Every registered planner is listed (others join after merges).
-  EXPECT_THAT(std::string(rows.status().message()), HasSubstr("unknown algorithm 'spiral'; registered: "));
+  EXPECT_THAT(std::string(rows.status().message()),
+              HasSubstr("unknown algorithm 'spiral'; registered: "));
   for (const std::string& name : registry.Names()) {
     EXPECT_THAT(std::string(rows.status().message()), HasSubstr(name));
   }
 
-  const std::string json = (std::filesystem::temp_directory_path() / absl::StrCat("cmp_", ::getpid(), ".json")).string();
+  const std::string json =
+      (std::filesystem::temp_directory_path() / absl::StrCat("cmp_", ::getpid(), ".json")).string();
   const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml");
-  EXPECT_EQ(RunCompareCommand({"--map", map, "--algorithms", "stc,oarp", "--json", json, "--time-limit", "0.3"}), 0);
+  EXPECT_EQ(RunCompareCommand(
+                {"--map", map, "--algorithms", "stc,oarp", "--json", json, "--time-limit", "0.3"}),
+            0);
   std::ifstream in(json);
   std::stringstream ss;
   ss << in.rdbuf();

@@ -12,9 +12,9 @@
 #include "absl/strings/str_cat.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/grid/grid.h"
-#include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/stc/stc_planner.h"
 #include "tests/server/test_maps.h"
@@ -91,9 +91,9 @@ TEST(MapFromProtoTest, RejectsBadMapsWithUsefulMessages) {
   EXPECT_THAT(MapFromProto(RasterMap(pgm.substr(0, pgm.size() / 2), 0.1), limits),
               StatusIs(kInvalid, "map.raster.image"));
   static const char kTruncatedPng[] = "\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0";
-  EXPECT_THAT(MapFromProto(RasterMap(std::string(kTruncatedPng, sizeof(kTruncatedPng) - 1), 0.1),
-                           limits),
-              StatusIs(kInvalid, "map.raster.image"));
+  EXPECT_THAT(
+      MapFromProto(RasterMap(std::string(kTruncatedPng, sizeof(kTruncatedPng) - 1), 0.1), limits),
+      StatusIs(kInvalid, "map.raster.image"));
   EXPECT_THAT(MapFromProto(RasterMap(AsciiToPgm({"###", "###"}, 2), 0.1), limits),
               StatusIs(kInvalid, "no free pixel"));
 
@@ -114,10 +114,12 @@ TEST(MapFromProtoTest, RejectsBadMapsWithUsefulMessages) {
 // without --resolution is refused there, before anything is sent or planned.
 TEST(MapProtoFromFileTest, ABareImageNeedsAResolution) {
   const std::string path =
-      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_bare_", getpid(), ".pgm")).string();
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_bare_", getpid(), ".pgm"))
+          .string();
   std::ofstream(path, std::ios::binary) << AsciiToPgm(TwoRooms(), 4);
   absl::StatusOr<v1::Map> bare = MapProtoFromFile(path, MapFileOverrides(), InputLimits());
-  EXPECT_THAT(bare, StatusIs(absl::StatusCode::kInvalidArgument, "is a bare image: --resolution M (metres per pixel) is required"));
+  EXPECT_THAT(bare, StatusIs(absl::StatusCode::kInvalidArgument,
+                             "is a bare image: --resolution M (metres per pixel) is required"));
   EXPECT_THAT(bare.status().message(), HasSubstr(path));
   MapFileOverrides with;
   with.resolution = 0.1;
@@ -147,7 +149,8 @@ TEST(PlanRequestFromProtoTest, ValidatesRobotAndSolvers) {
   const auto kInvalid = absl::StatusCode::kInvalidArgument;
   EXPECT_THAT(PlanRequestFromProto(RequestWithTool(0)), StatusIs(kInvalid, "tool_width_m"));
   EXPECT_THAT(PlanRequestFromProto(RequestWithTool(-1)), StatusIs(kInvalid, "tool_width_m"));
-  EXPECT_THAT(PlanRequestFromProto(RequestWithTool(std::nan(""))), StatusIs(kInvalid, "tool_width_m"));
+  EXPECT_THAT(PlanRequestFromProto(RequestWithTool(std::nan(""))),
+              StatusIs(kInvalid, "tool_width_m"));
   EXPECT_THAT(PlanRequestFromProto(RequestWithTool(std::numeric_limits<double>::infinity())),
               StatusIs(kInvalid, "tool_width_m"));
   v1::PlanRequest request = RequestWithTool(0.5);
@@ -231,7 +234,8 @@ TEST(PlanRequestFromProtoTest, CarriesPlannerAndZones) {
 TEST(EngineValidationTest, ToolMustFitPixelAndMapAndZonesTheMap) {
   const v1::Map map = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);  // 4.8 m x 3.2 m
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  auto check = [&](double tool, const InputLimits& limits, v1::PlanRequest request) -> absl::Status {
+  auto check = [&](double tool, const InputLimits& limits,
+                   v1::PlanRequest request) -> absl::Status {
     LocalArtifactCache cache;
     PlanningEngine engine(&registry, &cache, EngineLimitsFor(limits));
     request.mutable_robot()->set_tool_width_m(tool);
@@ -263,7 +267,8 @@ TEST(EngineValidationTest, ToolMustFitPixelAndMapAndZonesTheMap) {
   v1::PlanRequest unknown;
   unknown.set_planner("nope");
   EXPECT_THAT(absl::StatusOr<int>(check(0.4, limits, unknown)),
-              StatusIs(absl::StatusCode::kInvalidArgument, "unknown planner 'nope'; registered: boustrophedon, oarp"));
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       "unknown planner 'nope'; registered: boustrophedon, oarp"));
 }
 
 TEST(MapIdTest, ContentDerivedAndWellFormed) {
@@ -367,7 +372,7 @@ TEST(PlanJsonTest, SnakeCaseNamesEnumNamesAndDefaultsPrinted) {
   EXPECT_THAT(*json, HasSubstr("\"orientation\": \"VERTICAL\""));
   EXPECT_THAT(*json, HasSubstr("\"kind\": \"COVERAGE\""));
   EXPECT_THAT(*json, HasSubstr("\"first_cell\""));
-  EXPECT_THAT(*json, HasSubstr("\"num_ranks\": 3"));        // int32: a number, not a string
+  EXPECT_THAT(*json, HasSubstr("\"num_ranks\": 3"));            // int32: a number, not a string
   EXPECT_THAT(*json, HasSubstr("\"transition_length_m\": 0"));  // primitive default printed
   EXPECT_THAT(*json, HasSubstr("\"tour_cut_short\": true"));
   EXPECT_THAT(*json, HasSubstr("\"map_id\": \"\""));
@@ -395,19 +400,24 @@ TEST(PlanRequestFromProtoTest, StcOptionsAndTheirErrors) {
 
   v1::PlanRequest bad = request;
   bad.mutable_stc()->set_tree(static_cast<v1::StcTree>(7));
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.tree: unknown value 7"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "stc.tree: unknown value 7"));
   bad = request;
   bad.mutable_stc()->set_sweep_direction(static_cast<v1::StcSweepDirection>(-2));
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.sweep_direction"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "stc.sweep_direction"));
   bad = request;
   bad.mutable_stc()->set_partial_cells(static_cast<v1::StcPartialCells>(5));
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.partial_cells"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "stc.partial_cells"));
   bad = request;
   bad.mutable_stc()->set_tree(v1::STC_TREE_DFS);  // a direction without PRIM
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "stc.sweep_direction"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "stc.sweep_direction"));
   bad = request;
   bad.set_planner("oarp");
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "planner_options"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "planner_options"));
 }
 
 TEST(PlanProtoTest, StcDetailRoundTrips) {
@@ -469,17 +479,21 @@ TEST(BatteryProtoTest, BatteryAndBoustrophedonOptionsAreConvertedAndValidated) {
   for (double cap : {0.0, -1.0, std::nan("")}) {
     v1::PlanRequest bad = request;
     bad.mutable_battery()->set_capacity(cap);
-    EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "battery.capacity"));
+    EXPECT_THAT(PlanRequestFromProto(bad),
+                StatusIs(absl::StatusCode::kInvalidArgument, "battery.capacity"));
   }
   v1::PlanRequest bad = request;
   bad.mutable_battery()->set_reserve(100);
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "battery.reserve"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "battery.reserve"));
   bad = request;
   bad.mutable_battery()->clear_station();
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "battery.station"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "battery.station"));
   bad = request;
   bad.mutable_boustrophedon()->set_sweep_axis(static_cast<v1::SweepAxis>(42));
-  EXPECT_THAT(PlanRequestFromProto(bad), StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon.sweep_axis"));
+  EXPECT_THAT(PlanRequestFromProto(bad),
+              StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon.sweep_axis"));
 }
 
 TEST(BatteryProtoTest, BoustrophedonDetailRoundTrips) {
@@ -507,7 +521,8 @@ TEST(BatteryProtoTest, BoustrophedonDetailRoundTrips) {
   PlanToProto(*back, &again);
   EXPECT_EQ(again.SerializeAsString(), response.SerializeAsString());
   response.mutable_boustrophedon()->mutable_cells(0)->set_row_hi(0, 7);
-  EXPECT_THAT(PlanFromProto(response), StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon cell"));
+  EXPECT_THAT(PlanFromProto(response),
+              StatusIs(absl::StatusCode::kInvalidArgument, "boustrophedon cell"));
 }
 
 TEST(BatteryProtoTest, ChargeCyclesRoundTripAndReachPlanJson) {
@@ -529,7 +544,8 @@ TEST(BatteryProtoTest, ChargeCyclesRoundTripAndReachPlanJson) {
   EXPECT_THAT(*json, HasSubstr("\"cycles\""));
   EXPECT_THAT(*json, HasSubstr("\"resume_waypoint\": 1"));
   response.mutable_cycles(0)->set_last_waypoint(99);
-  EXPECT_THAT(PlanFromProto(response), StatusIs(absl::StatusCode::kInvalidArgument, "charge cycle"));
+  EXPECT_THAT(PlanFromProto(response),
+              StatusIs(absl::StatusCode::kInvalidArgument, "charge cycle"));
 }
 
 }  // namespace

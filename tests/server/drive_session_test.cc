@@ -31,9 +31,11 @@ using Stream = grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>;
 class DriveSessionTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_drive_", ::getpid())).string();
-    absl::StatusOr<v1::Map> map = MapProtoFromFile(
-        absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"), MapFileOverrides(), InputLimits());
+    dir_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_drive_", ::getpid()))
+               .string();
+    absl::StatusOr<v1::Map> map =
+        MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
+                         MapFileOverrides(), InputLimits());
     ASSERT_TRUE(map.ok()) << map.status();
     map_ = *map;
   }
@@ -92,7 +94,8 @@ class DriveSessionTest : public ::testing::Test {
   }
   static int Swept(const v1::PlanResponse& plan) {
     std::set<int> cells;
-    for (const v1::CoverageSweep& s : plan.sweeps()) cells.insert(s.cells().begin(), s.cells().end());
+    for (const v1::CoverageSweep& s : plan.sweeps())
+      cells.insert(s.cells().begin(), s.cells().end());
     return static_cast<int>(cells.size());
   }
   static bool CellFree(const v1::PlanResponse& plan, double x, double y) {
@@ -439,8 +442,18 @@ TEST_F(DriveSessionTest, ResumeContinuesFromWhereTheRobotStopped) {
 TEST_F(DriveSessionTest, TheSimulatorDrivesThroughASession) {
   Start();
   const std::vector<std::string> args = {
-      "--map", absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"), "--clutter", "5", "--seed", "3",
-      "--time-limit", "0.3", "--replan-tour-limit", "0.3", "--no-offline-bound", "--server",
+      "--map",
+      absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
+      "--clutter",
+      "5",
+      "--seed",
+      "3",
+      "--time-limit",
+      "0.3",
+      "--replan-tour-limit",
+      "0.3",
+      "--no-offline-bound",
+      "--server",
       absl::StrCat("127.0.0.1:", server_->port())};
   absl::StatusOr<std::string> json = SimulateCommandJson(args, &ConnectServerPlanSource);
   ASSERT_TRUE(json.ok()) << json.status();

@@ -47,7 +47,8 @@ std::string FromBuffer(const grpc::ByteBuffer& buffer) {
   std::vector<grpc::Slice> slices;
   std::string out;
   if (!buffer.Dump(&slices).ok()) return out;
-  for (const grpc::Slice& s : slices) out.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  for (const grpc::Slice& s : slices)
+    out.append(reinterpret_cast<const char*>(s.begin()), s.size());
   return out;
 }
 
@@ -71,7 +72,8 @@ absl::StatusOr<std::string> RawUnaryCall(const std::shared_ptr<grpc::Channel>& c
 absl::StatusOr<int> HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
                                  const std::string& service) {
   const std::string request = service.empty() ? "" : LengthDelimited(1, service);
-  absl::StatusOr<std::string> bytes = RawUnaryCall(channel, "/grpc.health.v1.Health/Check", request);
+  absl::StatusOr<std::string> bytes =
+      RawUnaryCall(channel, "/grpc.health.v1.Health/Check", request);
   if (!bytes.ok()) return bytes.status();
   google::protobuf::UnknownFieldSet fields;
   if (!fields.ParseFromString(*bytes)) return absl::DataLossError("bad health reply");
@@ -139,7 +141,8 @@ absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
     return absl::UnavailableError(absl::StrCat("cannot connect to 127.0.0.1:", port));
   }
   const std::string request = absl::StrCat("GET ", path, " HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n");
-  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) {
+  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) !=
+      static_cast<ssize_t>(request.size())) {
     ::close(fd);
     return absl::UnavailableError("send failed");
   }

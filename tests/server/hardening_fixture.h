@@ -58,7 +58,8 @@ inline bool SetDirReadOnly(const std::string& dir, bool read_only) {
 class HealthWatch final : public grpc::ClientBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer> {
  public:
   explicit HealthWatch(const std::shared_ptr<grpc::Channel>& channel) : stub_(channel) {
-    stub_.PrepareBidiStreamingCall(&context_, "/grpc.health.v1.Health/Watch", grpc::StubOptions(), this);
+    stub_.PrepareBidiStreamingCall(&context_, "/grpc.health.v1.Health/Watch", grpc::StubOptions(),
+                                   this);
     grpc::Slice empty;
     request_ = grpc::ByteBuffer(&empty, 1);
     StartWrite(&request_);
@@ -101,7 +102,8 @@ class HealthWatch final : public grpc::ClientBidiReactor<grpc::ByteBuffer, grpc:
 class ServerHardeningTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "covplan_harden_XXXXXX").string();
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "covplan_harden_XXXXXX").string();
     ASSERT_NE(mkdtemp(pattern.data()), nullptr);
     root_ = pattern;
     store_ = root_ + "/maps";
@@ -126,7 +128,8 @@ class ServerHardeningTest : public ::testing::Test {
     stub_ = v1::CoveragePlanner::NewStub(channel_);
   }
 
-  grpc::Status PutMap(const v1::Map& map, v1::PutMapResponse* response, const std::string& name = "") {
+  grpc::Status PutMap(const v1::Map& map, v1::PutMapResponse* response,
+                      const std::string& name = "") {
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     v1::PutMapRequest request;
@@ -186,7 +189,6 @@ class ServerHardeningTest : public ::testing::Test {
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::CoveragePlanner::Stub> stub_;
 };
-
 
 }  // namespace covplan::testing
 

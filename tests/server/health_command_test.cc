@@ -16,7 +16,8 @@ namespace {
 
 TEST(HealthCommandTest, ExitsZeroOnlyWhileServing) {
   const std::string store =
-      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_health_", ::getpid())).string();
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_health_", ::getpid()))
+          .string();
   ServerConfig config;
   config.port = 0;
   config.metrics_port = -1;

@@ -34,16 +34,26 @@ using ::covplan::testing::TwoRooms;
 
 const char* CodeName(grpc::StatusCode code) {
   switch (code) {
-    case grpc::StatusCode::OK: return "OK";
-    case grpc::StatusCode::INVALID_ARGUMENT: return "INVALID_ARGUMENT";
-    case grpc::StatusCode::NOT_FOUND: return "NOT_FOUND";
-    case grpc::StatusCode::DEADLINE_EXCEEDED: return "DEADLINE_EXCEEDED";
-    case grpc::StatusCode::RESOURCE_EXHAUSTED: return "RESOURCE_EXHAUSTED";
-    case grpc::StatusCode::FAILED_PRECONDITION: return "FAILED_PRECONDITION";
-    case grpc::StatusCode::UNAVAILABLE: return "UNAVAILABLE";
-    case grpc::StatusCode::INTERNAL: return "INTERNAL";
-    case grpc::StatusCode::UNKNOWN: return "UNKNOWN";
-    default: return "OTHER";
+    case grpc::StatusCode::OK:
+      return "OK";
+    case grpc::StatusCode::INVALID_ARGUMENT:
+      return "INVALID_ARGUMENT";
+    case grpc::StatusCode::NOT_FOUND:
+      return "NOT_FOUND";
+    case grpc::StatusCode::DEADLINE_EXCEEDED:
+      return "DEADLINE_EXCEEDED";
+    case grpc::StatusCode::RESOURCE_EXHAUSTED:
+      return "RESOURCE_EXHAUSTED";
+    case grpc::StatusCode::FAILED_PRECONDITION:
+      return "FAILED_PRECONDITION";
+    case grpc::StatusCode::UNAVAILABLE:
+      return "UNAVAILABLE";
+    case grpc::StatusCode::INTERNAL:
+      return "INTERNAL";
+    case grpc::StatusCode::UNKNOWN:
+      return "UNKNOWN";
+    default:
+      return "OTHER";
   }
 }
 
@@ -57,11 +67,20 @@ class Hostile {
   explicit Hostile(uint32_t seed) : rng_(seed) {}
 
   double Number() {
-    static const double kSpecial[] = {0.0, -0.0, -1.0, 1e-300, 1e300, -1e308, 1e308,
+    static const double kSpecial[] = {0.0,
+                                      -0.0,
+                                      -1.0,
+                                      1e-300,
+                                      1e300,
+                                      -1e308,
+                                      1e308,
                                       std::numeric_limits<double>::quiet_NaN(),
                                       std::numeric_limits<double>::infinity(),
                                       -std::numeric_limits<double>::infinity(),
-                                      std::numeric_limits<double>::denorm_min(), 0.05, 0.4, 3.0};
+                                      std::numeric_limits<double>::denorm_min(),
+                                      0.05,
+                                      0.4,
+                                      3.0};
     if (Chance(0.7)) return kSpecial[Below(std::size(kSpecial))];
     return std::uniform_real_distribution<double>(-1e6, 1e6)(rng_);
   }
@@ -71,29 +90,46 @@ class Hostile {
     std::string s(n, 'a');
     const int kind = Below(4);
     for (char& c : s) {
-      c = kind == 0 ? "0123456789abcdef"[Below(16)] : kind == 1 ? static_cast<char>(Below(256)) : kind == 2 ? '/' : 'x';
+      c = kind == 0   ? "0123456789abcdef"[Below(16)]
+          : kind == 1 ? static_cast<char>(Below(256))
+          : kind == 2 ? '/'
+                      : 'x';
     }
     if (Chance(0.1)) s = "../../../../etc/passwd";
     return s;
   }
   std::string Image() {
     switch (Below(6)) {
-      case 0: return Text();
-      case 1: return "P5\n99999999 99999999\n255\n";
-      case 2: return "P5\n4 4\n255\n" + std::string(3, '\xfe');  // truncated
-      case 3: return std::string("\x89PNG\r\n\x1a\n", 8) + Text();
-      case 4: return "P5\n-3 4\n65536\n" + std::string(64, '\0');
-      default: return AsciiToPgm(TwoRooms(), 1 + Below(4));
+      case 0:
+        return Text();
+      case 1:
+        return "P5\n99999999 99999999\n255\n";
+      case 2:
+        return "P5\n4 4\n255\n" + std::string(3, '\xfe');  // truncated
+      case 3:
+        return std::string("\x89PNG\r\n\x1a\n", 8) + Text();
+      case 4:
+        return "P5\n-3 4\n65536\n" + std::string(64, '\0');
+      default:
+        return AsciiToPgm(TwoRooms(), 1 + Below(4));
     }
   }
   std::string Yaml() {
     switch (Below(6)) {
-      case 0: return Text();
-      case 1: return "resolution: " + std::string(60000, '9');
-      case 2: return std::string(60000, '[');
-      case 3: return absl::StrCat("resolution: ", Number(), "\norigin: [", Number(), ", ", Number(), ", 0]\n");
-      case 4: return absl::StrCat("resolution: 0.1\nnegate: ", Text().substr(0, 8), "\nfree_thresh: ", Number(), "\n");
-      default: return "";
+      case 0:
+        return Text();
+      case 1:
+        return "resolution: " + std::string(60000, '9');
+      case 2:
+        return std::string(60000, '[');
+      case 3:
+        return absl::StrCat("resolution: ", Number(), "\norigin: [", Number(), ", ", Number(),
+                            ", 0]\n");
+      case 4:
+        return absl::StrCat("resolution: 0.1\nnegate: ", Text().substr(0, 8),
+                            "\nfree_thresh: ", Number(), "\n");
+      default:
+        return "";
     }
   }
   v1::Map Map() {
@@ -118,8 +154,10 @@ class Hostile {
   }
   v1::PlanRequest Plan(const std::string& good_map_id) {
     v1::PlanRequest r;
-    if (Chance(0.2)) *r.mutable_map() = Map();
-    else r.set_map_id(Chance(0.6) ? good_map_id : Text());
+    if (Chance(0.2))
+      *r.mutable_map() = Map();
+    else
+      r.set_map_id(Chance(0.6) ? good_map_id : Text());
     r.mutable_robot()->set_tool_width_m(Chance(0.5) ? 0.4 : Number());
     if (Chance(0.3)) r.mutable_robot()->set_max_speed_mps(Number());
     r.set_time_limit_s(Chance(0.5) ? 0.05 : Number());
@@ -136,7 +174,9 @@ class Hostile {
     return r;
   }
   bool Chance(double p) { return std::uniform_real_distribution<double>(0, 1)(rng_) < p; }
-  int Below(size_t n) { return static_cast<int>(std::uniform_int_distribution<size_t>(0, n - 1)(rng_)); }
+  int Below(size_t n) {
+    return static_cast<int>(std::uniform_int_distribution<size_t>(0, n - 1)(rng_));
+  }
 
  private:
   std::mt19937 rng_;
@@ -146,7 +186,8 @@ TEST(HostileRequestsTest, EveryReplyIsOkOrAClientErrorAndTheServerSurvives) {
   // Invalid UTF-8 in string fields is sent on purpose; the client library
   // would log an error for each.
   google::protobuf::SetLogHandler(nullptr);
-  std::string pattern = (std::filesystem::temp_directory_path() / "covplan_hostile_XXXXXX").string();
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "covplan_hostile_XXXXXX").string();
   ASSERT_NE(mkdtemp(pattern.data()), nullptr);
   const std::string root = pattern;
   {
@@ -154,7 +195,9 @@ TEST(HostileRequestsTest, EveryReplyIsOkOrAClientErrorAndTheServerSurvives) {
     ASSERT_TRUE(server.Start(root + "/maps", {"--metrics_port=-1", "--drain_notice_s=0"}).ok());
     auto channel = grpc::CreateChannel(server.target(), grpc::InsecureChannelCredentials());
     auto stub = v1::CoveragePlanner::NewStub(channel);
-    const auto deadline = [] { return std::chrono::system_clock::now() + std::chrono::seconds(20); };
+    const auto deadline = [] {
+      return std::chrono::system_clock::now() + std::chrono::seconds(20);
+    };
     std::string good_id;
     {
       grpc::ClientContext context;
@@ -203,13 +246,15 @@ TEST(HostileRequestsTest, EveryReplyIsOkOrAClientErrorAndTheServerSurvives) {
         case 3: {
           method = "ListMaps";
           v1::ListMapsRequest r;
-          r.set_page_size(hostile.Chance(0.5) ? hostile.Below(5) - 2 : static_cast<int>(hostile.Number()));
+          r.set_page_size(hostile.Chance(0.5) ? hostile.Below(5) - 2
+                                              : static_cast<int>(hostile.Number()));
           if (hostile.Chance(0.5)) r.set_page_token(hostile.Text());
           v1::ListMapsResponse out;
           status = stub->ListMaps(&context, r, &out);
           break;
         }
-        case 4: case 5: {
+        case 4:
+        case 5: {
           method = "Plan";
           v1::PlanResponse out;
           status = stub->Plan(&context, hostile.Plan(good_id), &out);
@@ -225,9 +270,12 @@ TEST(HostileRequestsTest, EveryReplyIsOkOrAClientErrorAndTheServerSurvives) {
         }
       }
       ++outcomes[absl::StrCat(method, " ", CodeName(status.error_code()))];
-      EXPECT_NE(status.error_code(), grpc::StatusCode::INTERNAL) << method << ": " << status.error_message();
-      EXPECT_NE(status.error_code(), grpc::StatusCode::UNKNOWN) << method << ": " << status.error_message();
-      EXPECT_NE(status.error_code(), grpc::StatusCode::UNAVAILABLE) << method << ": " << status.error_message();
+      EXPECT_NE(status.error_code(), grpc::StatusCode::INTERNAL)
+          << method << ": " << status.error_message();
+      EXPECT_NE(status.error_code(), grpc::StatusCode::UNKNOWN)
+          << method << ": " << status.error_message();
+      EXPECT_NE(status.error_code(), grpc::StatusCode::UNAVAILABLE)
+          << method << ": " << status.error_message();
       EXPECT_LE(status.error_message().size(), 1100u) << method;
     }
     std::cout << count << " hostile requests (method, gRPC code: calls):\n";

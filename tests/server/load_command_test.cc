@@ -39,10 +39,14 @@ class LoadCommandTest : public ::testing::Test {
   std::string Run(std::vector<std::string> extra, int* exit_code) {
     std::vector<std::string> args = {"--server", absl::StrCat("127.0.0.1:", server_->port())};
     // Defaults, unless `extra` gives the flag.
-    for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{
-             {"--concurrency", "2"}, {"--duration", "60"}, {"--requests", "8"},
-             {"--deadline-ms", "20000"}, {"--tour", "greedy"}}) {
-      if (std::find(extra.begin(), extra.end(), flag) == extra.end()) args.insert(args.end(), {flag, value});
+    for (const auto& [flag, value] :
+         std::vector<std::pair<std::string, std::string>>{{"--concurrency", "2"},
+                                                          {"--duration", "60"},
+                                                          {"--requests", "8"},
+                                                          {"--deadline-ms", "20000"},
+                                                          {"--tour", "greedy"}}) {
+      if (std::find(extra.begin(), extra.end(), flag) == extra.end())
+        args.insert(args.end(), {flag, value});
     }
     args.insert(args.end(), extra.begin(), extra.end());
     ::testing::internal::CaptureStdout();
@@ -52,7 +56,8 @@ class LoadCommandTest : public ::testing::Test {
 
   int StoredMaps() const {
     int n = 0;
-    for (const auto& e : std::filesystem::directory_iterator(store_)) n += e.path().extension() == ".map";
+    for (const auto& e : std::filesystem::directory_iterator(store_))
+      n += e.path().extension() == ".map";
     return n;
   }
 
@@ -71,7 +76,8 @@ TEST_F(LoadCommandTest, MapsListSpreadsRequestsOverEveryMap) {
   // Both maps were registered by PutMap and so built on first use.
   EXPECT_EQ(StoredMaps(), 2);
   // The acknowledged ids are listed, in --maps order.
-  EXPECT_THAT(json, ::testing::MatchesRegex(".*\"map_ids\": \\[\"[0-9a-f]{64}\", \"[0-9a-f]{64}\"\\]}\n"));
+  EXPECT_THAT(
+      json, ::testing::MatchesRegex(".*\"map_ids\": \\[\"[0-9a-f]{64}\", \"[0-9a-f]{64}\"\\]}\n"));
 }
 
 TEST_F(LoadCommandTest, InlineMapsNeedNoPutMap) {
@@ -94,13 +100,16 @@ TEST_F(LoadCommandTest, RandomStartsWarmStartFromTheRememberedTour) {
   int code = -1;
   const std::string json =
       Run({"--map", absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml"), "--random-start",
-           "--concurrency", "1", "--tour", "gtsp", "--seed", "9"}, &code);
+           "--concurrency", "1", "--tour", "gtsp", "--seed", "9"},
+          &code);
   EXPECT_EQ(code, 0);
   EXPECT_THAT(json, HasSubstr("\"requests\": 8, \"ok\": 8,"));
   EXPECT_THAT(json, HasSubstr("\"random_start\": true"));
   EXPECT_THAT(json, HasSubstr("\"cold\": 1"));
-  EXPECT_THAT(json, ::testing::MatchesRegex(".*\"plan_sources\": \\{(\"cache_hit\": [0-9], )?\"cold\": 1, \"warm_start\": [1-7]\\}.*"));
-  EXPECT_THAT(json, ::testing::ContainsRegex("\"mean_estimated_duration_s\": [1-9][0-9]*\\.[0-9]+"));
+  EXPECT_THAT(json, ::testing::MatchesRegex(".*\"plan_sources\": \\{(\"cache_hit\": [0-9], "
+                                            ")?\"cold\": 1, \"warm_start\": [1-7]\\}.*"));
+  EXPECT_THAT(json,
+              ::testing::ContainsRegex("\"mean_estimated_duration_s\": [1-9][0-9]*\\.[0-9]+"));
 }
 
 TEST_F(LoadCommandTest, MapAndMapsAreExclusive) {

@@ -20,9 +20,9 @@ ServerConfig Config(const std::string& store) {
   ServerConfig config;
   config.port = 0;
   config.metrics_port = -1;
-  config.store_dir = (std::filesystem::temp_directory_path() /
-                      absl::StrCat("covplan_store_choice_", ::getpid()))
-                         .string();
+  config.store_dir =
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_store_choice_", ::getpid()))
+          .string();
   config.map_store = store;
   return config;
 }

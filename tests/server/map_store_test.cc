@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "gtest/gtest.h"
 #include "api/convert.h"
+#include "gtest/gtest.h"
 #include "tests/server/test_maps.h"
 
 namespace covplan {
@@ -20,7 +20,8 @@ using ::covplan::testing::TwoRooms;
 class MapStoreTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "covplan_store_XXXXXX").string();
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "covplan_store_XXXXXX").string();
     ASSERT_NE(mkdtemp(pattern.data()), nullptr);
     dir_ = pattern;
     map_ = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);

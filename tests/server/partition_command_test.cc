@@ -23,7 +23,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::string MapPath(const std::string& name) { return absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/", name); }
+std::string MapPath(const std::string& name) {
+  return absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/", name);
+}
 
 // The number after "key": in the JSON text (NaN when absent).
 double Field(const std::string& json, const std::string& key) {
@@ -45,7 +47,9 @@ std::string WriteYard(const std::string& name) {
   fill(0, 0, w, 4), fill(0, h - 4, w, h), fill(0, 0, 4, h), fill(w - 4, 0, w, h);
   fill(60, 50, 140, 90), fill(300, 200, 330, 380), fill(420, 40, 560, 70), fill(200, 120, 215, 135);
   for (int k = 0; k < 150; ++k) fill(100 + k, 250 + k / 2, 104 + k, 254 + k / 2);
-  const std::string path = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_partition_", name, "_", getpid(), ".pgm")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            absl::StrCat("covplan_partition_", name, "_", getpid(), ".pgm"))
+                               .string();
   std::ofstream out(path, std::ios::binary);
   out << "P5\n" << w << " " << h << "\n255\n";
   out.write(reinterpret_cast<const char*>(px.data()), static_cast<std::streamsize>(px.size()));
@@ -74,7 +78,8 @@ TEST(PartitionCommand, EverySolverFindsTheLpOptimumOnThePlanningGrid) {
     std::printf("%s\n", lp->c_str());
     const double ranks = Field(*lp, "num_ranks");
     EXPECT_GT(ranks, 0);
-    for (const char* solver : {"pushrelabel", "matching", "matching-hk", "matching-pf", "mincut", "mincut-bk"}) {
+    for (const char* solver :
+         {"pushrelabel", "matching", "matching-hk", "matching-pf", "mincut", "mincut-bk"}) {
       std::vector<std::string> args = base;
       args.insert(args.end(), {"--solver", solver, "--repeat", "2"});
       absl::StatusOr<std::string> json = PartitionCommandJson(args);
@@ -123,7 +128,8 @@ TEST(PartitionCommand, BadFlagsAreInvalidArgumentNamingThem) {
   };
   for (const Case& c : cases) {
     absl::StatusOr<std::string> json = PartitionCommandJson(c.args);
-    EXPECT_EQ(json.status().code(), absl::StatusCode::kInvalidArgument) << c.message << ": " << json.status();
+    EXPECT_EQ(json.status().code(), absl::StatusCode::kInvalidArgument)
+        << c.message << ": " << json.status();
     EXPECT_THAT(std::string(json.status().message()), HasSubstr(c.message));
   }
   std::filesystem::remove(yard);

@@ -157,8 +157,8 @@ TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
   ASSERT_NE(one, nullptr);
   ASSERT_NE(two, nullptr);
   auto stub = [](const CovplanServer& s) {
-    return v1::CoveragePlanner::NewStub(grpc::CreateChannel(
-        absl::StrCat("127.0.0.1:", s.port()), grpc::InsecureChannelCredentials()));
+    return v1::CoveragePlanner::NewStub(grpc::CreateChannel(absl::StrCat("127.0.0.1:", s.port()),
+                                                            grpc::InsecureChannelCredentials()));
   };
   auto s1 = stub(*one), s2 = stub(*two);
   v1::PutMapRequest put;
@@ -171,7 +171,8 @@ TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
   v1::PlanResponse plan;
   {
     grpc::ClientContext context;
-    const grpc::Status status = s2->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
+    const grpc::Status status =
+        s2->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_GT(plan.stats().num_ranks(), 0);
   }
@@ -186,13 +187,15 @@ TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
   {
     // Replica one never built this map's artifacts: it needs the store.
     grpc::ClientContext context;
-    const grpc::Status status = s1->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
+    const grpc::Status status =
+        s1->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE) << status.error_message();
   }
   ASSERT_TRUE(pg_->Restart());
   {
     grpc::ClientContext context;
-    const grpc::Status status = s1->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
+    const grpc::Status status =
+        s1->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
     EXPECT_TRUE(status.ok()) << status.error_message();
   }
 }

@@ -35,8 +35,9 @@ std::unique_ptr<PgTestCluster> PgTestCluster::Start(std::string* why) {
   std::unique_ptr<PgTestCluster> pg(new PgTestCluster());
   pg->bin_ = FindBinDir();
   if (pg->bin_.empty()) {
-    *why = "no PostgreSQL server binaries (initdb, pg_ctl) under /usr/lib/postgresql; "
-           "apt-get install postgresql to run these tests";
+    *why =
+        "no PostgreSQL server binaries (initdb, pg_ctl) under /usr/lib/postgresql; "
+        "apt-get install postgresql to run these tests";
     return nullptr;
   }
   char pattern[] = "/tmp/covplan_pg_XXXXXX";

@@ -33,9 +33,9 @@ class PgTestCluster {
   PgTestCluster() = default;
   bool Run(const std::string& command) const;
 
-  std::string bin_;   // directory of initdb / pg_ctl
-  std::string dir_;   // temp dir: data/ and the socket
-  std::string as_;    // "runuser -u postgres -- " when root, else ""
+  std::string bin_;  // directory of initdb / pg_ctl
+  std::string dir_;  // temp dir: data/ and the socket
+  std::string as_;   // "runuser -u postgres -- " when root, else ""
   int port_ = 0;
 };
 

@@ -31,7 +31,7 @@ TEST(SharedLruCachePutTest, PutReplacesFindRefreshesAndTheBudgetHolds) {
   EXPECT_EQ(cache.stats().entries, 2u);
   ASSERT_NE(cache.Find("a"), nullptr);
   EXPECT_EQ(cache.Find("a")->id, 3);
-  EXPECT_EQ(cache.Find("b")->id, 2);  // b is now the most recently used
+  EXPECT_EQ(cache.Find("b")->id, 2);                          // b is now the most recently used
   cache.Put("c", std::make_shared<const Blob>(Blob{50, 4}));  // evicts a (least recently used)
   EXPECT_EQ(cache.Find("a"), nullptr);
   EXPECT_NE(cache.Find("b"), nullptr);

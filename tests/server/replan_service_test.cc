@@ -4,9 +4,9 @@
 #include <grpcpp/grpcpp.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <cmath>
 #include <random>
 #include <set>
 #include <sstream>
@@ -26,10 +26,12 @@ using ::testing::HasSubstr;
 class ReplanServiceTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_replan_", ::getpid())).string();
+    dir_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_replan_", ::getpid()))
+               .string();
     Start();
-    absl::StatusOr<v1::Map> map = MapProtoFromFile(
-        absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"), MapFileOverrides(), InputLimits());
+    absl::StatusOr<v1::Map> map =
+        MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
+                         MapFileOverrides(), InputLimits());
     ASSERT_TRUE(map.ok()) << map.status();
     map_ = *map;
   }
@@ -84,7 +86,8 @@ class ReplanServiceTest : public ::testing::Test {
   }
   static int Swept(const v1::PlanResponse& plan) {
     std::set<int> cells;
-    for (const v1::CoverageSweep& s : plan.sweeps()) cells.insert(s.cells().begin(), s.cells().end());
+    for (const v1::CoverageSweep& s : plan.sweeps())
+      cells.insert(s.cells().begin(), s.cells().end());
     return static_cast<int>(cells.size());
   }
 
@@ -109,7 +112,8 @@ TEST_F(ReplanServiceTest, ReplansByPlanIdAndInlineAndChains) {
   EXPECT_EQ(s.complete(), s.newly_unreachable_cells() == 0);
   EXPECT_NE(by_id.plan().plan_id(), plan.plan_id());
   EXPECT_NEAR(by_id.plan().path(0).x(), request.progress().position().x(), 1e-9);
-  EXPECT_NEAR(by_id.plan().path(by_id.plan().path_size() - 1).x(), plan.path(plan.path_size() - 1).x(), 1e-9);
+  EXPECT_NEAR(by_id.plan().path(by_id.plan().path_size() - 1).x(),
+              plan.path(plan.path_size() - 1).x(), 1e-9);
   // The new plan is retained: GetPlan and a second replan continue from it.
   {
     grpc::ClientContext context;
@@ -141,7 +145,8 @@ TEST_F(ReplanServiceTest, ReplansByPlanIdAndInlineAndChains) {
             s.newly_obstructed_cells() + second.replan().newly_obstructed_cells());
   EXPECT_GT(s.newly_obstructed_cells(), 0);  // the box stands on cells still to cover
   EXPECT_EQ(second.plan().stats().free_cells() + second.plan().stats().mission_covered_cells() +
-                second.plan().stats().mission_cut_off_cells() + second.plan().stats().mission_obstructed_cells(),
+                second.plan().stats().mission_cut_off_cells() +
+                second.plan().stats().mission_obstructed_cells(),
             plan.stats().free_cells());
   // The same chain from the client's inline copy of the replanned plan.
   {
@@ -153,8 +158,10 @@ TEST_F(ReplanServiceTest, ReplansByPlanIdAndInlineAndChains) {
     status = Replan(inline_again, &from_inline);
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_EQ(from_inline.replan().remaining_cells(), second.replan().remaining_cells());
-    EXPECT_EQ(from_inline.plan().stats().mission_covered_cells(), second.plan().stats().mission_covered_cells());
-    EXPECT_EQ(from_inline.plan().stats().unreachable_free_cells(), second.plan().stats().unreachable_free_cells());
+    EXPECT_EQ(from_inline.plan().stats().mission_covered_cells(),
+              second.plan().stats().mission_covered_cells());
+    EXPECT_EQ(from_inline.plan().stats().unreachable_free_cells(),
+              second.plan().stats().unreachable_free_cells());
   }
 
   // Inline: the client's copy of the plan and its request.
@@ -248,10 +255,11 @@ TEST_F(ReplanServiceTest, TheReplanCommandTalksToTheServer) {
   const v1::ReplanRequest r = RequestFor(plan);
   const std::string out = dir_ + "/replanned.json";
   const std::string server = absl::StrCat("127.0.0.1:", server_->port());
-  ASSERT_EQ(RunReplanCommand({"--server", server, "--plan-id", plan.plan_id(), "--waypoint",
-                              absl::StrCat(r.progress().waypoint()), "--at",
-                              absl::StrCat(r.progress().position().x(), ",", r.progress().position().y()),
-                              "--obstacle", "9,9.2 10.2,9.2 10.2,10 9,10", "--method", "ilp2", "--out", out}),
+  ASSERT_EQ(RunReplanCommand(
+                {"--server", server, "--plan-id", plan.plan_id(), "--waypoint",
+                 absl::StrCat(r.progress().waypoint()), "--at",
+                 absl::StrCat(r.progress().position().x(), ",", r.progress().position().y()),
+                 "--obstacle", "9,9.2 10.2,9.2 10.2,10 9,10", "--method", "ilp2", "--out", out}),
             0);
   std::ifstream in(out);
   std::stringstream ss;
@@ -272,8 +280,8 @@ TEST_F(ReplanServiceTest, TheResumeCommandTalksToTheServer) {
   const std::string out = dir_ + "/resumed.json";
   const std::string server = absl::StrCat("127.0.0.1:", server_->port());
   const std::string dock = absl::StrCat(plan.path(0).x(), ",", plan.path(0).y(), ",0.5");
-  ASSERT_EQ(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", dock, "--distance", "25",
-                              "--out", out}),
+  ASSERT_EQ(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", dock,
+                              "--distance", "25", "--out", out}),
             0);
   std::ifstream in(out);
   std::stringstream ss;
@@ -282,8 +290,11 @@ TEST_F(ReplanServiceTest, TheResumeCommandTalksToTheServer) {
   EXPECT_THAT(ss.str(), HasSubstr(absl::StrCat("\"x\": ", plan.path(0).x())));
   // Bad flags and server errors give a non-zero exit.
   EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id()}), 0);  // no --at
-  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", "1,2,3,4"}), 0);
-  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", dock, "--waypoint", "3"}), 0);
+  EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", plan.plan_id(), "--at", "1,2,3,4"}),
+            0);
+  EXPECT_NE(RunResumeCommand(
+                {"--server", server, "--plan-id", plan.plan_id(), "--at", dock, "--waypoint", "3"}),
+            0);
   EXPECT_NE(RunResumeCommand({"--server", server, "--plan-id", "p-unknown", "--at", dock}), 0);
 }
 
@@ -295,11 +306,10 @@ TEST_F(ReplanServiceTest, RandomHostileReplansAreAnsweredNeverCrash) {
   v1::PlanResponse plan;
   ASSERT_TRUE(Plan(PlanRequestForOffice(), &plan).ok());
   std::mt19937 rng(7);
-  const double nasty[] = {std::nan(""), INFINITY, -INFINITY, 0.0, -0.0, 1e300, -1e300, 1e-300, 3.0, 12.5};
+  const double nasty[] = {std::nan(""), INFINITY, -INFINITY, 0.0, -0.0,
+                          1e300,        -1e300,   1e-300,    3.0, 12.5};
   auto pick = [&]() { return nasty[rng() % (sizeof(nasty) / sizeof(nasty[0]))]; };
-  auto plausible = [&](int k, int axis) {
-    return axis == 0 ? plan.path(k).x() : plan.path(k).y();
-  };
+  auto plausible = [&](int k, int axis) { return axis == 0 ? plan.path(k).x() : plan.path(k).y(); };
   int ok = 0, invalid = 0;
   for (int i = 0; i < 60; ++i) {
     v1::ReplanRequest r;
@@ -308,8 +318,10 @@ TEST_F(ReplanServiceTest, RandomHostileReplansAreAnsweredNeverCrash) {
     switch (rng() % 3) {
       case 0:
         r.mutable_progress()->set_waypoint(k);
-        r.mutable_progress()->mutable_position()->set_x(rng() % 2 ? pick() : plausible(std::min(k, plan.path_size() - 1), 0));
-        r.mutable_progress()->mutable_position()->set_y(rng() % 2 ? pick() : plausible(std::min(k, plan.path_size() - 1), 1));
+        r.mutable_progress()->mutable_position()->set_x(
+            rng() % 2 ? pick() : plausible(std::min(k, plan.path_size() - 1), 0));
+        r.mutable_progress()->mutable_position()->set_y(
+            rng() % 2 ? pick() : plausible(std::min(k, plan.path_size() - 1), 1));
         break;
       case 1:
         r.mutable_progress()->set_distance_m(rng() % 2 ? pick() : 7.0 * (rng() % 50));
@@ -348,8 +360,8 @@ TEST_F(ReplanServiceTest, RandomHostileReplansAreAnsweredNeverCrash) {
       }
     } else {
       ++invalid;
-      EXPECT_THAT(status.error_code(), ::testing::AnyOf(grpc::StatusCode::INVALID_ARGUMENT,
-                                                        grpc::StatusCode::NOT_FOUND))
+      EXPECT_THAT(status.error_code(),
+                  ::testing::AnyOf(grpc::StatusCode::INVALID_ARGUMENT, grpc::StatusCode::NOT_FOUND))
           << i << ": " << status.error_message();
       EXPECT_FALSE(status.error_message().empty());
     }

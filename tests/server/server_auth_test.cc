@@ -71,7 +71,8 @@ class ServerAuthTest : public ::testing::Test {
   }
   void StartServer(std::vector<std::string> extra = {}) {
     server_ = std::make_unique<ServerProcess>();
-    std::vector<std::string> args = {"--metrics_port=-1", "--drain_notice_s=0", "--token_file=" + tokens_};
+    std::vector<std::string> args = {"--metrics_port=-1", "--drain_notice_s=0",
+                                     "--token_file=" + tokens_};
     args.insert(args.end(), extra.begin(), extra.end());
     const absl::Status started = server_->Start(dir_ + "/maps", args);
     ASSERT_TRUE(started.ok()) << started << server_->log();
@@ -104,7 +105,8 @@ class ServerAuthTest : public ::testing::Test {
     for (const v1::MapInfo& info : response.maps()) ids->push_back(info.map_id());
     return status;
   }
-  grpc::Status Plan(const std::string& token, const std::string& map_id, v1::PlanResponse* response) {
+  grpc::Status Plan(const std::string& token, const std::string& map_id,
+                    v1::PlanResponse* response) {
     return stub_->Plan(Ctx(token).get(), PlanRequestFor(map_id, 0.3), response);
   }
 
@@ -148,7 +150,8 @@ TEST_F(ServerAuthTest, CallsWithoutAValidTokenAreUnauthenticatedHealthStaysOpen)
   EXPECT_EQ(*health, 1);
   absl::StatusOr<std::vector<std::string>> services = ReflectionServices(channel_);
   ASSERT_TRUE(services.ok()) << services.status();
-  EXPECT_NE(std::find(services->begin(), services->end(), "covplan.v1.CoveragePlanner"), services->end());
+  EXPECT_NE(std::find(services->begin(), services->end(), "covplan.v1.CoveragePlanner"),
+            services->end());
   // A valid token is served.
   EXPECT_TRUE(ListMaps(kAlpha, &ids).ok());
 }
@@ -208,12 +211,14 @@ TEST_F(ServerAuthTest, TenantsSeeOnlyTheirOwnMapsAndPlans) {
     request.set_plan_id(plan.plan_id());
     request.mutable_progress()->set_distance_m(0.5);
     v1::ReplanResponse response;
-    EXPECT_EQ(stub_->Replan(Ctx(kBeta).get(), request, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_EQ(stub_->Replan(Ctx(kBeta).get(), request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
     v1::ResumeRequest resume;
     resume.set_plan_id(plan.plan_id());
     resume.mutable_pose()->set_x(1.0);
     resume.mutable_pose()->set_y(1.0);
-    EXPECT_EQ(stub_->Resume(Ctx(kBeta).get(), resume, &response).error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_EQ(stub_->Resume(Ctx(kBeta).get(), resume, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
   }
 
   {  // Drive: alpha adopts its plan, beta's session on it ends NOT_FOUND
@@ -297,7 +302,8 @@ TEST_F(ServerAuthTest, SighupRereadsTheTokenFile) {
   WriteFile(tokens_, "not a token line\n");
   ASSERT_EQ(::kill(server_->pid(), SIGHUP), 0);
   const absl::Time logged = absl::Now() + absl::Seconds(10);
-  while (server_->log().find("token file not reloaded") == std::string::npos && absl::Now() < logged) {
+  while (server_->log().find("token file not reloaded") == std::string::npos &&
+         absl::Now() < logged) {
     absl::SleepFor(absl::Milliseconds(50));
   }
   EXPECT_NE(server_->log().find("token file not reloaded"), std::string::npos) << server_->log();
@@ -311,19 +317,22 @@ TEST_F(ServerAuthTest, ABadTokenFileStopsStartup) {
   EXPECT_FALSE(server.Start(dir_ + "/maps", {"--metrics_port=-1", "--token_file=" + tokens_}).ok());
   EXPECT_NE(server.log().find("line 1"), std::string::npos) << server.log();
   ServerProcess missing;
-  EXPECT_FALSE(missing.Start(dir_ + "/maps", {"--metrics_port=-1", "--token_file=" + dir_ + "/none"}).ok());
+  EXPECT_FALSE(
+      missing.Start(dir_ + "/maps", {"--metrics_port=-1", "--token_file=" + dir_ + "/none"}).ok());
   EXPECT_NE(missing.log().find("cannot read"), std::string::npos) << missing.log();
 }
 
 TEST_F(ServerAuthTest, CliReachesATlsServerWithATokenAndACa) {
-  const std::string script = absl::StrCat(
-      "set -e; cd ", dir_, "; exec >openssl.log 2>&1\n",
-      "key() { openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:prime256v1 -out $1.key; }\n",
-      "key ca; openssl req -x509 -new -key ca.key -out ca.pem -days 2 -subj /CN=ca\n",
-      "printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' > san.cnf\n",
-      "key server; openssl req -new -key server.key -out server.csr -subj /CN=server; "
-      "openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -out server.pem -days 2 "
-      "-extfile san.cnf\n");
+  const std::string script =
+      absl::StrCat("set -e; cd ", dir_, "; exec >openssl.log 2>&1\n",
+                   "key() { openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:prime256v1 "
+                   "-out $1.key; }\n",
+                   "key ca; openssl req -x509 -new -key ca.key -out ca.pem -days 2 -subj /CN=ca\n",
+                   "printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' > san.cnf\n",
+                   "key server; openssl req -new -key server.key -out server.csr -subj /CN=server; "
+                   "openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -out "
+                   "server.pem -days 2 "
+                   "-extfile san.cnf\n");
   if (std::system(("bash -c '" + script + "'").c_str()) != 0) {
     GTEST_SKIP() << "openssl could not make test certificates: " << ReadFile(dir_ + "/openssl.log");
   }
@@ -332,9 +341,10 @@ TEST_F(ServerAuthTest, CliReachesATlsServerWithATokenAndACa) {
   WriteFile(map, AsciiToPgm(TwoRooms(), 4));
   WriteFile(dir_ + "/alpha.token", std::string(kAlpha) + "\n");
   const std::string out = dir_ + "/plan.json";
-  const std::vector<std::string> plan = {"--map", map, "--resolution", "0.05", "--tool-width", "0.3",
-                                         "--server", server_->target(), "--tls-ca", dir_ + "/ca.pem",
-                                         "--out", out};
+  const std::vector<std::string> plan = {
+      "--map", map,        "--resolution",    "0.05",     "--tool-width",
+      "0.3",   "--server", server_->target(), "--tls-ca", dir_ + "/ca.pem",
+      "--out", out};
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = plan;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -349,8 +359,8 @@ TEST_F(ServerAuthTest, CliReachesATlsServerWithATokenAndACa) {
   EXPECT_EQ(RunPlanCommand(with({"--token-file", dir_ + "/alpha.token"})), 0);
   EXPECT_TRUE(std::filesystem::exists(out));
   // Plaintext to the TLS port fails; bad connection flags are clear errors.
-  EXPECT_NE(RunPlanCommand({"--map", map, "--resolution", "0.05", "--server", server_->target(), "--token",
-                            kAlpha}),
+  EXPECT_NE(RunPlanCommand({"--map", map, "--resolution", "0.05", "--server", server_->target(),
+                            "--token", kAlpha}),
             0);
   EXPECT_NE(RunPlanCommand(with({"--token", kAlpha, "--token-file", dir_ + "/alpha.token"})), 0);
   EXPECT_NE(RunPlanCommand(with({"--tls-cert", dir_ + "/server.pem"})), 0);  // without --tls-key

@@ -46,8 +46,9 @@ using ::testing::Not;
 
 // Defect 11.
 TEST_F(ServerHardeningTest, BadFlagsExitWithCode2AndNameTheFlag) {
-  for (const std::string flag : {"--port=70000", "--threads=100000", "--cache_mb=-1", "--plan_ttl_s=-5",
-                                 "--drain_grace_s=-1", "--max_retained_plans=0"}) {
+  for (const std::string flag :
+       {"--port=70000", "--threads=100000", "--cache_mb=-1", "--plan_ttl_s=-5",
+        "--drain_grace_s=-1", "--max_retained_plans=0"}) {
     ServerProcess server;
     const absl::Status started = server.Start(store_, {flag});
     EXPECT_FALSE(started.ok()) << flag;
@@ -97,7 +98,8 @@ TEST_F(ServerHardeningTest, OverlongStringsAreRejectedNamingFieldAndLimit) {
   big_yaml.mutable_raster()->set_yaml("resolution: 0.1\n" + std::string(70000, '#'));
   status = PutMap(big_yaml, &put);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(status.error_message(), HasSubstr("map.raster.yaml is 70016 bytes; the limit is 65536"));
+  EXPECT_THAT(status.error_message(),
+              HasSubstr("map.raster.yaml is 70016 bytes; the limit is 65536"));
   {
     grpc::ClientContext context;
     v1::PlanRequest request = testing::PlanRequestFor(std::string(5000, 'a'), 0.4);
@@ -127,14 +129,15 @@ TEST_F(ServerHardeningTest, ListMapsIsPaged) {
     v1::ListMapsResponse response;
     ASSERT_TRUE(stub_->ListMaps(&context, request, &response).ok());
     EXPECT_LE(response.maps_size(), 2);
-    for (const v1::MapInfo& info : response.maps()) EXPECT_TRUE(listed.insert(info.map_id()).second);
+    for (const v1::MapInfo& info : response.maps())
+      EXPECT_TRUE(listed.insert(info.map_id()).second);
     token = response.next_page_token();
     ++pages;
   } while (!token.empty() && pages < 10);
   EXPECT_EQ(pages, 3);
   EXPECT_EQ(listed, ids);
-  for (const auto& [size, page_token] : std::vector<std::pair<int, std::string>>{
-           {-1, ""}, {2, "not-a-token"}}) {
+  for (const auto& [size, page_token] :
+       std::vector<std::pair<int, std::string>>{{-1, ""}, {2, "not-a-token"}}) {
     grpc::ClientContext context;
     v1::ListMapsRequest request;
     request.set_page_size(size);
@@ -185,8 +188,8 @@ TEST_F(ServerHardeningTest, PutMapRejectsGeometryThatCannotBePlanned) {
     double resolution, origin_x;
     const char* expect;
   };
-  for (const Case& c : {Case{0.1, 1e308, "origin"}, Case{1e-300, 0, "resolution"},
-                        Case{1e300, 0, "resolution"}}) {
+  for (const Case& c :
+       {Case{0.1, 1e308, "origin"}, Case{1e-300, 0, "resolution"}, Case{1e300, 0, "resolution"}}) {
     v1::Map map = Variant(0);
     map.mutable_raster()->set_resolution(c.resolution);
     map.mutable_raster()->set_origin_x_m(c.origin_x);

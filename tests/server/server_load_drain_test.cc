@@ -43,14 +43,15 @@ using ::testing::Not;
 // Defect 13: a request that is not its protobuf.
 TEST_F(ServerHardeningTest, MalformedRequestsAreInvalidArgumentLoggedAndCounted) {
   StartServer({"--metrics_port=0"});
-  absl::StatusOr<std::string> reply = testing::RawUnaryCall(channel_, "/covplan.v1.CoveragePlanner/PutMap",
-                                                            std::string("\xff\xff\xff\xff\x0f", 5));
+  absl::StatusOr<std::string> reply = testing::RawUnaryCall(
+      channel_, "/covplan.v1.CoveragePlanner/PutMap", std::string("\xff\xff\xff\xff\x0f", 5));
   EXPECT_TRUE(absl::IsInvalidArgument(reply.status())) << reply.status();
   EXPECT_THAT(reply.status().message(), HasSubstr("covplan.v1.PutMapRequest"));
   EXPECT_THAT(server_->log(), HasSubstr("method=PutMap code=INVALID_ARGUMENT"));
   absl::StatusOr<std::string> metrics = testing::HttpGet(server_->metrics_port(), "/metrics");
   ASSERT_TRUE(metrics.ok()) << metrics.status();
-  EXPECT_THAT(*metrics, HasSubstr("covplan_requests_total{code=\"INVALID_ARGUMENT\",method=\"PutMap\"} 1"));
+  EXPECT_THAT(*metrics,
+              HasSubstr("covplan_requests_total{code=\"INVALID_ARGUMENT\",method=\"PutMap\"} 1"));
 }
 
 // Defect 9: a call admitted behind a long solve that starts with too little
@@ -59,8 +60,10 @@ TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExce
   // The all-pairs transitions and the dense GTSP (not the much faster sparse
   // path) keep the busy solve long enough.
   StartServer({"--threads=1", "--dense_transition_mb=1024"});
-  const std::string busy_map = PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
-  const std::string fresh_map = PutMapOk(RasterMap(AsciiToPgm(PillarField(240, 180, 600, 5), 4), 0.025));
+  const std::string busy_map =
+      PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
+  const std::string fresh_map =
+      PutMapOk(RasterMap(AsciiToPgm(PillarField(240, 180, 600, 5), 4), 0.025));
   v1::PlanResponse warm;
   ASSERT_TRUE(Plan(busy_map, 0.3, &warm).ok());
   std::thread busy([&] {
@@ -88,7 +91,8 @@ TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExce
 // decoded, and GetMap does not wait behind decoding.
 TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNotWait) {
   StartServer();
-  testing::PngSpec spec{.width = 3000, .height = 3000, .color_type = PNG_COLOR_TYPE_GRAY, .bit_depth = 16};
+  testing::PngSpec spec{
+      .width = 3000, .height = 3000, .color_type = PNG_COLOR_TYPE_GRAY, .bit_depth = 16};
   spec.samples.assign(static_cast<size_t>(spec.width) * spec.height, 65535);
   const v1::Map big = RasterMap(testing::EncodePng(spec), 0.05);
   const std::string small_id = PutMapOk(Variant(0));
@@ -97,7 +101,8 @@ TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNo
   const absl::Duration one = absl::Now() - one_start;  // one decode, uncontended
   // Enough PutMaps that decoding them all would take >= 4 s on the 2 I/O
   // threads; each may wait 0.5 s.
-  const int n = std::clamp(static_cast<int>(8 * absl::Seconds(1) / std::max(one, absl::Milliseconds(10))), 8, 60);
+  const int n = std::clamp(
+      static_cast<int>(8 * absl::Seconds(1) / std::max(one, absl::Milliseconds(10))), 8, 60);
   std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
   std::vector<v1::PutMapRequest> requests(n);
   std::vector<v1::PutMapResponse> responses(n);
@@ -122,7 +127,8 @@ TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNo
     EXPECT_TRUE(status.ok()) << status.error_message();
   }
   EXPECT_LT(absl::Now() - read_start, absl::Milliseconds(300));
-  while (done.load() < n && absl::Now() < fired + absl::Seconds(60)) absl::SleepFor(absl::Milliseconds(10));
+  while (done.load() < n && absl::Now() < fired + absl::Seconds(60))
+    absl::SleepFor(absl::Milliseconds(10));
   ASSERT_EQ(done.load(), n);
   // The server stops working on them soon after their deadline: a small
   // PutMap right after is answered at once, not behind the queue.
@@ -140,10 +146,12 @@ TEST_F(ServerHardeningTest, DrainKeepsItsGraceAndAnswersWithTheBestPlan) {
   // Without remembered plans: the seed-2 request must search, not warm-start.
   // The dense GTSP keeps searching for its whole budget (the sparse path
   // converges before the drain).
-  StartServer({"--drain_grace_s=1", "--threads=1", "--plan_memory=false", "--dense_transition_mb=1024"});
+  StartServer(
+      {"--drain_grace_s=1", "--threads=1", "--plan_memory=false", "--dense_transition_mb=1024"});
   const std::string map_id = PutMapOk(RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05));
   v1::PlanResponse warm;
-  ASSERT_TRUE(Plan(map_id, 0.3, &warm).ok());  // artifacts cached: the next search has a plan at once
+  ASSERT_TRUE(
+      Plan(map_id, 0.3, &warm).ok());  // artifacts cached: the next search has a plan at once
   ASSERT_GT(warm.stats().num_ranks(), 100);
   HealthWatch watch(channel_);
   v1::PlanResponse long_plan;

@@ -41,11 +41,16 @@ absl::Status ServerProcess::Start(const std::string& store_dir,
   // show that a test fails on the code before a fix).
   const char* override_bin = std::getenv("COVPLAN_TEST_SERVER_BIN");
   const std::string program = !binary.empty() ? binary
-                              : (override_bin != nullptr && *override_bin != '\0') ? override_bin
-                                                                                    : COVPLAN_SERVER_BIN;
-  log_path_ = absl::StrCat(store_dir, ".server.", ::getpid(), ".", absl::ToUnixMicros(absl::Now()), ".log");
-  std::vector<std::string> args = {program, "--address=127.0.0.1", "--port=0",
-                                   "--metrics_address=127.0.0.1", "--metrics_port=0",
+                              : (override_bin != nullptr && *override_bin != '\0')
+                                  ? override_bin
+                                  : COVPLAN_SERVER_BIN;
+  log_path_ =
+      absl::StrCat(store_dir, ".server.", ::getpid(), ".", absl::ToUnixMicros(absl::Now()), ".log");
+  std::vector<std::string> args = {program,
+                                   "--address=127.0.0.1",
+                                   "--port=0",
+                                   "--metrics_address=127.0.0.1",
+                                   "--metrics_port=0",
                                    "--store_dir=" + store_dir};
   args.insert(args.end(), extra_args.begin(), extra_args.end());
   const int log_fd = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -77,7 +82,8 @@ absl::Status ServerProcess::Start(const std::string& store_dir,
         return absl::InternalError(absl::StrCat("cannot parse start-up line: ", line));
       }
       // The store is indexed after the port opens; tests start once it is.
-      for (int j = 0; j < 600 && log().find("msg=\"map store indexed\"") == std::string::npos; ++j) {
+      for (int j = 0; j < 600 && log().find("msg=\"map store indexed\"") == std::string::npos;
+           ++j) {
         absl::SleepFor(absl::Milliseconds(20));
       }
       return absl::OkStatus();

@@ -8,19 +8,19 @@
 
 #include <algorithm>
 #include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
-#include <thread>
 #include <set>
-#include <csignal>
+#include <thread>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
+#include "api/convert.h"
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "api/convert.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
 #include "tests/server/test_maps.h"
@@ -39,9 +39,9 @@ using ::testing::HasSubstr;
 // The furnished office at a 0.5 m tool: about 100 ranks, whose full GTSP
 // search takes a few hundred milliseconds on this machine.
 v1::Map OfficeMap() {
-  absl::StatusOr<v1::Map> map = MapProtoFromFile(
-      absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office_furnished.yaml"), MapFileOverrides(),
-      InputLimits());
+  absl::StatusOr<v1::Map> map =
+      MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office_furnished.yaml"),
+                       MapFileOverrides(), InputLimits());
   EXPECT_TRUE(map.ok()) << map.status();
   return map.ok() ? *map : v1::Map();
 }
@@ -140,7 +140,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   const std::string map_id = PutMap(OfficeMap());
   v1::PlanResponse plan;
   ASSERT_TRUE(Plan(Request(map_id, 0.8, 0.5), &plan).ok());
-  std::string trace = absl::StrFormat("start (%.3f, %.3f)", plan.path(0).x(), plan.path(0).y());  // for a failure's message
+  std::string trace = absl::StrFormat("start (%.3f, %.3f)", plan.path(0).x(),
+                                      plan.path(0).y());  // for a failure's message
   auto replan = [&](const v1::PlanResponse& p, v1::ReplanResponse* out) {
     v1::ReplanRequest r;
     r.set_plan_id(p.plan_id());
@@ -153,8 +154,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     v1::Point2* obstacle = r.mutable_obstacles()->add_points();
     obstacle->set_x(p.path(j).x());
     obstacle->set_y(p.path(j).y());
-    absl::StrAppendFormat(&trace, "; obstacle at (%.3f, %.3f), waypoint %d of %d", p.path(j).x(), p.path(j).y(), j,
-                          p.path_size());
+    absl::StrAppendFormat(&trace, "; obstacle at (%.3f, %.3f), waypoint %d of %d", p.path(j).x(),
+                          p.path(j).y(), j, p.path_size());
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
     return stub_->Replan(&context, r, out);
@@ -187,7 +188,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
   ASSERT_TRUE(status.ok()) << status.error_message() << "\n" << server_->log();
   EXPECT_LE(second.replan().remaining_cells(), first.replan().remaining_cells());
   std::set<int> swept;
-  for (const v1::CoverageSweep& s : second.plan().sweeps()) swept.insert(s.cells().begin(), s.cells().end());
+  for (const v1::CoverageSweep& s : second.plan().sweeps())
+    swept.insert(s.cells().begin(), s.cells().end());
   EXPECT_EQ(static_cast<int>(swept.size()), second.replan().remaining_cells());
 
   // The robot reports its progress in a Drive session, is interrupted with
@@ -214,7 +216,8 @@ TEST_F(ServerProcessTest, AMissionSurvivesSigkill) {
     ASSERT_TRUE(stream->Finish().ok());
   }
   const std::string progress_file = store_ + "/plans/" + driving.plan_id() + ".progress";
-  for (int i = 0; i < 250 && !std::filesystem::exists(progress_file); ++i) absl::SleepFor(absl::Milliseconds(20));
+  for (int i = 0; i < 250 && !std::filesystem::exists(progress_file); ++i)
+    absl::SleepFor(absl::Milliseconds(20));
   ASSERT_TRUE(std::filesystem::exists(progress_file));
   ASSERT_EQ(::kill(server_->pid(), SIGKILL), 0);
   EXPECT_EQ(server_->Wait(absl::Seconds(10)), 128 + SIGKILL);

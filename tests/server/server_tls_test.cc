@@ -38,15 +38,19 @@ class ServerTlsTest : public ::testing::Test {
     // both signed by the first.
     const std::string script = absl::StrCat(
         "set -e; cd ", dir_, "; exec >openssl.log 2>&1\n",
-        "key() { openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:prime256v1 -out $1.key; }\n",
+        "key() { openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:prime256v1 -out $1.key; "
+        "}\n",
         "for ca in ca other; do key $ca; openssl req -x509 -new -key $ca.key -out $ca.pem -days 2 "
         "-subj /CN=$ca; done\n",
         "printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' > san.cnf\n",
-        "for who in server client; do key $who; openssl req -new -key $who.key -out $who.csr -subj /CN=$who; "
-        "openssl x509 -req -in $who.csr -CA ca.pem -CAkey ca.key -CAcreateserial -out $who.pem -days 2 "
+        "for who in server client; do key $who; openssl req -new -key $who.key -out $who.csr -subj "
+        "/CN=$who; "
+        "openssl x509 -req -in $who.csr -CA ca.pem -CAkey ca.key -CAcreateserial -out $who.pem "
+        "-days 2 "
         "-extfile san.cnf; done\n");
     if (std::system(("bash -c '" + script + "'").c_str()) != 0) {
-      GTEST_SKIP() << "openssl could not make test certificates: " << ReadFile(dir_ + "/openssl.log");
+      GTEST_SKIP() << "openssl could not make test certificates: "
+                   << ReadFile(dir_ + "/openssl.log");
     }
   }
   void TearDown() override {
@@ -57,7 +61,8 @@ class ServerTlsTest : public ::testing::Test {
   void StartServer(bool mutual) {
     server_ = std::make_unique<ServerProcess>();
     std::vector<std::string> args = {"--metrics_port=-1", "--drain_notice_s=0",
-                                     "--tls_cert=" + dir_ + "/server.pem", "--tls_key=" + dir_ + "/server.key"};
+                                     "--tls_cert=" + dir_ + "/server.pem",
+                                     "--tls_key=" + dir_ + "/server.key"};
     if (mutual) args.push_back("--tls_client_ca=" + dir_ + "/ca.pem");
     const absl::Status started = server_->Start(dir_ + "/maps", args);
     ASSERT_TRUE(started.ok()) << started;
@@ -105,8 +110,10 @@ TEST_F(ServerTlsTest, TlsFlagsAreChecked) {
     EXPECT_EQ(server.start_exit_status(), 2) << server.log();
   }
   ServerProcess server;  // a key that is not PEM
-  EXPECT_FALSE(server.Start(dir_ + "/maps", {"--tls_cert=" + dir_ + "/server.pem",
-                                             "--tls_key=" + dir_ + "/san.cnf"}).ok());
+  EXPECT_FALSE(server
+                   .Start(dir_ + "/maps",
+                          {"--tls_cert=" + dir_ + "/server.pem", "--tls_key=" + dir_ + "/san.cnf"})
+                   .ok());
   EXPECT_NE(server.log().find("not a readable PEM file"), std::string::npos) << server.log();
 }
 

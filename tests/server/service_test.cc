@@ -35,7 +35,8 @@ using ::testing::Contains;
 using ::testing::HasSubstr;
 
 std::string MakeTempDir() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "covplan_service_XXXXXX").string();
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "covplan_service_XXXXXX").string();
   const char* dir = mkdtemp(pattern.data());
   return dir == nullptr ? std::string() : std::string(dir);
 }
@@ -288,8 +289,8 @@ TEST_F(ServiceTest, EveryBadInputIsInvalidArgumentWithAMessage) {
        [&](v1::PlanRequest* r) { *r->mutable_map() = RasterMap(pgm, std::nan("")); }, "resolution"},
       {"zero tool width", [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(0); },
        "tool_width_m"},
-      {"negative tool width", [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(-0.4); },
-       "tool_width_m"},
+      {"negative tool width",
+       [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(-0.4); }, "tool_width_m"},
       {"NaN tool width",
        [](v1::PlanRequest* r) { r->mutable_robot()->set_tool_width_m(std::nan("")); },
        "tool_width_m"},
@@ -305,7 +306,8 @@ TEST_F(ServiceTest, EveryBadInputIsInvalidArgumentWithAMessage) {
        "no free"},
       {"image too large",
        [](v1::PlanRequest* r) {
-         *r->mutable_map() = RasterMap(AsciiToPgm(std::vector<std::string>(80, std::string(80, '.')), 16), 0.01);
+         *r->mutable_map() =
+             RasterMap(AsciiToPgm(std::vector<std::string>(80, std::string(80, '.')), 16), 0.01);
        },
        "too large"},
       {"corrupt image",
@@ -350,8 +352,8 @@ TEST_F(ServiceTest, RandomHostileRequestsAreAnsweredNeverCrash) {
   const std::string pgm = AsciiToPgm(TwoRooms(), 4);
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<double> hostile = {0.0, -1.0, nan, inf, -inf, 1e300, 1e-300, -0.0,
-                                       std::numeric_limits<double>::denorm_min()};
+  const std::vector<double> hostile = {
+      0.0, -1.0, nan, inf, -inf, 1e300, 1e-300, -0.0, std::numeric_limits<double>::denorm_min()};
   std::mt19937 rng(20261122);
   auto pick = [&](const std::vector<double>& good) {
     return rng() % 3 == 0 ? hostile[rng() % hostile.size()] : good[rng() % good.size()];
@@ -474,13 +476,16 @@ TEST_F(ServiceTest, RepeatedHitsAreOnePlanUnderOneId) {
 // sent as stored bytes with this call's stats appended.
 TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
   const std::string map_id = PutTwoRooms();
-  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(absl::StrCat("127.0.0.1:", server_->port()));
-  absl::StatusOr<v1::PlanStats> cold = remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
+  std::unique_ptr<RemotePlanner> remote =
+      RemotePlanner::Connect(absl::StrCat("127.0.0.1:", server_->port()));
+  absl::StatusOr<v1::PlanStats> cold =
+      remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
   ASSERT_TRUE(cold.ok()) << cold.status();
   EXPECT_EQ(cold->plan_source(), v1::PLAN_SOURCE_COLD);
   EXPECT_GT(cold->num_ranks(), 0);
   for (int i = 0; i < 3; ++i) {  // the first hit, then repeated hits
-    absl::StatusOr<v1::PlanResponse> full = remote->Plan(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
+    absl::StatusOr<v1::PlanResponse> full =
+        remote->Plan(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
     absl::StatusOr<v1::PlanStats> stats =
         remote->PlanStatsOnly(PlanRequestFor(map_id, 0.4), absl::Seconds(30));
     ASSERT_TRUE(full.ok()) << full.status();
@@ -492,8 +497,8 @@ TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
     expected.set_planning_ms(stats->planning_ms());
     EXPECT_EQ(stats->SerializeAsString(), expected.SerializeAsString()) << i;
   }
-  absl::StatusOr<v1::PlanStats> missing = remote->PlanStatsOnly(PlanRequestFor(std::string(64, 'a'), 0.4),
-                                                                absl::Seconds(10));
+  absl::StatusOr<v1::PlanStats> missing =
+      remote->PlanStatsOnly(PlanRequestFor(std::string(64, 'a'), 0.4), absl::Seconds(10));
   EXPECT_TRUE(absl::IsNotFound(missing.status())) << missing.status();
 }
 
@@ -601,7 +606,8 @@ TEST_F(OneWorkerServiceTest, RepeatedHitsAreAnsweredWhileTheWorkerIsBusy) {
   ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &first).ok());  // its reply is kept for the repeats
   ASSERT_EQ(first.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
   v1::PutMapResponse put;
-  ASSERT_TRUE(PutMap(RasterMap(AsciiToPgm(testing::PillarField(240, 180, 600, 5), 4), 0.025), &put).ok());
+  ASSERT_TRUE(
+      PutMap(RasterMap(AsciiToPgm(testing::PillarField(240, 180, 600, 5), 4), 0.025), &put).ok());
   const auto metrics = [&] {
     absl::StatusOr<std::string> body = testing::HttpGet(server_->metrics_port(), "/metrics");
     return body.ok() ? *body : std::string();
@@ -625,7 +631,8 @@ TEST_F(OneWorkerServiceTest, RepeatedHitsAreAnsweredWhileTheWorkerIsBusy) {
   // A search is refused: the worker is busy and the queue holds none.
   const auto refused = [&] {
     v1::PlanResponse response;
-    return Plan(PlanRequestFor(map_id, 0.3), &response).error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
+    return Plan(PlanRequestFor(map_id, 0.3), &response).error_code() ==
+           grpc::StatusCode::RESOURCE_EXHAUSTED;
   };
   const bool refused_before = running && refused();
   constexpr int kRepeats = 20;
@@ -653,7 +660,8 @@ TEST_F(OneWorkerServiceTest, RepeatedHitsAreAnsweredWhileTheWorkerIsBusy) {
       EXPECT_EQ(again.path(k).y(), first.path(k).y());
     }
   }
-  EXPECT_THAT(metrics(), HasSubstr(absl::StrCat("\ncovplan_plan_hits_without_worker_total ", kRepeats, "\n")));
+  EXPECT_THAT(metrics(),
+              HasSubstr(absl::StrCat("\ncovplan_plan_hits_without_worker_total ", kRepeats, "\n")));
 }
 
 // Remembered plans follow map content: the id is the content's, DeleteMap
@@ -722,9 +730,9 @@ TEST_F(MetricsServiceTest, MetricsEndpointExposesTheFamilies) {
         "covplan_request_duration_seconds_bucket{method=\"Plan\"",
         "covplan_plan_solve_duration_seconds_count 1", "covplan_plans_cut_short_total",
         "covplan_worker_queue_depth", "covplan_solves_in_flight",
-        "covplan_artifact_cache_misses_total 4", // grid, area, partition, transitions
-        "covplan_plan_source_total{source=\"cold\"} 1", "covplan_plan_source_total{source=\"cache_hit\"} 0",
-        "covplan_artifact_cache_hits_total",
+        "covplan_artifact_cache_misses_total 4",  // grid, area, partition, transitions
+        "covplan_plan_source_total{source=\"cold\"} 1",
+        "covplan_plan_source_total{source=\"cache_hit\"} 0", "covplan_artifact_cache_hits_total",
         "covplan_artifact_cache_evictions_total", "covplan_artifact_cache_bytes",
         "covplan_maps_stored 1"}) {
     EXPECT_THAT(*body, HasSubstr(family));
@@ -748,7 +756,8 @@ TEST_F(DenseServiceTest, DecompositionCutOffByADeadlineIsFinishedInTheBackground
   // 60 x 50 cells of 0.5 m with 80 pillars: a transition table that takes far
   // longer than a 60 ms deadline (25 ms of which are kept for the reply).
   v1::PutMapResponse put;
-  ASSERT_TRUE(PutMap(RasterMap(AsciiToPgm(testing::PillarField(60, 50, 80, 3), 5), 0.1), &put).ok());
+  ASSERT_TRUE(
+      PutMap(RasterMap(AsciiToPgm(testing::PillarField(60, 50, 80, 3), 5), 0.1), &put).ok());
   const v1::PlanRequest request = PlanRequestFor(put.map_id(), 0.5);
   auto plan_within = [&](std::chrono::milliseconds deadline, v1::PlanResponse* response) {
     grpc::ClientContext context;
@@ -770,7 +779,8 @@ TEST_F(DenseServiceTest, DecompositionCutOffByADeadlineIsFinishedInTheBackground
     ++refused;
     absl::SleepFor(absl::Milliseconds(100));
   }
-  ASSERT_TRUE(status.ok()) << "still " << status.error_message() << " after " << refused << " calls";
+  ASSERT_TRUE(status.ok()) << "still " << status.error_message() << " after " << refused
+                           << " calls";
   EXPECT_TRUE(response.stats().decomposition_cached());
   EXPECT_GT(response.stats().num_ranks(), 0);
   EXPECT_GE(server_->service().cache().stats().misses, 1);
@@ -857,7 +867,8 @@ TEST_F(ServiceTest, BatteryPlansOverGrpcAndBadBatteryInput) {
       {[](v1::Battery* x) { x->set_reserve(25); }, "battery.reserve"},
       {[](v1::Battery* x) { x->clear_station(); }, "battery.station"},
       {[](v1::Battery* x) { x->mutable_station()->set_x(40); }, "outside the map"},
-      {[](v1::Battery* x) { x->mutable_station()->set_x(0.2), x->mutable_station()->set_y(0.2); }, "obstacle"},
+      {[](v1::Battery* x) { x->mutable_station()->set_x(0.2), x->mutable_station()->set_y(0.2); },
+       "obstacle"},
       {[](v1::Battery* x) { x->set_capacity(1.5); }, "needs"},
   };
   for (const auto& [mutate, message] : bad) {

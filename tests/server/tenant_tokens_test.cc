@@ -33,7 +33,8 @@ TEST(TenantTokensTest, ParsesHashesAndRejectsMalformedLines) {
 }
 
 TEST(TenantTokensTest, AuthenticatesBearerTokensAndReloads) {
-  const std::string path = (std::filesystem::temp_directory_path() / "covplan_tokens_test.txt").string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "covplan_tokens_test.txt").string();
   { std::ofstream(path) << Line("secret-a", "alpha"); }
   absl::StatusOr<std::unique_ptr<TenantTokens>> tokens = TenantTokens::Load(path);
   ASSERT_TRUE(tokens.ok()) << tokens.status();

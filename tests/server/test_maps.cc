@@ -13,7 +13,9 @@ std::string AsciiToPgm(const std::vector<std::string>& rows, int k) {
   for (const std::string& row : rows) {
     for (int dy = 0; dy < k; ++dy) {
       for (char c : row) {
-        const char value = c == '.' ? static_cast<char>(254) : c == '#' ? 0 : static_cast<char>(205);
+        const char value = c == '.'   ? static_cast<char>(254)
+                           : c == '#' ? 0
+                                      : static_cast<char>(205);
         pgm.append(static_cast<size_t>(k), value);
       }
     }

@@ -64,13 +64,16 @@ BatteryOptions Battery(const Pose2& station) {
   return b;
 }
 
-bool AtStation(const Waypoint& w, const Pose2& s) { return std::hypot(w.x - s.x, w.y - s.y) <= 1e-6; }
+bool AtStation(const Waypoint& w, const Pose2& s) {
+  return std::hypot(w.x - s.x, w.y - s.y) <= 1e-6;
+}
 
 TEST(BatterySimulation, APerfectMapDrivesExactlyThePlannedCyclesAndRecharges) {
   const OccupancyMap map = testing::LoadShippedMap(kMap);
   SimulationOptions o = Options();
   o.plan.battery = Battery(FreeStation(map));
-  o.plan.battery->energy.per_turn = 0.25;  // turns cost too: the plan's energy model, not just distance
+  o.plan.battery->energy.per_turn =
+      0.25;  // turns cost too: the plan's energy model, not just distance
   o.recharge_s = 900.0;
   absl::StatusOr<EngineResult> plan = PlanCoverageWithArea(map, o.plan);
   ASSERT_TRUE(plan.ok()) << plan.status();
@@ -88,7 +91,8 @@ TEST(BatterySimulation, APerfectMapDrivesExactlyThePlannedCyclesAndRecharges) {
   EXPECT_EQ(b.charge_cycles_planned, static_cast<int>(cycles.size()));
   EXPECT_EQ(b.charge_cycles_driven, static_cast<int>(cycles.size()));
   ASSERT_EQ(b.cycle_energy.size(), cycles.size());
-  for (size_t c = 0; c < cycles.size(); ++c) EXPECT_NEAR(b.cycle_energy[c], cycles[c].energy, 1e-9) << c;
+  for (size_t c = 0; c < cycles.size(); ++c)
+    EXPECT_NEAR(b.cycle_energy[c], cycles[c].energy, 1e-9) << c;
   EXPECT_NEAR(b.energy_used, plan->plan.stats.energy_total, 1e-9);
   EXPECT_DOUBLE_EQ(b.energy_planned, plan->plan.stats.energy_total);
   EXPECT_NEAR(r->drive_time_s, plan->plan.stats.estimated_duration_s, 1e-9);
@@ -114,7 +118,8 @@ void DriveThroughClutter(const Pose2& station, double capacity) {
   o.plan.battery = Battery(station);
   o.plan.battery->capacity = capacity;
   o.recharge_s = 600.0;
-  o.method = ReplanMethod::kAuto;  // battery plans are replanned by greedy detour whatever this says
+  o.method =
+      ReplanMethod::kAuto;  // battery plans are replanned by greedy detour whatever this says
   ClutterOptions co;
   co.keep_connected_cell_m = kTool;
   absl::StatusOr<OccupancyMap> cluttered = AddClutter(map, 8.0, 5, co);
@@ -125,7 +130,8 @@ void DriveThroughClutter(const Pose2& station, double capacity) {
     for (int col = 0; col < map.width(); ++col) {
       const double x = map.origin().x + (col + 0.5) * map.resolution();
       const double y = map.origin().y + (row + 0.5) * map.resolution();
-      if (std::abs(x - station.x) <= kTool && std::abs(y - station.y) <= kTool) truth.set(row, col, map.at(row, col));
+      if (std::abs(x - station.x) <= kTool && std::abs(y - station.y) <= kTool)
+        truth.set(row, col, map.at(row, col));
     }
   }
   absl::StatusOr<EngineResult> plan = PlanCoverageWithArea(map, o.plan);
@@ -135,10 +141,11 @@ void DriveThroughClutter(const Pose2& station, double capacity) {
   ASSERT_TRUE(r.ok()) << r.status();
   ASSERT_TRUE(r->battery.has_value());
   const BatteryRun& b = *r->battery;
-  std::printf("battery + clutter: %d replans, %d cycles driven (%d planned), energy %.2f (planned %.2f), "
-              "min left %.2f, over budget %d\n",
-              r->num_replans, b.charge_cycles_driven, b.charge_cycles_planned, b.energy_used, b.energy_planned,
-              b.min_battery_left, b.cycles_over_budget);
+  std::printf(
+      "battery + clutter: %d replans, %d cycles driven (%d planned), energy %.2f (planned %.2f), "
+      "min left %.2f, over budget %d\n",
+      r->num_replans, b.charge_cycles_driven, b.charge_cycles_planned, b.energy_used,
+      b.energy_planned, b.min_battery_left, b.cycles_over_budget);
   EXPECT_TRUE(r->completed) << r->termination;
   EXPECT_GT(r->num_replans, 0);
   EXPECT_THAT(r->replan_methods, ::testing::Each(::testing::AnyOf("greedy_detour", "unchanged")));
@@ -235,7 +242,9 @@ TEST(BatterySimulation, AStationTheTrueMapBlocksIsInvalidArgument) {
   EXPECT_THAT(std::string(Simulate(map, map, o).status().message()), HasSubstr("recharge_s"));
 }
 
-std::string MapPath(const std::string& name) { return std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name; }
+std::string MapPath(const std::string& name) {
+  return std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name;
+}
 
 // A number after "key": in the JSON text.
 double JsonField(const std::string& json, const std::string& key) {
@@ -246,8 +255,20 @@ double JsonField(const std::string& json, const std::string& key) {
 }
 
 std::vector<std::string> BatteryArgs(const Pose2& s) {
-  return {"--map", MapPath(kMap), "--true-map", MapPath(kMap), "--tool-width", "0.6", "--time-limit", "0.2",
-          "--battery-capacity", "60", "--reserve", "5", "--station", absl::StrFormat("%.6f,%.6f", s.x, s.y)};
+  return {"--map",
+          MapPath(kMap),
+          "--true-map",
+          MapPath(kMap),
+          "--tool-width",
+          "0.6",
+          "--time-limit",
+          "0.2",
+          "--battery-capacity",
+          "60",
+          "--reserve",
+          "5",
+          "--station",
+          absl::StrFormat("%.6f,%.6f", s.x, s.y)};
 }
 
 TEST(SimulateCommandBattery, PrintsTheBatteryFigures) {
@@ -264,7 +285,8 @@ TEST(SimulateCommandBattery, PrintsTheBatteryFigures) {
   EXPECT_EQ(cycles, JsonField(*json, "planned_charge_cycles"));
   EXPECT_NEAR(JsonField(*json, "recharge_time_s"), 1200 * cycles, 1e-6);
   EXPECT_NEAR(JsonField(*json, "total_time_s"),
-              JsonField(*json, "drive_time_s") + JsonField(*json, "stoppage_s") + 1200 * cycles, 1e-5);
+              JsonField(*json, "drive_time_s") + JsonField(*json, "stoppage_s") + 1200 * cycles,
+              1e-5);
   EXPECT_NEAR(JsonField(*json, "energy_used"), JsonField(*json, "planned_energy"), 1e-5);
   EXPECT_GE(JsonField(*json, "min_battery_left"), 5.0);
   // The offline bound (a battery plan of the true map) counts its recharges
@@ -307,13 +329,16 @@ TEST(SimulateCommandBattery, BadBatteryFlagsAreInvalidArgumentNamingTheFlag) {
       }
     }
     absl::StatusOr<std::string> r = SimulateCommandJson(args);
-    EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument) << c.extra[0] << " " << c.extra[1];
+    EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument)
+        << c.extra[0] << " " << c.extra[1];
     EXPECT_THAT(std::string(r.status().message()), HasSubstr(c.flag)) << r.status();
   }
   // A station without a capacity, and a capacity without a station.
   for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"--map", MapPath(kMap), "--true-map", MapPath(kMap), "--station", "1,1"},
-        std::vector<std::string>{"--map", MapPath(kMap), "--true-map", MapPath(kMap), "--battery-capacity", "9"}}) {
+       {std::vector<std::string>{"--map", MapPath(kMap), "--true-map", MapPath(kMap), "--station",
+                                 "1,1"},
+        std::vector<std::string>{"--map", MapPath(kMap), "--true-map", MapPath(kMap),
+                                 "--battery-capacity", "9"}}) {
     absl::StatusOr<std::string> r = SimulateCommandJson(args);
     EXPECT_EQ(r.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_THAT(std::string(r.status().message()), HasSubstr("--battery-capacity E and --station"));

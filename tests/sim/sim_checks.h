@@ -32,17 +32,21 @@ inline std::string FirstBlockedPoint(const Grid& grid, const std::vector<Waypoin
   for (size_t i = 1; i < path.size(); ++i) {
     const Waypoint& a = path[i - 1];
     const Waypoint& b = path[i];
-    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / (grid.cell_size() / 100))));
+    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) /
+                                                         (grid.cell_size() / 100))));
     for (int k = 0; k <= n; ++k) {
       const Point2 p{a.x + (b.x - a.x) * k / n, a.y + (b.y - a.y) * k / n};
-      const double fx = (p.x - grid.origin().x) / grid.cell_size(), fy = (p.y - grid.origin().y) / grid.cell_size();
-      const double border = std::min({fx - std::floor(fx), std::ceil(fx) - fx, fy - std::floor(fy), std::ceil(fy) - fy});
+      const double fx = (p.x - grid.origin().x) / grid.cell_size(),
+                   fy = (p.y - grid.origin().y) / grid.cell_size();
+      const double border = std::min(
+          {fx - std::floor(fx), std::ceil(fx) - fx, fy - std::floor(fy), std::ceil(fy) - fy});
       if (border < 1e-6) continue;  // on a cell border: in no cell
       const CellIndex c = grid.CellAt(p);
       if (c != start) left_start = true;
       if ((c != start || left_start) && !grid.IsFree(c)) {
-        return "segment " + std::to_string(i) + " enters blocked cell (" + std::to_string(c.row) + ", " +
-               std::to_string(c.col) + ") at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")";
+        return "segment " + std::to_string(i) + " enters blocked cell (" + std::to_string(c.row) +
+               ", " + std::to_string(c.col) + ") at (" + std::to_string(p.x) + ", " +
+               std::to_string(p.y) + ")";
       }
     }
   }

@@ -18,9 +18,9 @@
 #include "planner/engine/engine.h"
 #include "planner/grid/grid.h"
 #include "planner/grid/map_io.h"
-#include "tests/testing/shipped_maps.h"
 #include "planner/sim/clutter.h"
 #include "tests/sim/sim_checks.h"
+#include "tests/testing/shipped_maps.h"
 
 namespace covplan {
 namespace {
@@ -30,7 +30,9 @@ using testing::TrueGrid;
 
 using ::testing::HasSubstr;
 
-std::string MapPath(const std::string& name) { return std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name; }
+std::string MapPath(const std::string& name) {
+  return std::string(COVPLAN_SOURCE_DIR) + "/maps/" + name;
+}
 
 OccupancyMap Load(const std::string& name) { return testing::LoadShippedMap(name); }
 
@@ -44,7 +46,8 @@ SimulationOptions Options(ReplanMethod method) {
 
 class EveryReplanMethod : public ::testing::TestWithParam<ReplanMethod> {};
 
-TEST_P(EveryReplanMethod, DrivesTheFurnishedOfficeCoveringWhatAnOfflinePlanCoversWithoutEnteringFurniture) {
+TEST_P(EveryReplanMethod,
+       DrivesTheFurnishedOfficeCoveringWhatAnOfflinePlanCoversWithoutEnteringFurniture) {
   const OccupancyMap known = Load("sample_office.yaml");
   const OccupancyMap truth = Load("sample_office_furnished.yaml");
   const SimulationOptions o = Options(GetParam());
@@ -56,13 +59,14 @@ TEST_P(EveryReplanMethod, DrivesTheFurnishedOfficeCoveringWhatAnOfflinePlanCover
   ASSERT_TRUE(cells.ok()) << cells.status();
   absl::StatusOr<OfflineBound> cell_bound = OfflineLowerBound(*cells, o.plan);
   ASSERT_TRUE(cell_bound.ok()) << cell_bound.status();
-  std::printf("%s: total %.1f s (drive %.1f, stoppage %.2f), planned %.1f, offline %.1f (cells %.1f); "
-              "replans %d, encounters %d, detours %d, found %zu, touch %d; in obstacles %.2f m; "
-              "coverage %.4f (offline %.4f)\n",
-              ReplanMethodName(GetParam()), r->total_time_s, r->drive_time_s, r->stoppage_s,
-              r->planned_duration_s, offline->duration_s, cell_bound->duration_s, r->num_replans, r->num_encounters,
-              r->num_greedy_detours, r->obstacles_found.size(), r->num_touch_detections,
-              r->length_in_obstacles_m, r->covered_free_area_ratio, offline->covered_free_area_ratio);
+  std::printf(
+      "%s: total %.1f s (drive %.1f, stoppage %.2f), planned %.1f, offline %.1f (cells %.1f); "
+      "replans %d, encounters %d, detours %d, found %zu, touch %d; in obstacles %.2f m; "
+      "coverage %.4f (offline %.4f)\n",
+      ReplanMethodName(GetParam()), r->total_time_s, r->drive_time_s, r->stoppage_s,
+      r->planned_duration_s, offline->duration_s, cell_bound->duration_s, r->num_replans,
+      r->num_encounters, r->num_greedy_detours, r->obstacles_found.size(), r->num_touch_detections,
+      r->length_in_obstacles_m, r->covered_free_area_ratio, offline->covered_free_area_ratio);
   for (const std::string& p : r->problems) std::printf("  problem: %s\n", p.c_str());
 
   EXPECT_TRUE(r->completed) << r->termination;
@@ -88,7 +92,8 @@ TEST_P(EveryReplanMethod, DrivesTheFurnishedOfficeCoveringWhatAnOfflinePlanCover
     // Every encounter is driven around, no compute time is charged.
     EXPECT_EQ(r->num_greedy_detours, r->num_encounters);
     EXPECT_EQ(r->stoppage_s, 0.0);
-    for (const std::string& m : r->replan_methods) EXPECT_THAT(m, ::testing::AnyOf("greedy_detour", "unchanged"));
+    for (const std::string& m : r->replan_methods)
+      EXPECT_THAT(m, ::testing::AnyOf("greedy_detour", "unchanged"));
   }
   // Coverage, against the true map's free area: close to what an offline plan of
   // the true map covers. Calibration: on this office the runs cover 0.882 and
@@ -252,7 +257,8 @@ TEST(Clutter, KeepingTheGridConnectedCutsNoCellOff) {
 TEST(Clutter, PercentOutsideZeroToFiftyIsInvalidArgument) {
   const OccupancyMap office = Load("sample_office.yaml");
   for (double percent : {-0.1, 50.5, std::nan("")}) {
-    EXPECT_EQ(AddClutter(office, percent, 1).status().code(), absl::StatusCode::kInvalidArgument) << percent;
+    EXPECT_EQ(AddClutter(office, percent, 1).status().code(), absl::StatusCode::kInvalidArgument)
+        << percent;
   }
 }
 
@@ -264,13 +270,15 @@ TEST(Simulate, TenPercentClutterIsDrivenAroundByAuto) {
   o.replan_tour_time_limit_s = 0.25;  // ~50 replans: keep the test quick
   absl::StatusOr<SimulationResult> r = Simulate(office, *truth, o);
   ASSERT_TRUE(r.ok()) << r.status();
-  std::printf("clutter 10 %%: total %.1f s, stoppage %.2f s, replans %d, coverage %.4f\n", r->total_time_s,
-              r->stoppage_s, r->num_replans, r->covered_free_area_ratio);
+  std::printf("clutter 10 %%: total %.1f s, stoppage %.2f s, replans %d, coverage %.4f\n",
+              r->total_time_s, r->stoppage_s, r->num_replans, r->covered_free_area_ratio);
   EXPECT_TRUE(r->completed) << r->termination;
   EXPECT_THAT(r->problems, ::testing::IsEmpty());
   EXPECT_GT(r->num_replans, 0);
   // Clutter on the start pose is taken off (see the test below).
-  EXPECT_EQ(FirstBlockedPoint(TrueGrid(r->truth_used != nullptr ? *r->truth_used : *truth), r->driven), "");
+  EXPECT_EQ(
+      FirstBlockedPoint(TrueGrid(r->truth_used != nullptr ? *r->truth_used : *truth), r->driven),
+      "");
   EXPECT_NEAR(r->total_time_s, r->drive_time_s + r->stoppage_s, 1e-9 * r->total_time_s);
 }
 
@@ -319,9 +327,10 @@ double JsonField(const std::string& json, const std::string& key) {
 }
 
 TEST(SimulateCommand, PrintsEveryFigureAsOneJsonObject) {
-  absl::StatusOr<std::string> json = SimulateCommandJson(
-      {"--map", MapPath("sample_office.yaml"), "--true-map", MapPath("sample_office_furnished.yaml"),
-       "--method", "ilp2", "--local", "--time-limit", "0.5"});
+  absl::StatusOr<std::string> json =
+      SimulateCommandJson({"--map", MapPath("sample_office.yaml"), "--true-map",
+                           MapPath("sample_office_furnished.yaml"), "--method", "ilp2", "--local",
+                           "--time-limit", "0.5"});
   ASSERT_TRUE(json.ok()) << json.status();
   std::printf("%s\n", json->c_str());
   EXPECT_EQ(json->front(), '{');
@@ -348,7 +357,8 @@ TEST(SimulateCommand, BadFlagsAreInvalidArgument) {
     const char* message;
   };
   const std::vector<Case> cases = {
-      {{"--map", office, "--clutter", "10", "--server", "127.0.0.1:50051"}, "not available in this build"},
+      {{"--map", office, "--clutter", "10", "--server", "127.0.0.1:50051"},
+       "not available in this build"},
       {{"--map", office, "--clutter", "10", "--server", "127.0.0.1:50051", "--local"}, "not both"},
       {{"--map", office}, "exactly one of --true-map"},
       {{"--map", office, "--true-map", office, "--clutter", "5"}, "exactly one of --true-map"},

@@ -55,7 +55,8 @@ TEST(OnlineStc, CoversTheSameSubCellsAsOfflineIncludingPartlyFreeCoarseCells) {
     }
     ASSERT_TRUE(start.has_value());
     StcDetail detail;
-    const std::vector<CellIndex> offline = OfflineTrail(truth, OfflineLikeOnline(PartialCells::kCover), *start, &detail);
+    const std::vector<CellIndex> offline =
+        OfflineTrail(truth, OfflineLikeOnline(PartialCells::kCover), *start, &detail);
     SubCellRobot robot(truth, *start);
     absl::StatusOr<OnlineStcStats> online = RunOnlineStc(&robot, PartialCells::kCover);
     ASSERT_TRUE(online.ok()) << online.status();
@@ -77,8 +78,10 @@ TEST(OnlineStc, BothRobotsDriveTheOfflinePathWhenEveryCoarseCellIsWhollyFree) {
     absl::StatusOr<CellIndex> first = DefaultStartCell(truth, truth);
     ASSERT_TRUE(first.ok());
     // Start in different sub-cells of the first coarse cell.
-    const CellIndex start{first->row + static_cast<int>(seed % 2), first->col + static_cast<int>(seed / 2 % 2)};
-    const std::vector<CellIndex> offline = OfflineTrail(truth, OfflineLikeOnline(PartialCells::kCover), start);
+    const CellIndex start{first->row + static_cast<int>(seed % 2),
+                          first->col + static_cast<int>(seed / 2 % 2)};
+    const std::vector<CellIndex> offline =
+        OfflineTrail(truth, OfflineLikeOnline(PartialCells::kCover), start);
     ASSERT_EQ(static_cast<int64_t>(offline.size()), truth.CountFree() + 1);
     SubCellRobot online_robot(truth, start);
     ASSERT_TRUE(RunOnlineStc(&online_robot, PartialCells::kCover).ok());
@@ -139,7 +142,8 @@ TEST(SubCellRobot, RefusesMovesTheTruthBlocks) {
   EXPECT_EQ(robot.Step({1, 2}).code(), absl::StatusCode::kFailedPrecondition);  // obstacle
   EXPECT_EQ(robot.Step({0, 0}).code(), absl::StatusCode::kFailedPrecondition);  // not a neighbour
   SubCellRobot ant(truth, {0, 2});
-  EXPECT_EQ(RunAntStc(&ant).status().code(), absl::StatusCode::kInvalidArgument);  // partly free start cell
+  EXPECT_EQ(RunAntStc(&ant).status().code(),
+            absl::StatusCode::kInvalidArgument);  // partly free start cell
 }
 
 }  // namespace

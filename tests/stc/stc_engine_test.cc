@@ -34,7 +34,8 @@ struct Variant {
 
 TEST(StcEngine, ConformsOnShippedMapsWithZonesAndPoses) {
   const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  for (const std::string name : {"small_rooms.yaml", "sample_office.yaml", "sample_office_furnished.yaml"}) {
+  for (const std::string name :
+       {"small_rooms.yaml", "sample_office.yaml", "sample_office_furnished.yaml"}) {
     const OccupancyMap map = testing::LoadShippedMap(name);
     LocalArtifactCache cache;
     PlanningEngine engine(&registry, &cache, EngineLimits{});
@@ -58,7 +59,8 @@ TEST(StcEngine, ConformsOnShippedMapsWithZonesAndPoses) {
         Pose2 start, end;
         if (setup == 2) {
           // Poses inside free cells of the drive grid (first and last free cell).
-          absl::StatusOr<std::shared_ptr<const CoverageArea>> area = engine.AreaFor(SourceOf(map, name), r);
+          absl::StatusOr<std::shared_ptr<const CoverageArea>> area =
+              engine.AreaFor(SourceOf(map, name), r);
           ASSERT_TRUE(area.ok()) << area.status();
           const Grid& drive = *(*area)->drive;
           int64_t first = -1, last = -1;
@@ -67,7 +69,8 @@ TEST(StcEngine, ConformsOnShippedMapsWithZonesAndPoses) {
             if (first < 0) first = i;
             last = i;
           }
-          const Point2 a = drive.CellCenter(drive.FromIndex(first)), b = drive.CellCenter(drive.FromIndex(last));
+          const Point2 a = drive.CellCenter(drive.FromIndex(first)),
+                       b = drive.CellCenter(drive.FromIndex(last));
           start = {a.x + 0.1, a.y - 0.05, 0.3};
           end = {b.x - 0.05, b.y, 0.0};
           r.common.robot.start = start;
@@ -76,8 +79,11 @@ TEST(StcEngine, ConformsOnShippedMapsWithZonesAndPoses) {
         absl::StatusOr<EngineResult> result = engine.Plan(SourceOf(map, name), r);
         ASSERT_TRUE(result.ok()) << result.status();
         EXPECT_EQ(result->plan.planner, "stc");
-        EXPECT_EQ(testing::CheckPlanConformance(result->plan, *result->area, r.common.robot, r.no_go), "");
-        EXPECT_EQ(testing::CheckPathAvoidsMapObstacles(map, result->plan.path, setup == 2 ? 1 : 0), "");
+        EXPECT_EQ(
+            testing::CheckPlanConformance(result->plan, *result->area, r.common.robot, r.no_go),
+            "");
+        EXPECT_EQ(testing::CheckPathAvoidsMapObstacles(map, result->plan.path, setup == 2 ? 1 : 0),
+                  "");
         EXPECT_EQ(result->plan.stats.covered_cells, result->plan.stats.free_cells);
         const StcDetail* d = result->plan.detail_as<StcDetail>();
         ASSERT_NE(d, nullptr);

@@ -47,7 +47,8 @@ TEST(OfflineStc, WhollyFreeCoarseCellsAreVisitedOnceOnATourOfLength4ND) {
       const int64_t coarse = free / 4;
       for (const StcOptions& options : TreeVariants()) {
         SCOPED_TRACE(absl::StrFormat("seed %d shift %d tree %d dir %d", seed, shift,
-                                     static_cast<int>(options.tree), static_cast<int>(options.sweep_direction)));
+                                     static_cast<int>(options.tree),
+                                     static_cast<int>(options.sweep_direction)));
         absl::StatusOr<CoveragePlan> plan = testing::PlanStcOnGrid(grid, options);
         ASSERT_TRUE(plan.ok()) << plan.status();
         const StcDetail* detail = plan->detail_as<StcDetail>();
@@ -64,7 +65,8 @@ TEST(OfflineStc, WhollyFreeCoarseCellsAreVisitedOnceOnATourOfLength4ND) {
         // Closed: back at the start.
         EXPECT_NEAR(plan->path.front().x, plan->path.back().x, 1e-12);
         EXPECT_NEAR(plan->path.front().y, plan->path.back().y, 1e-12);
-        const std::vector<int> entries = testing::CellEntries(grid, plan->path, LastCoverage(*plan));
+        const std::vector<int> entries =
+            testing::CellEntries(grid, plan->path, LastCoverage(*plan));
         for (int64_t i = 0; i < grid.size(); ++i) {
           ASSERT_EQ(entries[i], grid.free_flags()[i] ? 1 : 0) << "cell " << i;
         }
@@ -81,7 +83,8 @@ TEST(OfflineStc, TreesSpanTheCoarseCellsAndTheRingVisitsEachSubCellOnce) {
     for (PartialCells partial : {PartialCells::kCover, PartialCells::kDiscard}) {
       const CoarseGrid coarse(grid, grid, {static_cast<int>(seed % 2), 0}, partial);
       const StcRoot root{coarse.CoarseOf(grid.FromIndex(0)), 0};
-      for (const StcTree& tree : {BuildDfsTree(coarse, root), BuildPrimTree(coarse, root, SweepDirection::kVertical)}) {
+      for (const StcTree& tree :
+           {BuildDfsTree(coarse, root), BuildPrimTree(coarse, root, SweepDirection::kVertical)}) {
         EXPECT_EQ(tree.num_nodes, coarse.num_nodes());
         // A forest: edges = nodes - trees, and every edge is a link STC may use.
         EXPECT_EQ(tree.num_edges, tree.num_nodes - static_cast<int>(tree.roots.size()));
@@ -139,7 +142,8 @@ TEST(OfflineStc, PartlyFreeCoarseCellsAreCoveredAndTheRepeatsAreReportedExactly)
 TEST(OfflineStc, HandWorkedPartialCells) {
   StcOptions fixed;
   fixed.search_offset = false;
-  absl::StatusOr<CoveragePlan> block = testing::PlanStcOnGrid(Grid::FromAscii({"...", "..."}), fixed);
+  absl::StatusOr<CoveragePlan> block =
+      testing::PlanStcOnGrid(Grid::FromAscii({"...", "..."}), fixed);
   ASSERT_TRUE(block.ok());
   EXPECT_EQ(block->detail_as<StcDetail>()->partial_coarse_cells, 1);
   EXPECT_EQ(block->detail_as<StcDetail>()->extra_moves, 0);
@@ -182,8 +186,10 @@ TEST(OfflineStc, PrimFollowsTheSweepDirection) {
   absl::StatusOr<CoveragePlan> pv = testing::PlanStcOnGrid(room, v);
   ASSERT_TRUE(ph.ok() && pv.ok());
   double along_h = 0, along_v = 0;
-  for (size_t i = 1; i < ph->path.size(); ++i) along_h += std::abs(ph->path[i].x - ph->path[i - 1].x);
-  for (size_t i = 1; i < pv->path.size(); ++i) along_v += std::abs(pv->path[i].y - pv->path[i - 1].y);
+  for (size_t i = 1; i < ph->path.size(); ++i)
+    along_h += std::abs(ph->path[i].x - ph->path[i - 1].x);
+  for (size_t i = 1; i < pv->path.size(); ++i)
+    along_v += std::abs(pv->path[i].y - pv->path[i - 1].y);
   // Horizontal lanes: most of the 400 m of driving is along x (and for
   // vertical lanes along y).
   EXPECT_GT(along_h, 0.8 * 400);

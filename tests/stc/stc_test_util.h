@@ -27,7 +27,8 @@ inline Grid RandomCoarseShape(int rows, int cols, int n_coarse, uint32_t seed, i
   in[frontier[0]] = 1;
   int count = 1;
   while (count < n_coarse && !frontier.empty()) {
-    const int pick = std::uniform_int_distribution<int>(0, static_cast<int>(frontier.size()) - 1)(rng);
+    const int pick =
+        std::uniform_int_distribution<int>(0, static_cast<int>(frontier.size()) - 1)(rng);
     const int id = frontier[pick];
     const int dr[4] = {0, 1, 0, -1}, dc[4] = {1, 0, -1, 0};
     const int d = std::uniform_int_distribution<int>(0, 3)(rng);
@@ -101,7 +102,8 @@ inline absl::StatusOr<CoveragePlan> PlanStcOnGrid(const Grid& grid, const StcOpt
 
 // Times the path's centre line enters each cell (the start cell counts once
 // at the start), over waypoints 1..last. Axis-parallel unit-cell paths only.
-inline std::vector<int> CellEntries(const Grid& grid, const std::vector<Waypoint>& path, size_t last) {
+inline std::vector<int> CellEntries(const Grid& grid, const std::vector<Waypoint>& path,
+                                    size_t last) {
   std::vector<int> entries(grid.size(), 0);
   if (path.empty()) return entries;
   CellIndex prev = grid.CellAt({path[0].x, path[0].y});

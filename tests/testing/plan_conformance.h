@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "absl/strings/str_format.h"
 #include <algorithm>
+#include "absl/strings/str_format.h"
 
 #include "planner/engine/engine.h"
 #include "planner/engine/plan_coverage.h"
@@ -49,10 +49,11 @@ inline std::string CheckPathAvoidsMapObstacles(const OccupancyMap& map,
       const double y = (a.y + t * (b.y - a.y) - map.origin().y) / res;
       if (blocked(x - kNudge, y - kNudge) && blocked(x + kNudge, y - kNudge) &&
           blocked(x - kNudge, y + kNudge) && blocked(x + kNudge, y + kNudge)) {
-        return absl::StrFormat("segment %d (%s) enters an obstacle at pixel (%d, %d), (%.3f, %.3f) m",
-                               i, b.kind == SegmentKind::kCoverage ? "coverage" : "transition",
-                               static_cast<int>(std::floor(y)), static_cast<int>(std::floor(x)),
-                               a.x + t * (b.x - a.x), a.y + t * (b.y - a.y));
+        return absl::StrFormat(
+            "segment %d (%s) enters an obstacle at pixel (%d, %d), (%.3f, %.3f) m", i,
+            b.kind == SegmentKind::kCoverage ? "coverage" : "transition",
+            static_cast<int>(std::floor(y)), static_cast<int>(std::floor(x)), a.x + t * (b.x - a.x),
+            a.y + t * (b.y - a.y));
       }
     }
   }
@@ -87,8 +88,10 @@ inline std::string CheckPathStaysFree(const Grid& grid, const std::vector<Waypoi
         if (std::abs(dr) + std::abs(dc) == 1) {
           ok = grid.Passable(prev.row, prev.col, dr, dc);
         } else if (std::abs(dr) == 1 && std::abs(dc) == 1) {
-          ok = (grid.Passable(prev.row, prev.col, 0, dc) && grid.Passable(prev.row, prev.col + dc, dr, 0)) ||
-               (grid.Passable(prev.row, prev.col, dr, 0) && grid.Passable(prev.row + dr, prev.col, 0, dc));
+          ok = (grid.Passable(prev.row, prev.col, 0, dc) &&
+                grid.Passable(prev.row, prev.col + dc, dr, 0)) ||
+               (grid.Passable(prev.row, prev.col, dr, 0) &&
+                grid.Passable(prev.row + dr, prev.col, 0, dc));
         }
         if (!ok) {
           return absl::StrFormat("segment %d crosses a barrier near (%.3f, %.3f)", i, p.x, p.y);
@@ -175,16 +178,19 @@ inline std::string CheckPlanConformance(const CoveragePlan& plan, const Coverage
   err = CheckPathAvoidsZones(plan.path, no_go);
   if (!err.empty()) return err;
   int coverage_segments = 0;
-  for (size_t i = 1; i < plan.path.size(); ++i) coverage_segments += plan.path[i].kind == SegmentKind::kCoverage;
+  for (size_t i = 1; i < plan.path.size(); ++i)
+    coverage_segments += plan.path[i].kind == SegmentKind::kCoverage;
   if (static_cast<int>(plan.sweeps.size()) != coverage_segments) {
-    return absl::StrFormat("%d sweeps for %d coverage segments", plan.sweeps.size(), coverage_segments);
+    return absl::StrFormat("%d sweeps for %d coverage segments", plan.sweeps.size(),
+                           coverage_segments);
   }
   std::vector<uint8_t> swept(drive.size(), 0);
   int last = 0;
   for (const CoverageSweep& s : plan.sweeps) {
     if (s.waypoint <= last || s.waypoint >= static_cast<int>(plan.path.size()) ||
         plan.path[s.waypoint].kind != SegmentKind::kCoverage) {
-      return absl::StrFormat("sweep at waypoint %d is not a coverage segment in path order", s.waypoint);
+      return absl::StrFormat("sweep at waypoint %d is not a coverage segment in path order",
+                             s.waypoint);
     }
     last = s.waypoint;
     const Waypoint& a = plan.path[s.waypoint - 1];
@@ -195,9 +201,11 @@ inline std::string CheckPlanConformance(const CoveragePlan& plan, const Coverage
       }
       const Point2 m = drive.CellCenter(c);
       const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-      const double t = len2 > 0 ? std::clamp(((m.x - a.x) * dx + (m.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+      const double t =
+          len2 > 0 ? std::clamp(((m.x - a.x) * dx + (m.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
       if (std::hypot(m.x - (a.x + t * dx), m.y - (a.y + t * dy)) > 1e-6) {
-        return absl::StrFormat("sweep %d claims cell (%d, %d) that its segment misses", s.waypoint, c.row, c.col);
+        return absl::StrFormat("sweep %d claims cell (%d, %d) that its segment misses", s.waypoint,
+                               c.row, c.col);
       }
       swept[drive.Index(c.row, c.col)] = 1;
     }
@@ -213,11 +221,16 @@ inline std::string CheckPlanConformance(const CoveragePlan& plan, const Coverage
     }
   }
   const PlanStats s = ComputePathStats(plan.path, robot);
-  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b)); };
+  auto close = [](double a, double b) {
+    return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b));
+  };
   if (s.num_turns != plan.stats.num_turns) return "num_turns inconsistent with the path";
-  if (!close(s.coverage_length_m, plan.stats.coverage_length_m)) return "coverage length inconsistent";
-  if (!close(s.transition_length_m, plan.stats.transition_length_m)) return "transition length inconsistent";
-  if (!close(s.estimated_duration_s, plan.stats.estimated_duration_s)) return "duration inconsistent";
+  if (!close(s.coverage_length_m, plan.stats.coverage_length_m))
+    return "coverage length inconsistent";
+  if (!close(s.transition_length_m, plan.stats.transition_length_m))
+    return "transition length inconsistent";
+  if (!close(s.estimated_duration_s, plan.stats.estimated_duration_s))
+    return "duration inconsistent";
   if (plan.stats.covered_cells != covered) return "covered_cells inconsistent with the sweeps";
   if (plan.stats.free_cells != to_cover) return "free_cells is not the number of cells to cover";
   return "";
@@ -235,20 +248,23 @@ inline std::string CheckOarpDetail(const CoveragePlan& plan, const Grid& cover) 
   for (size_t i = 1; i < plan.path.size(); ++i) {
     const Waypoint& w = plan.path[i];
     if (w.kind != SegmentKind::kCoverage) continue;
-    if (w.rank < 0 || w.rank >= static_cast<int>(oarp->ranks.size())) return "coverage segment without rank";
+    if (w.rank < 0 || w.rank >= static_cast<int>(oarp->ranks.size()))
+      return "coverage segment without rank";
     const Rank& r = oarp->ranks[w.rank];
     const Point2 f = grid.CellCenter(r.first), l = grid.CellCenter(r.last);
     const Waypoint& prev = plan.path[i - 1];
     auto near = [](double x, double y, Point2 p) { return std::hypot(x - p.x, y - p.y) < 1e-6; };
     const bool fwd = near(prev.x, prev.y, f) && near(w.x, w.y, l);
     const bool bwd = near(prev.x, prev.y, l) && near(w.x, w.y, f);
-    if (!fwd && !bwd) return absl::StrFormat("coverage segment %d does not run along rank %d", i, w.rank);
+    if (!fwd && !bwd)
+      return absl::StrFormat("coverage segment %d does not run along rank %d", i, w.rank);
     ++driven[w.rank];
   }
   for (size_t k = 0; k < driven.size(); ++k) {
     if (driven[k] != 1) return absl::StrFormat("rank %d driven %d times", k, driven[k]);
   }
-  if (plan.stats.num_ranks != static_cast<int64_t>(oarp->ranks.size())) return "num_ranks inconsistent";
+  if (plan.stats.num_ranks != static_cast<int64_t>(oarp->ranks.size()))
+    return "num_ranks inconsistent";
   return "";
 }
 

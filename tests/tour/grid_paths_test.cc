@@ -105,7 +105,8 @@ TEST(JoinCell, AMoveOutOfABlockedCellCutsNoCorner) {
   // A free own cell is its own join cell; nothing free around is InvalidArgument.
   EXPECT_EQ(*JoinCell(g, Pose2{2.5, 0.5, 0.0}, "start"), (CellIndex{0, 2}));
   Grid walled = Grid::FromAscii({"###", "###", "###"});
-  EXPECT_EQ(JoinCell(walled, Pose2{1.5, 1.5, 0.0}, "end").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(JoinCell(walled, Pose2{1.5, 1.5, 0.0}, "end").status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(AnyAngleSearch, PathAroundWallIsShortAndFree) {
@@ -132,7 +133,8 @@ TEST(AnyAngleSearch, PathAroundWallIsShortAndFree) {
   }
   EXPECT_EQ(testing::CheckPathStaysFree(g, wps), "");
   EXPECT_NEAR(length, search.DistanceCells({3, 9}), 1e-4);
-  // Must go round the wall (rows 1..3 at col 4): longer than 9, far shorter than a 4-connected detour.
+  // Must go round the wall (rows 1..3 at col 4): longer than 9, far shorter than a 4-connected
+  // detour.
   EXPECT_GT(length, 9.0);
   EXPECT_LT(length, 10.5);
 }
@@ -166,7 +168,8 @@ TEST(AnyAngleSearch, RandomGridsPathsStayFree) {
         ASSERT_TRUE(LineOfSight(g, path[k - 1], path[k])) << "seed " << seed;
       }
       std::vector<Waypoint> wps;
-      for (const CellIndex& p : path) wps.push_back({g.CellCenter(p).x, g.CellCenter(p).y, 0, SegmentKind::kTransition, -1});
+      for (const CellIndex& p : path)
+        wps.push_back({g.CellCenter(p).x, g.CellCenter(p).y, 0, SegmentKind::kTransition, -1});
       ASSERT_EQ(testing::CheckPathStaysFree(g, wps), "") << "seed " << seed;
     }
   }
@@ -191,7 +194,8 @@ TEST(AnyAngleSearch, CappedRunToResumesAsOneSearch) {
     std::mt19937 rng(seed);
     int resumed = 0;
     for (int k = 0; k < 40; ++k) {
-      const CellIndex a = free_cells[rng() % free_cells.size()], b = free_cells[rng() % free_cells.size()];
+      const CellIndex a = free_cells[rng() % free_cells.size()],
+                      b = free_cells[rng() % free_cells.size()];
       ASSERT_TRUE(fresh.RunTo(a, b, StopToken()));
       float bound = -1.0f;
       if (capped.RunTo(a, b, StopToken(), 25, &bound)) {
@@ -220,7 +224,8 @@ TEST(AnyAngleSearch, CellsClosedOnTheWayHaveTheirPaths) {
     const std::vector<CellIndex> free_cells = FreeCells(g);
     std::mt19937 rng(seed);
     AnyAngleSearch search(g);
-    const CellIndex a = free_cells[rng() % free_cells.size()], b = free_cells[rng() % free_cells.size()];
+    const CellIndex a = free_cells[rng() % free_cells.size()],
+                    b = free_cells[rng() % free_cells.size()];
     ASSERT_TRUE(search.RunTo(a, b, StopToken()));
     int64_t closed = 0;
     search.ForEachClosed([&](int64_t i) {
@@ -254,10 +259,12 @@ TEST(AnyAngleSearch, VisibleAgreesWithLineOfSight) {
       for (int c = 0; c < map.width(); ++c) map.set(r, c, CellState::kFree);
     }
     for (int k = 0; k < 25; ++k) {  // specks and small blocks
-      const int r0 = static_cast<int>(rng() % map.height()), c0 = static_cast<int>(rng() % map.width());
+      const int r0 = static_cast<int>(rng() % map.height()),
+                c0 = static_cast<int>(rng() % map.width());
       const int h = 1 + static_cast<int>(rng() % 8), w = 1 + static_cast<int>(rng() % 8);
       for (int r = r0; r < std::min(map.height(), r0 + h); ++r) {
-        for (int c = c0; c < std::min(map.width(), c0 + w); ++c) map.set(r, c, CellState::kOccupied);
+        for (int c = c0; c < std::min(map.width(), c0 + w); ++c)
+          map.set(r, c, CellState::kOccupied);
       }
     }
     for (int k = 0; k < 3; ++k) {  // one-pixel walls with a gap: barriers between free cells
@@ -278,8 +285,8 @@ TEST(AnyAngleSearch, VisibleAgreesWithLineOfSight) {
       for (int64_t b = 0; b < g->size(); ++b) {
         const CellIndex ca = g->FromIndex(a), cb = g->FromIndex(b);
         const bool los = LineOfSight(*g, ca, cb);
-        ASSERT_EQ(search.Visible(ca, cb), los)
-            << "seed " << seed << " (" << ca.row << "," << ca.col << ") -> (" << cb.row << "," << cb.col << ")";
+        ASSERT_EQ(search.Visible(ca, cb), los) << "seed " << seed << " (" << ca.row << "," << ca.col
+                                               << ") -> (" << cb.row << "," << cb.col << ")";
         (los ? visible : hidden) += 1;
       }
     }

@@ -3,9 +3,9 @@
 #include <cmath>
 
 #include "gtest/gtest.h"
-#include "planner/partition/mincut_partitioner.h"
 #include "planner/engine/engine.h"
 #include "planner/oarp/oarp_planner.h"
+#include "planner/partition/mincut_partitioner.h"
 #include "planner/tour/grid_paths.h"
 #include "tests/testing/grid_fixtures.h"
 #include "tests/testing/plan_conformance.h"
@@ -26,7 +26,8 @@ Fixture Make(Grid grid) {
   return f;
 }
 
-CoveragePlan AsPlan(const Fixture& f, const RankTourCost& cost, const TourOrder& tour, const RobotModel& robot) {
+CoveragePlan AsPlan(const Fixture& f, const RankTourCost& cost, const TourOrder& tour,
+                    const RobotModel& robot) {
   CoveragePlan plan;
   plan.grid = std::make_shared<const Grid>(f.grid);
   auto detail = std::make_shared<OarpDetail>();
@@ -60,7 +61,9 @@ TEST(TransitionTable, PathsConnectEndpointsAndStayFree) {
       ASSERT_EQ(cells.front(), f.table->endpoint(a));
       ASSERT_EQ(cells.back(), f.table->endpoint(b));
       std::vector<Waypoint> wps;
-      for (const CellIndex& c : cells) wps.push_back({f.grid.CellCenter(c).x, f.grid.CellCenter(c).y, 0, SegmentKind::kTransition, -1});
+      for (const CellIndex& c : cells)
+        wps.push_back(
+            {f.grid.CellCenter(c).x, f.grid.CellCenter(c).y, 0, SegmentKind::kTransition, -1});
       ASSERT_EQ(testing::CheckPathStaysFree(f.grid, wps), "") << a << "->" << b;
     }
   }
@@ -75,7 +78,7 @@ TEST(RankTour, TourTimeEqualsPathDuration) {
   ASSERT_TRUE(cost.ok()) << cost.status();
   for (bool gtsp : {false, true}) {
     absl::StatusOr<TourOrder> tour = gtsp ? GtspOrderer({0.3, 1, 1}).Order(*cost, StopToken())
-                                         : GreedyOrderer().Order(*cost, StopToken());
+                                          : GreedyOrderer().Order(*cost, StopToken());
     ASSERT_TRUE(tour.ok()) << tour.status();
     ASSERT_EQ(tour->vertices.size(), f.partition.ranks.size());
     CoveragePlan plan = AsPlan(f, *cost, *tour, robot);

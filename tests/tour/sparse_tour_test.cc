@@ -66,7 +66,8 @@ TEST(EndpointGraph, CandidatesAreTheNearestEndpointsAtExactAnyAngleDistances) {
     AnyAngleSearch full(grid);
     for (int a = 0; a < count; ++a) {
       ASSERT_TRUE(full.Run(endpoints[a], StopToken()));
-      for (int b = 0; b < count; ++b) dist[a][b] = static_cast<float>(full.DistanceCells(endpoints[b]));
+      for (int b = 0; b < count; ++b)
+        dist[a][b] = static_cast<float>(full.DistanceCells(endpoints[b]));
     }
     for (int e = 0; e < count; ++e) {
       ASSERT_TRUE(full.Run(endpoints[e], StopToken()));
@@ -79,15 +80,18 @@ TEST(EndpointGraph, CandidatesAreTheNearestEndpointsAtExactAnyAngleDistances) {
         ASSERT_NE(c.endpoint, e);
         ASSERT_NE(c.endpoint, e ^ 1);
         const float forward = dist[e][c.endpoint], backward = dist[c.endpoint][e];
-        EXPECT_TRUE(std::abs(c.length_cells - forward) <= 1e-4 || std::abs(c.length_cells - backward) <= 1e-4)
-            << e << "->" << c.endpoint << ": " << c.length_cells << " vs " << forward << " / " << backward;
+        EXPECT_TRUE(std::abs(c.length_cells - forward) <= 1e-4 ||
+                    std::abs(c.length_cells - backward) <= 1e-4)
+            << e << "->" << c.endpoint << ": " << c.length_cells << " vs " << forward << " / "
+            << backward;
         std::vector<CellIndex> cells;
         (*graph)->AppendPath(e, c, &cells);
         ASSERT_EQ(cells.front(), endpoints[e]);
         ASSERT_EQ(cells.back(), endpoints[c.endpoint]);
         std::vector<Waypoint> wps;
         for (const CellIndex& cell : cells) {
-          wps.push_back({grid.CellCenter(cell).x, grid.CellCenter(cell).y, 0, SegmentKind::kTransition, -1});
+          wps.push_back(
+              {grid.CellCenter(cell).x, grid.CellCenter(cell).y, 0, SegmentKind::kTransition, -1});
         }
         EXPECT_EQ(testing::CheckPathStaysFree(grid, wps), "") << e << "->" << c.endpoint;
       }
@@ -104,12 +108,15 @@ TEST(EndpointGraph, CandidatesAreTheNearestEndpointsAtExactAnyAngleDistances) {
       const float kth = others[3];
       for (int f = 0; f < count; ++f) {
         if (f == e || f == (e ^ 1) || full.DistanceCells(endpoints[f]) >= kth - 1.0f) continue;
-        EXPECT_TRUE(std::any_of(cands.begin(), cands.end(), [&](const EndpointCandidate& c) { return c.endpoint == f; }))
-            << "endpoint " << f << " is nearer to " << e << " than the 4th nearest but no candidate";
+        EXPECT_TRUE(std::any_of(cands.begin(), cands.end(),
+                                [&](const EndpointCandidate& c) { return c.endpoint == f; }))
+            << "endpoint " << f << " is nearer to " << e
+            << " than the 4th nearest but no candidate";
       }
       // Lower bounds never exceed the exact distance.
       for (int f = 0; f < count; ++f) {
-        EXPECT_LE((*graph)->LowerBoundCells(endpoints[e], endpoints[f]), full.DistanceCells(endpoints[f]) + 1e-4);
+        EXPECT_LE((*graph)->LowerBoundCells(endpoints[e], endpoints[f]),
+                  full.DistanceCells(endpoints[f]) + 1e-4);
       }
     }
   }
@@ -208,7 +215,8 @@ TEST(SparseTour, ThreadsShareOneIncumbent) {
       (threads == 1 ? one_total : four_total) += plan.stats.estimated_duration_s;
     }
   }
-  EXPECT_LE(four_total, 1.05 * one_total) << "4 threads " << four_total << " s vs 1 thread " << one_total << " s";
+  EXPECT_LE(four_total, 1.05 * one_total)
+      << "4 threads " << four_total << " s vs 1 thread " << one_total << " s";
 }
 
 // A warm start from a cold search's own tour, from another start pose:
@@ -225,7 +233,8 @@ TEST(SparseTour, WarmStartFromARememberedTour) {
     robot.start = Pose2{grid.CellCenter(s).x, grid.CellCenter(s).y, 0.3};
     SparseTourOptions options;
     options.time_limit_s = 5.0;
-    auto remembered = PlanSparseRankTour(grid, partition.ranks, **graph, robot, options, StopToken());
+    auto remembered =
+        PlanSparseRankTour(grid, partition.ranks, **graph, robot, options, StopToken());
     ASSERT_TRUE(remembered.ok()) << remembered.status();
     EXPECT_FALSE(remembered->warm_started);
 
@@ -237,7 +246,8 @@ TEST(SparseTour, WarmStartFromARememberedTour) {
     SparseTourOptions warm_options = options;
     warm_options.warm_vertices = remembered->vertices;
     warm_options.warm_kicks = false;
-    auto warm = PlanSparseRankTour(grid, partition.ranks, **graph, moved, warm_options, StopToken());
+    auto warm =
+        PlanSparseRankTour(grid, partition.ranks, **graph, moved, warm_options, StopToken());
     ASSERT_TRUE(warm.ok()) << warm.status();
     EXPECT_TRUE(warm->warm_started);
     ASSERT_EQ(warm->vertices.size(), partition.ranks.size());
@@ -297,7 +307,8 @@ TEST(SparseTour, ExceededTransitionBudgetIsResourceExhaustedNamingTheBudget) {
   const OccupancyMap map = Comb(1250);
   EngineLimits limits;
   limits.max_transition_bytes = int64_t{1} << 20;
-  absl::StatusOr<EngineResult> r = PlanCoverageWithArea(map, CombOptions(), nullptr, "local", limits);
+  absl::StatusOr<EngineResult> r =
+      PlanCoverageWithArea(map, CombOptions(), nullptr, "local", limits);
   ASSERT_EQ(r.status().code(), absl::StatusCode::kResourceExhausted) << r.status();
   EXPECT_THAT(std::string(r.status().message()), HasSubstr("transition memory budget of 1 MiB"));
   EXPECT_THAT(std::string(r.status().message()), HasSubstr("--max_transition_mb"));

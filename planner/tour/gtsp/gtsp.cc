@@ -26,8 +26,8 @@ using gtsp_internal::SeedFor;
 using gtsp_internal::TrialOutcome;
 
 struct EffortConfig {
-  int trials;              // when neither max_trials nor "until deadline" applies
-  int cold_trials;         // trials started from a fresh random tour
+  int trials;       // when neither max_trials nor "until deadline" applies
+  int cold_trials;  // trials started from a fresh random tour
   int64_t iterations_per_set;
   int64_t stall_per_set;
   int64_t min_iterations;
@@ -73,13 +73,14 @@ absl::Status GtspInstance::Validate() const {
   }
   const size_t expected = static_cast<size_t>(num_vertices) * num_vertices;
   if (costs.size() != expected) {
-    return absl::InvalidArgumentError(absl::StrCat("GTSP cost matrix has ", costs.size(),
-                                                   " entries, expected num_vertices^2 = ", expected));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "GTSP cost matrix has ", costs.size(), " entries, expected num_vertices^2 = ", expected));
   }
   if (sets.empty()) return absl::InvalidArgumentError("GTSP instance has no sets");
   std::vector<int> owner(num_vertices, -1);
   for (size_t s = 0; s < sets.size(); ++s) {
-    if (sets[s].empty()) return absl::InvalidArgumentError(absl::StrCat("GTSP set ", s, " is empty"));
+    if (sets[s].empty())
+      return absl::InvalidArgumentError(absl::StrCat("GTSP set ", s, " is empty"));
     for (int v : sets[s]) {
       if (v < 0 || v >= num_vertices) {
         return absl::InvalidArgumentError(absl::StrCat("GTSP set ", s, " contains vertex ", v,
@@ -87,7 +88,8 @@ absl::Status GtspInstance::Validate() const {
       }
       if (owner[v] >= 0) {
         return absl::InvalidArgumentError(absl::StrCat("vertex ", v, " is in GTSP set ", owner[v],
-                                                       " and in set ", s, "; sets must be disjoint"));
+                                                       " and in set ", s,
+                                                       "; sets must be disjoint"));
       }
       owner[v] = static_cast<int>(s);
     }
@@ -111,7 +113,8 @@ absl::Status GtspInstance::Validate() const {
 
 absl::Status GtspOptions::Validate() const {
   if (num_threads < 1 || num_threads > 256) {
-    return absl::InvalidArgumentError(absl::StrCat("num_threads must be in [1, 256], got ", num_threads));
+    return absl::InvalidArgumentError(
+        absl::StrCat("num_threads must be in [1, 256], got ", num_threads));
   }
   if (max_trials < GtspOptions::kLocalStepOnly) {
     return absl::InvalidArgumentError(absl::StrCat("max_trials must be >= -1, got ", max_trials));
@@ -129,7 +132,8 @@ double TourCost(const GtspInstance& instance, const std::vector<int>& tour) {
 
 absl::Status ValidateTour(const GtspInstance& instance, const std::vector<int>& tour) {
   if (tour.size() != instance.sets.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("tour visits ", tour.size(), " vertices, expected one per set (",
+    return absl::InvalidArgumentError(absl::StrCat("tour visits ", tour.size(),
+                                                   " vertices, expected one per set (",
                                                    instance.sets.size(), ")"));
   }
   std::vector<int> owner(instance.num_vertices, -1);
@@ -141,8 +145,8 @@ absl::Status ValidateTour(const GtspInstance& instance, const std::vector<int>& 
   std::vector<char> seen(instance.sets.size(), 0);
   for (int v : tour) {
     if (v < 0 || v >= instance.num_vertices) {
-      return absl::InvalidArgumentError(absl::StrCat("tour vertex ", v, " out of range [0, ",
-                                                     instance.num_vertices, ")"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("tour vertex ", v, " out of range [0, ", instance.num_vertices, ")"));
     }
     const int s = owner[v];
     if (s < 0) return absl::InvalidArgumentError(absl::StrCat("tour vertex ", v, " is in no set"));
@@ -166,7 +170,8 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
 
   SearchParams params;
   params.max_iterations = std::max<int64_t>(cfg.min_iterations, cfg.iterations_per_set * problem.m);
-  params.stall_iterations = std::max<int64_t>(cfg.min_iterations / 2, cfg.stall_per_set * problem.m);
+  params.stall_iterations =
+      std::max<int64_t>(cfg.min_iterations / 2, cfg.stall_per_set * problem.m);
 
   // Shared best, only for progress reporting; the returned tour is chosen
   // deterministically from the per-trial results below.

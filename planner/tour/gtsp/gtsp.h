@@ -37,8 +37,8 @@ namespace covplan {
 struct GtspInstance {
   static constexpr double kInfeasibleCost = 1e15;
   int num_vertices = 0;
-  std::vector<double> costs;             // num_vertices^2, row-major
-  std::vector<std::vector<int>> sets;    // 0-based vertex ids; partition of vertices
+  std::vector<double> costs;           // num_vertices^2, row-major
+  std::vector<std::vector<int>> sets;  // 0-based vertex ids; partition of vertices
   double cost(int i, int j) const { return costs[static_cast<size_t>(i) * num_vertices + j]; }
 
   // Checks shapes, that sets partition the vertices and are non-empty, and
@@ -50,13 +50,13 @@ enum class GtspEffort { kFast, kDefault, kThorough };
 
 struct GtspOptions {
   uint64_t seed = 1;
-  int num_threads = 1;            // trials run in parallel on this many threads; the
-                                  // effort's trials run in whole rounds of this many
-                                  // (thorough with a deadline: one population each)
+  int num_threads = 1;  // trials run in parallel on this many threads; the
+                        // effort's trials run in whole rounds of this many
+                        // (thorough with a deadline: one population each)
   GtspEffort effort = GtspEffort::kDefault;
-  int max_trials = 0;             // 0 = chosen by effort; kLocalStepOnly: no LNS trial
+  int max_trials = 0;                        // 0 = chosen by effort; kLocalStepOnly: no LNS trial
   static constexpr int kLocalStepOnly = -1;  // the initial (or greedy) tour, locally optimised
-  StopToken stop;                 // deadline / cancellation
+  StopToken stop;                            // deadline / cancellation
   // Optional starting tour (one vertex per set, in visiting order) to improve.
   std::vector<int> initial_tour;
   // Called (from solver threads, serialized) whenever the best tour improves.
@@ -66,12 +66,12 @@ struct GtspOptions {
 };
 
 struct GtspResult {
-  std::vector<int> tour;     // one vertex per set, visiting order (cycle)
-  double cost = 0.0;         // sum of arc costs including the closing arc
+  std::vector<int> tour;       // one vertex per set, visiting order (cycle)
+  double cost = 0.0;           // sum of arc costs including the closing arc
   bool stopped_early = false;  // the StopToken cut the search short
-  int64_t iterations = 0;     // LNS iterations, or children evolved (thorough with a deadline)
-  int trials_completed = 0;   // trials that ended before the StopToken fired (thorough with a
-                              // deadline: 0, or num_threads when m = 2 and the greedy step is exact)
+  int64_t iterations = 0;      // LNS iterations, or children evolved (thorough with a deadline)
+  int trials_completed = 0;    // trials that ended before the StopToken fired (thorough with a
+                             // deadline: 0, or num_threads when m = 2 and the greedy step is exact)
   double elapsed_s = 0.0;
   double time_to_best_s = 0.0;
 };

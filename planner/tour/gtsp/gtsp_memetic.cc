@@ -67,7 +67,8 @@ void MemeticSearch::AddRandomTour(std::vector<SearchTour>& pop, const StopToken&
 }
 
 void MemeticSearch::Select(std::vector<SearchTour>& pop) {
-  std::sort(pop.begin(), pop.end(), [](const SearchTour& x, const SearchTour& y) { return x.cost < y.cost; });
+  std::sort(pop.begin(), pop.end(),
+            [](const SearchTour& x, const SearchTour& y) { return x.cost < y.cost; });
   size_t kept = 0;
   for (size_t i = 0; i < pop.size() && kept < static_cast<size_t>(kPopulation); ++i) {
     if (kept > 0 && SameCost(pop[i].cost, pop[kept - 1].cost)) continue;
@@ -107,7 +108,8 @@ TrialOutcome MemeticSearch::Run(const SearchTour* start, const StopToken& stop,
   // the time left (at least two tours in all).
   auto fill = [&] {
     const absl::Time now = absl::Now();
-    const absl::Time until = end == absl::InfiniteFuture() ? end : now + (end - now) * kInitialShare;
+    const absl::Time until =
+        end == absl::InfiniteFuture() ? end : now + (end - now) * kInitialShare;
     while (static_cast<int>(pop.size()) < kPopulation && time_left() &&
            (pop.size() < 2 || absl::Now() < until)) {
       AddRandomTour(pop, stop);

@@ -37,7 +37,8 @@ Problem Problem::Build(const GtspInstance& instance) {
     const int lo = p.set_begin[s], size = p.set_size(s);
     for (int a = 0; a < p.n; ++a) {
       double* to = &p.to_set_block[static_cast<size_t>(p.n) * lo + static_cast<size_t>(a) * size];
-      double* from = &p.from_set_block[static_cast<size_t>(p.n) * lo + static_cast<size_t>(a) * size];
+      double* from =
+          &p.from_set_block[static_cast<size_t>(p.n) * lo + static_cast<size_t>(a) * size];
       for (int k = 0; k < size; ++k) {
         to[k] = p.c(a, lo + k);
         from[k] = p.c(lo + k, a);
@@ -69,9 +70,8 @@ Problem Problem::Build(const GtspInstance& instance) {
     }
     const int keep = std::min<int>(kNearSets, static_cast<int>(order.size()));
     const double* drow = &set_dist[static_cast<size_t>(s) * p.m];
-    std::partial_sort(order.begin(), order.begin() + keep, order.end(), [&](int a, int b) {
-      return drow[a] != drow[b] ? drow[a] < drow[b] : a < b;
-    });
+    std::partial_sort(order.begin(), order.begin() + keep, order.end(),
+                      [&](int a, int b) { return drow[a] != drow[b] ? drow[a] < drow[b] : a < b; });
     p.near_sets[s].assign(order.begin(), order.begin() + keep);
   }
   return p;

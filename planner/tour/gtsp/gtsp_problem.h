@@ -21,17 +21,17 @@
 namespace covplan::gtsp_internal {
 
 struct Problem {
-  int n = 0;  // vertices
-  int m = 0;  // sets
-  std::vector<double> cost;     // n*n, internal ids, cost[i*n+j] = arc i->j
+  int n = 0;                 // vertices
+  int m = 0;                 // sets
+  std::vector<double> cost;  // n*n, internal ids, cost[i*n+j] = arc i->j
   // Set blocks, both at offset n*set_begin[s]: to_set[.. + a*|s| + k] is the
   // arc a -> (k-th vertex of s), from_set[.. + b*|s| + k] the arc k-th -> b.
   std::vector<double> to_set_block;
   std::vector<double> from_set_block;
-  std::vector<int> set_begin;   // m+1; set s = internal ids [set_begin[s], set_begin[s+1])
-  std::vector<int> set_of;      // internal id -> set
-  std::vector<int> to_external; // internal id -> instance vertex id
-  std::vector<int> to_internal; // instance vertex id -> internal id
+  std::vector<int> set_begin;    // m+1; set s = internal ids [set_begin[s], set_begin[s+1])
+  std::vector<int> set_of;       // internal id -> set
+  std::vector<int> to_external;  // internal id -> instance vertex id
+  std::vector<int> to_internal;  // instance vertex id -> internal id
   // Per set, the other sets ordered by min_{a in S, b in T} min(c(a,b), c(b,a)),
   // truncated to kNearSets entries.
   static constexpr int kNearSets = 24;
@@ -43,18 +43,22 @@ struct Problem {
   const double* row(int i) const { return &cost[static_cast<size_t>(i) * n]; }
   // The |s| arc costs a -> v for v in set s, in id order.
   const double* to_set(int s, int a) const {
-    return &to_set_block[static_cast<size_t>(n) * set_begin[s] + static_cast<size_t>(a) * set_size(s)];
+    return &to_set_block[static_cast<size_t>(n) * set_begin[s] +
+                         static_cast<size_t>(a) * set_size(s)];
   }
   // The |s| arc costs v -> b for v in set s, in id order.
   const double* from_set(int s, int b) const {
-    return &from_set_block[static_cast<size_t>(n) * set_begin[s] + static_cast<size_t>(b) * set_size(s)];
+    return &from_set_block[static_cast<size_t>(n) * set_begin[s] +
+                           static_cast<size_t>(b) * set_size(s)];
   }
   int set_size(int s) const { return set_begin[s + 1] - set_begin[s]; }
 };
 
 // True if `cost` beats `than` by more than rounding (relative 1e-9): how
 // trials and populations decide that a tour is a new best.
-inline bool Cheaper(double cost, double than) { return cost < than - 1e-9 * std::max(1.0, std::abs(than)); }
+inline bool Cheaper(double cost, double than) {
+  return cost < than - 1e-9 * std::max(1.0, std::abs(than));
+}
 
 // A (possibly partial) cyclic tour: at most one vertex per set, with O(1)
 // position lookup by set.

@@ -8,7 +8,7 @@ namespace covplan::gtsp_internal {
 namespace {
 
 constexpr double kNoiseLevels[3] = {0.0, 0.1, 0.35};  // x mean tour arc
-constexpr double kRemovalPower = 3.0;  // rank bias of worst / distance removal
+constexpr double kRemovalPower = 3.0;                 // rank bias of worst / distance removal
 constexpr int kDistanceCandidates = 6;
 constexpr int kWeightPeriod = 100;
 constexpr double kWeightReaction = 0.25;
@@ -114,8 +114,7 @@ void LnsTrial::Evaluate(const SearchTour& t, int set, double noise, Insertion& o
 }
 
 void LnsTrial::InsertSets(SearchTour& t, int mode, double noise) {
-  const double noise_amp =
-      noise > 0.0 && t.size() > 0 ? noise * t.cost / t.size() : 0.0;
+  const double noise_amp = noise > 0.0 && t.size() > 0 ? noise * t.cost / t.size() : 0.0;
   if (mode == kRandomOrder) {
     for (int i = static_cast<int>(removed_.size()) - 1; i > 0; --i) {
       std::swap(removed_[i], removed_[rng_.UniformInt(i + 1)]);
@@ -193,7 +192,8 @@ void LnsTrial::Remove(SearchTour& t, int heuristic, int k) {
       for (int i = 0; i < len; ++i) gain_[i] = gain(i);
       for (int step = 0; step < k; ++step) {
         const int cnt = static_cast<int>(idx_.size());
-        const int j = std::min(cnt - 1, static_cast<int>(std::pow(rng_.Uniform(), kRemovalPower) * cnt));
+        const int j =
+            std::min(cnt - 1, static_cast<int>(std::pow(rng_.Uniform(), kRemovalPower) * cnt));
         std::nth_element(idx_.begin(), idx_.begin() + j, idx_.end(),
                          [&](int x, int y) { return gain_[x] > gain_[y]; });
         const int i = idx_[j];
@@ -226,7 +226,8 @@ void LnsTrial::Remove(SearchTour& t, int heuristic, int k) {
           }
         }
         if (cnt > 0) {
-          take(cand[std::min(cnt - 1, static_cast<int>(std::pow(rng_.Uniform(), kRemovalPower) * cnt))]);
+          take(cand[std::min(cnt - 1,
+                             static_cast<int>(std::pow(rng_.Uniform(), kRemovalPower) * cnt))]);
         } else {
           int s = p_.set_of[t.seq[rng_.UniformInt(len)]];
           while (drop_[s]) s = p_.set_of[t.seq[rng_.UniformInt(len)]];
@@ -264,13 +265,16 @@ TrialOutcome LnsTrial::Run(const SearchTour* start, const StopToken& stop,
 
   const absl::Time t0 = absl::Now();
   const bool timed = params_.time_budget_end != absl::InfiniteFuture();
-  const double budget_s = timed ? std::max(1e-3, absl::ToDoubleSeconds(params_.time_budget_end - t0)) : 1.0;
+  const double budget_s =
+      timed ? std::max(1e-3, absl::ToDoubleSeconds(params_.time_budget_end - t0)) : 1.0;
   // Small instances still need room to move: at least 5 removals (or m-1).
-  const int kmax = std::max(1, std::min({p_.m - 1, params_.max_removals_cap,
-                                         std::max(5, static_cast<int>(std::lround(
-                                                         params_.max_removal_fraction * p_.m)))}));
+  const int kmax = std::max(
+      1,
+      std::min({p_.m - 1, params_.max_removals_cap,
+                std::max(5, static_cast<int>(std::lround(params_.max_removal_fraction * p_.m)))}));
   // A warm start is already good: begin cooler so as not to throw it away.
-  const double accept_start = params_.accept_start * (start != nullptr ? params_.warm_start_factor : 1.0);
+  const double accept_start =
+      params_.accept_start * (start != nullptr ? params_.warm_start_factor : 1.0);
   const double log_ratio = std::log(params_.accept_end / accept_start);
   int64_t half_way = 0;
   SearchTour cand;
@@ -319,7 +323,8 @@ TrialOutcome LnsTrial::Run(const SearchTour* start, const StopToken& stop,
         last_improvement = it;
         if (on_best) on_best(out.best);
       }
-    } else if (rng_.Uniform() < std::exp(-(cand.cost - current.cost) / std::max(temperature, 1e-300))) {
+    } else if (rng_.Uniform() <
+               std::exp(-(cand.cost - current.cost) / std::max(temperature, 1e-300))) {
       score = kScoreAccepted;
       std::swap(current, cand);
     }

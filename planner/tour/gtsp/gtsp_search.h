@@ -30,7 +30,7 @@
 namespace covplan::gtsp_internal {
 
 struct SearchParams {
-  int64_t max_iterations = 10000;    // per trial
+  int64_t max_iterations = 10000;  // per trial
   // End the trial after this many iterations without a new trial best (only
   // counted in the second half of the annealing schedule).
   int64_t stall_iterations = 5000;

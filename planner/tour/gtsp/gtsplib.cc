@@ -84,14 +84,22 @@ absl::Status ReadSections(absl::string_view text, Header& h) {
     if (!keyword) {
       std::vector<Token>* dst = nullptr;
       switch (section) {
-        case Section::kCoords: dst = &h.coords; break;
-        case Section::kWeights: dst = &h.weights; break;
-        case Section::kSets: dst = &h.sets; break;
-        case Section::kSkip: continue;
+        case Section::kCoords:
+          dst = &h.coords;
+          break;
+        case Section::kWeights:
+          dst = &h.weights;
+          break;
+        case Section::kSets:
+          dst = &h.sets;
+          break;
+        case Section::kSkip:
+          continue;
         case Section::kNone:
           return Error(line_no, absl::StrCat("data outside of any section: '", line, "'"));
       }
-      for (absl::string_view tok : absl::StrSplit(line, absl::ByAnyChar(" \t\r\v\f"), absl::SkipEmpty())) {
+      for (absl::string_view tok :
+           absl::StrSplit(line, absl::ByAnyChar(" \t\r\v\f"), absl::SkipEmpty())) {
         dst->push_back({tok, line_no});
       }
       continue;
@@ -153,7 +161,8 @@ absl::Status FillFromCoordinates(const Header& h, GtspInstance& inst) {
     long id = 0;
     if (absl::Status st = ParseLong(h.coords[3 * i], id); !st.ok()) return st;
     if (id < 1 || id > n || seen[id - 1]) {
-      return Error(h.coords[3 * i].line, absl::StrCat("node id ", id, " is out of range [1, ", n, "] or repeated"));
+      return Error(h.coords[3 * i].line,
+                   absl::StrCat("node id ", id, " is out of range [1, ", n, "] or repeated"));
     }
     seen[id - 1] = 1;
     if (absl::Status st = ParseDouble(h.coords[3 * i + 1], x[id - 1]); !st.ok()) return st;
@@ -201,14 +210,16 @@ absl::Status FillFromWeights(const Header& h, GtspInstance& inst) {
   } else if (f == "UPPER_DIAG_ROW" || f == "LOWER_DIAG_ROW") {
     expected = n * (n + 1) / 2;
   } else {
-    return Error(h.weights_line, absl::StrCat("unsupported EDGE_WEIGHT_FORMAT '", f,
-                                              "' (FULL_MATRIX, UPPER_ROW, LOWER_ROW, UPPER_DIAG_ROW, "
-                                              "LOWER_DIAG_ROW are supported)"));
+    return Error(h.weights_line,
+                 absl::StrCat("unsupported EDGE_WEIGHT_FORMAT '", f,
+                              "' (FULL_MATRIX, UPPER_ROW, LOWER_ROW, UPPER_DIAG_ROW, "
+                              "LOWER_DIAG_ROW are supported)"));
   }
   if (h.weights.size() != static_cast<size_t>(expected)) {
     const int line = h.weights.empty() ? h.weights_line : h.weights.back().line;
-    return Error(line, absl::StrCat("EDGE_WEIGHT_SECTION has ", h.weights.size(), " numbers, expected ",
-                                    expected, " for ", f, " with DIMENSION ", n));
+    return Error(line,
+                 absl::StrCat("EDGE_WEIGHT_SECTION has ", h.weights.size(), " numbers, expected ",
+                              expected, " for ", f, " with DIMENSION ", n));
   }
   inst.costs.assign(static_cast<size_t>(n) * n, 0.0);
   size_t k = 0;
@@ -249,24 +260,27 @@ absl::Status FillSets(const Header& h, GtspInstance& inst) {
     long id = 0;
     if (absl::Status st = ParseLong(h.sets[k], id); !st.ok()) return st;
     if (id < 1 || id > m || seen[id - 1]) {
-      return Error(h.sets[k].line, absl::StrCat("set id ", id, " is out of range [1, ", m, "] or repeated"));
+      return Error(h.sets[k].line,
+                   absl::StrCat("set id ", id, " is out of range [1, ", m, "] or repeated"));
     }
     seen[id - 1] = 1;
     const int set_line = h.sets[k].line;
     ++k;
     for (;;) {
-      if (k >= h.sets.size()) return Error(set_line, absl::StrCat("set ", id, " is not terminated by -1"));
+      if (k >= h.sets.size())
+        return Error(set_line, absl::StrCat("set ", id, " is not terminated by -1"));
       long v = 0;
       if (absl::Status st = ParseLong(h.sets[k], v); !st.ok()) return st;
       ++k;
       if (v == -1) break;
       if (v < 1 || v > inst.num_vertices) {
-        return Error(h.sets[k - 1].line,
-                     absl::StrCat("set ", id, " lists vertex ", v, ", outside [1, ", inst.num_vertices, "]"));
+        return Error(h.sets[k - 1].line, absl::StrCat("set ", id, " lists vertex ", v,
+                                                      ", outside [1, ", inst.num_vertices, "]"));
       }
       if (owner[v - 1] != 0) {
-        return Error(h.sets[k - 1].line, absl::StrCat("vertex ", v, " is in set ", owner[v - 1],
-                                                      " and in set ", id, "; sets must be disjoint"));
+        return Error(h.sets[k - 1].line,
+                     absl::StrCat("vertex ", v, " is in set ", owner[v - 1], " and in set ", id,
+                                  "; sets must be disjoint"));
       }
       owner[v - 1] = id;
       inst.sets[id - 1].push_back(static_cast<int>(v - 1));
@@ -274,12 +288,15 @@ absl::Status FillSets(const Header& h, GtspInstance& inst) {
     if (inst.sets[id - 1].empty()) return Error(set_line, absl::StrCat("set ", id, " is empty"));
   }
   if (k != h.sets.size()) {
-    return Error(h.sets[k].line, absl::StrCat("unexpected data after the ", m, " sets of GTSP_SET_SECTION"));
+    return Error(h.sets[k].line,
+                 absl::StrCat("unexpected data after the ", m, " sets of GTSP_SET_SECTION"));
   }
   for (long v = 0; v < inst.num_vertices; ++v) {
     if (owner[v] == 0) {
-      return Error(h.sets_line, absl::StrCat("vertex ", v + 1, " belongs to no set; the sets must "
-                                             "partition the vertices 1..", inst.num_vertices));
+      return Error(h.sets_line, absl::StrCat("vertex ", v + 1,
+                                             " belongs to no set; the sets must "
+                                             "partition the vertices 1..",
+                                             inst.num_vertices));
     }
   }
   return absl::OkStatus();
@@ -290,11 +307,13 @@ absl::Status FillSets(const Header& h, GtspInstance& inst) {
 absl::StatusOr<GtspLibFile> ParseGtspLib(std::string_view text) {
   // Debian's abseil has its own string_view type.
   Header h;
-  if (absl::Status st = ReadSections(absl::string_view(text.data(), text.size()), h); !st.ok()) return st;
+  if (absl::Status st = ReadSections(absl::string_view(text.data(), text.size()), h); !st.ok())
+    return st;
   if (h.dimension < 0) return Error(h.last_line, "missing DIMENSION");
   if (h.num_sets < 0) return Error(h.last_line, "missing GTSP_SETS");
   if (h.num_sets > h.dimension) {
-    return Error(h.last_line, absl::StrCat("GTSP_SETS (", h.num_sets, ") exceeds DIMENSION (", h.dimension, ")"));
+    return Error(h.last_line, absl::StrCat("GTSP_SETS (", h.num_sets, ") exceeds DIMENSION (",
+                                           h.dimension, ")"));
   }
   GtspLibFile file;
   file.name = h.name;
