@@ -15,8 +15,8 @@
 //   PlanToProto(plan, &response);
 //
 // Thread-safety: stateless free functions, safe to call concurrently.
-#ifndef COVPLAN_SERVER_CONVERT_H_
-#define COVPLAN_SERVER_CONVERT_H_
+#ifndef COVPLAN_API_CONVERT_H_
+#define COVPLAN_API_CONVERT_H_
 
 #include <cstdint>
 #include <optional>
@@ -122,4 +122,4 @@ absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path, const MapFileO
 
 }  // namespace covplan
 
-#endif  // COVPLAN_SERVER_CONVERT_H_
+#endif  // COVPLAN_API_CONVERT_H_

@@ -3,8 +3,8 @@
 //   std::string hex = Sha256Hex("abc");  // 64 lowercase hex digits
 //
 // Thread-safety: stateless, safe to call concurrently.
-#ifndef COVPLAN_SERVER_DIGEST_H_
-#define COVPLAN_SERVER_DIGEST_H_
+#ifndef COVPLAN_API_DIGEST_H_
+#define COVPLAN_API_DIGEST_H_
 
 #include <string>
 #include "absl/strings/string_view.h"
@@ -15,4 +15,4 @@ std::string Sha256Hex(absl::string_view bytes);
 
 }  // namespace covplan
 
-#endif  // COVPLAN_SERVER_DIGEST_H_
+#endif  // COVPLAN_API_DIGEST_H_

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Held-out-sized buildings and small tools (docs/benchmarks.md section 14,
-# issue 12): the whole `covplan plan --local` process on every plain IPA
+# Held-out-sized buildings and small tools (docs/benchmarks.md section 14):
+# the whole `covplan plan --local` process on every plain IPA
 # building and the shipped maps at tool TOOL (0.8 m) with 2 threads, median
 # wall of RUNS runs, and
 # the estimated duration against a REF_S s `--tour-effort thorough` search

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Repeated identical Plan requests against one covplan-server (issue 12,
-# item 3): starts the server from BIN_DIR, plans the shipped office once
+# Repeated identical Plan requests against one covplan-server (remembered
+# plans): starts the server from BIN_DIR, plans the shipped office once
 # (cold) and once more (the first hit), then runs `covplan load` for 10 s at
 # concurrency 1, 4 and 16 with identical requests and prints one line each.
 #

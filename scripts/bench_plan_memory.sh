@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Remembered plans (docs/benchmarks.md §12): the same Release covplan-server,
-# first with --plan_memory=false ("before": every request searches, as
-# before issue 12.3), then with it on ("after"). For each: one warm-up Plan
+# first with --plan_memory=false ("before": every request searches, with
+# no plan memory), then with it on ("after"). For each: one warm-up Plan
 # (per-map artifacts cached; after: the first plan remembered), then
 # `covplan load` at concurrency 1, 4 and 16 with identical requests and with
 # --random-start, then 40 random starts at concurrency 1 with one fixed seed

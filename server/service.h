@@ -207,7 +207,7 @@ class CoveragePlannerService final
   // queue (`queued`), the mean solve times the admission prices queued
   // calls with (a hit answered on the gRPC thread would pull them down).
   void RecordPlanSolve(absl::Time start, const PlanStats& stats, bool queued = true);
-  // Repeated cache hits (issue 12): the reply already sent for the
+  // Repeated cache hits: the reply already sent for the
   // remembered `entry` to this tenant, if that plan is still retained; else
   // null. RememberServedHit records a reply for the next ones.
   std::shared_ptr<const ServedBody> ServedHitReply(

@@ -1,4 +1,4 @@
-// Remembered plans (issue 12, item 3): the engine keeps the best plan found
+// Remembered plans: the engine keeps the best plan found
 // per request, in the same ArtifactCache (and byte budget) as the per-map
 // artifacts, so the server and `covplan plan --local` share the behaviour.
 //

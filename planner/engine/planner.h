@@ -80,7 +80,7 @@ struct EngineLimits {
   int64_t dense_transition_bytes = int64_t{4} << 20;
   int64_t max_area_vertices = 100'000;  // per regions / no_go / polygon map
   // Remember plans in the artifact cache (planner/engine/plan_memory.h);
-  // false: every request searches from scratch, as before issue 12.3.
+  // false: every request searches from scratch.
   bool plan_memory = true;
 };
 

@@ -1,4 +1,4 @@
-// Exact minimum rank partition as a maximum bipartite matching (issue 12).
+// Exact minimum rank partition as a maximum bipartite matching.
 //
 // A rank of k cells has k - 1 internal adjacencies, so ranks = free cells -
 // the adjacencies whose two cells share the adjacency's orientation. Keeping a

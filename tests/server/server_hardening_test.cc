@@ -1,4 +1,4 @@
-// Integration tests of issue 13's defects against a real covplan-server
+// Integration tests of hardening defects against a real covplan-server
 // process, one per defect: checked flags (exit 2), a locked store, deletes
 // that change the index only after the file is gone, bounded string fields
 // and paged ListMaps, short error messages without server paths, geometry

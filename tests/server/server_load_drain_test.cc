@@ -1,4 +1,4 @@
-// Integration tests of issue 13's load defects against a real
+// Integration tests of load-handling defects against a real
 // covplan-server process: malformed protobuf logged and counted, time lost
 // in the queue answered as overload, PutMaps past their deadline dropped
 // unstarted while reads go on, a drain that keeps its grace and answers

@@ -1,5 +1,5 @@
-// Battery plans in the simulator (issue 11: "covplan simulate drives battery
-// plans"). With a perfect map the run drives exactly the plan's charge
+// Battery plans in the simulator (`covplan simulate` drives battery
+// plans). With a perfect map the run drives exactly the plan's charge
 // cycles: total = drive + recharge x cycles, the energy used is the plan's,
 // the battery never goes below the reserve. With clutter the run completes
 // around it on the greedy detour, never enters a blocked cell, and its
