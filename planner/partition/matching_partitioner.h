@@ -14,7 +14,7 @@
 // The conflict graph is implicit in the grid (an H-adjacency meets at most
 // four V-adjacencies), so nothing but a few per-cell arrays is allocated.
 // A greedy initial matching, then multi-source BFS phases (default) or
-// Hopcroft-Karp; see docs/benchmarks.md §1 for why the default.
+// Hopcroft-Karp; see docs/benchmarks-archive.md §1b for why the default.
 //
 //   MatchingPartitioner p;
 //   absl::StatusOr<RankPartition> part = p.Partition(grid, stop);
