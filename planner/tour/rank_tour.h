@@ -55,6 +55,7 @@ class RankTourCost final : public ElementTourModel {
   TourElementKind kind(int) const override { return TourElementKind::kRank; }
 
   // Waypoints of the whole tour (start, transitions, coverage, return).
+  // No sweeps: OARP derives them from its ranks.
   std::vector<Waypoint> BuildPath(const std::vector<int>& vertices) const;
 
  private:
