@@ -4,7 +4,7 @@
 // enter a cell at any of its four corners and leave at the matching
 // opposite one. Moves between cells are any-angle transitions on the drive
 // grid between the variants' end cells, priced by the injected MotionCost
-// (travel time), as PolylineTourModel does for two-variant elements.
+// (travel time), by the plumbing of planner/tour/element_tour.h.
 //
 //   std::vector<std::array<PolylineElement, 2>> cells = ...;  // plain, mirrored
 //   ASSIGN_OR_RETURN(CellTourModel model, CellTourModel::Create(drive, std::move(cells), start,
@@ -25,13 +25,13 @@
 
 #include "absl/status/statusor.h"
 #include "planner/grid/grid.h"
+#include "planner/tour/element_tour.h"
 #include "planner/tour/polyline_tour.h"
 #include "planner/tour/tour_model.h"
-#include "planner/tour/transitions.h"
 
 namespace covplan {
 
-class CellTourModel final : public TourModel {
+class CellTourModel final : public ElementTourModel {
  public:
   // InvalidArgument for malformed elements or a start/end off the drive
   // grid; FailedPrecondition when a cell cannot be reached from the start.
@@ -44,29 +44,15 @@ class CellTourModel final : public TourModel {
   int num_elements() const override { return static_cast<int>(cells_.size()); }
   int num_variants(int) const override { return 4; }
   TourElementKind kind(int) const override { return TourElementKind::kCell; }
-  bool has_end() const override { return has_end_; }
-  double FromStart(int v) const override { return from_start_[v]; }
-  double Between(int u, int v) const override;
-  double ToEnd(int u) const override { return to_end_[u]; }
-
-  void BuildPath(const std::vector<int>& vertices, std::vector<Waypoint>* path,
-                 std::vector<CoverageSweep>* sweeps) const;
-  double transitions_ms() const { return transitions_ms_; }
 
  private:
   CellTourModel() = default;
   const PolylineElement& Element(int v) const { return cells_[v / 4][(v / 2) % 2]; }
-  void TransitionPoints(int u, int v, std::vector<Point2>* pts) const;
+  void DriveVariant(int v, TourPathWriter* writer) const override;
+  absl::Status Unreachable(int element) const override;
 
-  const Grid* grid_ = nullptr;
+  // Table endpoint 2p = first cell, 2p + 1 = last cell of ox-plow p = 2e + m.
   std::vector<std::array<PolylineElement, 2>> cells_;
-  std::shared_ptr<const TransitionTable> table_;  // endpoint v = entry of vertex v, v ^ 1 its exit
-  std::shared_ptr<const MotionCost> motion_;
-  Pose2 start_, end_;
-  bool has_end_ = false;
-  std::vector<double> heading_in_, heading_out_, traverse_, from_start_, to_end_;
-  std::vector<std::vector<Point2>> start_paths_, end_paths_;
-  double transitions_ms_ = 0.0;
 };
 
 }  // namespace covplan

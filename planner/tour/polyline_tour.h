@@ -4,7 +4,8 @@
 // driven forwards or backwards (two variants). Moves between elements are
 // any-angle transitions on the drive grid; everything is priced by the
 // injected MotionCost. This is the model TOUR-REPLAN solves (path sets and
-// rank sets of the thesis), and any planner can use it for its own units.
+// rank sets of the thesis), and any planner can use it for its own units;
+// the helpers below serve every model whose variants are polylines.
 //
 //   std::vector<PolylineElement> elements = ...;
 //   ASSIGN_OR_RETURN(PolylineTourModel model,
@@ -25,8 +26,8 @@
 #include "absl/status/statusor.h"
 #include "planner/grid/grid.h"
 #include "planner/plan/coverage_plan.h"
+#include "planner/tour/element_tour.h"
 #include "planner/tour/tour_model.h"
-#include "planner/tour/transitions.h"
 
 namespace covplan {
 
@@ -44,7 +45,22 @@ struct PolylineElement {
 // A rank as a two-point polyline element.
 PolylineElement RankElement(const Grid& grid, CellIndex first, CellIndex last, int tag);
 
-class PolylineTourModel final : public TourModel {
+// True when `el` has a segment and one kind, sweep and tag per segment.
+bool IsWellFormed(const PolylineElement& el);
+
+// The variant that drives `pts` (`rev` is the same points reversed): it is
+// entered along its first segment of at least kMinSegmentM (`fallback_in`
+// if there is none), left along the last one (`fallback_back` is rev's
+// fallback heading), and costs `motion` along `pts`.
+ElementVariant PolylineVariant(const std::vector<Point2>& pts, const std::vector<Point2>& rev,
+                               double fallback_in, double fallback_back, const MotionCost& motion);
+
+// Drives `el` from the end it is entered at, heading `heading_in` there
+// (coverage segments keep their tags and sweeps).
+void DrivePolyline(const PolylineElement& el, bool forward, double heading_in,
+                   TourPathWriter* writer);
+
+class PolylineTourModel final : public ElementTourModel {
  public:
   // InvalidArgument when an element is malformed or the start or end pose is
   // off the drive grid; FailedPrecondition when an element cannot be reached
@@ -58,57 +74,14 @@ class PolylineTourModel final : public TourModel {
   int num_elements() const override { return static_cast<int>(elements_.size()); }
   int num_variants(int) const override { return 2; }
   TourElementKind kind(int e) const override { return elements_[e].kind; }
-  bool has_end() const override { return has_end_; }
-  double FromStart(int v) const override { return from_start_[v]; }
-  double Between(int u, int v) const override;
-  double ToEnd(int u) const override { return to_end_[u]; }
-
-  // The waypoints (starting with the start pose) and one sweep per coverage
-  // segment, for a tour given as one vertex per element.
-  void BuildPath(const std::vector<int>& vertices, std::vector<Waypoint>* path,
-                 std::vector<CoverageSweep>* sweeps) const;
   const std::vector<PolylineElement>& elements() const { return elements_; }
-  double transitions_ms() const { return transitions_ms_; }
 
  private:
   PolylineTourModel() = default;
-  double HeadingIn(int v) const { return heading_in_[v]; }
-  double HeadingOut(int v) const { return heading_out_[v]; }
-  // Transition-table endpoints where variant v is entered and left.
-  static int EntryEndpoint(int v) { return v; }  // 2e (first cell) forwards, 2e + 1 backwards
-  static int ExitEndpoint(int v) { return v ^ 1; }
-  void TransitionPoints(int u, int v, std::vector<Point2>* pts) const;
+  void DriveVariant(int v, TourPathWriter* writer) const override;
+  absl::Status Unreachable(int element) const override;
 
-  const Grid* grid_ = nullptr;
-  std::vector<PolylineElement> elements_;
-  std::shared_ptr<const TransitionTable> table_;  // endpoint 2e = first cell, 2e + 1 = last cell
-  std::shared_ptr<const MotionCost> motion_;
-  Pose2 start_;
-  Pose2 end_;
-  bool has_end_ = false;
-  std::vector<double> heading_in_, heading_out_, traverse_;  // per vertex
-  std::vector<double> from_start_, to_end_;
-  std::vector<std::vector<Point2>> start_paths_, end_paths_;
-  double transitions_ms_ = 0.0;
-};
-
-// Writes a tour's waypoints: transitions given as point lists, and polyline
-// elements driven forwards or backwards (coverage segments keep their tags
-// and sweeps). Shared by the tour models whose elements are polylines.
-class PolylinePathWriter {
- public:
-  PolylinePathWriter(const Pose2& start, std::vector<Waypoint>* path,
-                     std::vector<CoverageSweep>* sweeps);
-  // Drives pts[1..] as transition segments (pts[0] is where the robot is).
-  void Transit(const std::vector<Point2>& pts);
-  // Drives `el` from the end it is entered at, heading `heading_in` there.
-  void Drive(const PolylineElement& el, bool forward, double heading_in);
-
- private:
-  Point2 at_;
-  double heading_;
-  std::vector<Waypoint>* path_;
-  std::vector<CoverageSweep>* sweeps_;
+  std::vector<PolylineElement> elements_;  // table endpoint 2e = first cell, 2e + 1 = last cell
 };
 
 }  // namespace covplan

@@ -26,6 +26,10 @@
 // one before its next kick. The threads share the cost cache; the returned
 // tour is audited (order, positions, links, cost).
 // A warm start replaces the construction by a remembered tour.
+// Three units: the cost oracle (sparse_cost_oracle.h: bounds, probes, exact
+// costs and their cache), the local search (sparse_local_search.h:
+// construction, 2-opt/Or-opt, kicks, the shared incumbent) and this driver
+// (poses, threads, the final paths).
 // Only the final tour's transitions become paths (in parallel); plan
 // durations come from those paths.
 //
