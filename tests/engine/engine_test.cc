@@ -170,5 +170,19 @@ TEST(Artifacts, AreBuiltOnceAndPrepareWarmsThem) {
   EXPECT_EQ(cache.size(), 6u);  // the 4 artifacts + the remembered tour and plan
 }
 
+// The site checks are the engine's, so every entry point (the server,
+// `covplan plan --local`, PlanCoverage) refuses such maps alike.
+TEST(Engine, RefusesMapsNoRobotCanPlanOn) {
+  PlanOptions o;
+  o.robot.tool_width_m = 0.8;
+  const absl::Status coarse = PlanCoverage(OccupancyMap(4, 4, 5000.0, {0.0, 0.0}), o).status();
+  EXPECT_EQ(coarse.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(coarse.message(), "map resolution 5000 m/px is outside [0.0001, 1000] m/px");
+  const absl::Status far = PlanCoverage(OccupancyMap(40, 40, 0.1, {2e7, 0.0}), o).status();
+  EXPECT_EQ(far.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(far.message(),
+            "map origin/extent (2e+07, 0) m is beyond 1e+07 m from the map frame's origin");
+}
+
 }  // namespace
 }  // namespace covplan
