@@ -14,6 +14,7 @@
 #include "api/convert_stc.h"
 #include "api/digest.h"
 #include "api/geojson.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/common/status_macros.h"
 #include "planner/grid/grid.h"
@@ -108,14 +109,6 @@ absl::StatusOr<std::string> ReadFile(const std::string& path, int64_t max_bytes)
 
 }  // namespace
 
-absl::Status InputLimits::Validate() const {
-  if (max_image_bytes <= 0 || max_map_pixels <= 0 || max_grid_cells <= 0 || max_ranks <= 0 ||
-      max_transition_bytes <= 0 || dense_transition_bytes < 0) {
-    return absl::InvalidArgumentError("input limits must be positive");
-  }
-  return absl::OkStatus();
-}
-
 std::string ComputeMapId(const v1::Map& map) {
   if (map.source_case() == v1::Map::kPolygons) {
     std::string canonical = "covplan.map.v1.polygons\n";
@@ -162,7 +155,7 @@ absl::Status ValidateMapId(absl::string_view map_id) {
       "map_id '", map_id.substr(0, 80), "' is malformed: expected 64 lowercase hex digits"));
 }
 
-absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits& limits) {
+absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const EngineLimits& limits) {
   if (map.source_case() != v1::Map::kRaster) {
     return absl::InvalidArgumentError(map.source_case() == v1::Map::kPolygons
                                           ? "map.polygons is a vector map, not a raster"
@@ -237,10 +230,109 @@ absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits&
   return decoded;
 }
 
-absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request) {
+namespace {
+
+// OARP's options: the nested message, or the top-level fields of older
+// clients; `local` adds what the proto does not carry.
+absl::StatusOr<std::shared_ptr<const OarpOptions>> OarpOptionsFromProto(
+    const v1::PlanRequest& request, const LocalPlanOptions& local) {
+  const bool nested = request.has_oarp();
+  const char* prefix = nested ? "oarp." : "";
+  const v1::PartitionSolver partition =
+      nested ? request.oarp().partition_solver() : request.partition_solver();
+  const v1::TourSolver tour = nested ? request.oarp().tour_solver() : request.tour_solver();
+  auto oarp = std::make_shared<OarpOptions>();
+  switch (partition) {
+    case v1::PARTITION_SOLVER_UNSPECIFIED:
+      break;  // the planner's default (push-relabel)
+    case v1::MINCUT:
+      oarp->partition_solver = PartitionSolver::kMinCut;
+      break;
+    case v1::LP:
+      oarp->partition_solver = PartitionSolver::kLp;
+      break;
+    case v1::MATCHING:
+      oarp->partition_solver = PartitionSolver::kMatching;
+      break;
+    case v1::PUSH_RELABEL:
+      oarp->partition_solver = PartitionSolver::kPushRelabel;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat(prefix, "partition_solver: unknown value ", static_cast<int>(partition)));
+  }
+  switch (tour) {
+    case v1::TOUR_SOLVER_UNSPECIFIED:
+    case v1::GTSP:
+      oarp->tour_solver = TourSolver::kGtsp;
+      break;
+    case v1::GREEDY:
+      oarp->tour_solver = TourSolver::kGreedy;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat(prefix, "tour_solver: unknown value ", static_cast<int>(tour)));
+  }
+  if (local.oarp_tour_effort) oarp->tour_effort = *local.oarp_tour_effort;
+  return oarp;
+}
+
+absl::StatusOr<std::shared_ptr<const BoustrophedonOptions>> BoustrophedonOptionsFromProto(
+    const v1::PlanRequest& request) {
+  const v1::BoustrophedonOptions& b = request.boustrophedon();
+  auto options_b = std::make_shared<BoustrophedonOptions>();
+  switch (b.sweep_axis()) {
+    case v1::SWEEP_AXIS_UNSPECIFIED:
+    case v1::SWEEP_AXIS_AUTO:
+      options_b->sweep_axis = BoustrophedonAxis::kAuto;
+      break;
+    case v1::SWEEP_AXIS_VERTICAL:
+      options_b->sweep_axis = BoustrophedonAxis::kVertical;
+      break;
+    case v1::SWEEP_AXIS_HORIZONTAL:
+      options_b->sweep_axis = BoustrophedonAxis::kHorizontal;
+      break;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("boustrophedon.sweep_axis: unknown value ",
+                                                     static_cast<int>(b.sweep_axis())));
+  }
+  switch (b.tour_solver()) {
+    case v1::TOUR_SOLVER_UNSPECIFIED:
+    case v1::GTSP:
+      options_b->tour_solver = TourSolver::kGtsp;
+      break;
+    case v1::GREEDY:
+      options_b->tour_solver = TourSolver::kGreedy;
+      break;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("boustrophedon.tour_solver: unknown value ",
+                                                     static_cast<int>(b.tour_solver())));
+  }
+  return options_b;
+}
+
+absl::StatusOr<BatteryOptions> BatteryFromProto(const v1::PlanRequest& request) {
+  const v1::Battery& b = request.battery();
+  if (!b.has_station()) return absl::InvalidArgumentError("battery.station is required");
+  BatteryOptions battery;
+  battery.capacity = b.capacity();
+  battery.reserve = b.reserve();
+  battery.station = Pose2{b.station().x(), b.station().y(), b.station().theta()};
+  if (b.energy().has_per_metre()) battery.energy.per_metre = b.energy().per_metre();
+  battery.energy.per_turn = b.energy().per_turn();
+  battery.energy.per_second = b.energy().per_second();
+  battery.interruptible_units = b.interruptible_units();
+  battery.atomic_units.assign(b.atomic_units().begin(), b.atomic_units().end());
+  RETURN_IF_ERROR(battery.Validate());
+  return battery;
+}
+
+}  // namespace
+
+absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request,
+                                                 const LocalPlanOptions& local) {
   PlanRequest out;
-  out.planner =
-      request.planner().empty() ? std::string(PlannerRegistry::kDefault) : request.planner();
+  out.planner = request.planner().empty() ? std::string(kDefaultPlanner) : request.planner();
   if (out.planner.size() > 64) {
     return absl::InvalidArgumentError("planner: name longer than 64 characters");
   }
@@ -262,44 +354,7 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
         request.planner_options_case() != v1::PlanRequest::PLANNER_OPTIONS_NOT_SET) {
       return absl::InvalidArgumentError("planner_options: planner 'oarp' takes the oarp options");
     }
-    const bool nested = request.has_oarp();
-    const char* prefix = nested ? "oarp." : "";
-    const v1::PartitionSolver partition =
-        nested ? request.oarp().partition_solver() : request.partition_solver();
-    const v1::TourSolver tour = nested ? request.oarp().tour_solver() : request.tour_solver();
-    auto oarp = std::make_shared<OarpOptions>();
-    switch (partition) {
-      case v1::PARTITION_SOLVER_UNSPECIFIED:
-        break;  // the planner's default (push-relabel)
-      case v1::MINCUT:
-        oarp->partition_solver = PartitionSolver::kMinCut;
-        break;
-      case v1::LP:
-        oarp->partition_solver = PartitionSolver::kLp;
-        break;
-      case v1::MATCHING:
-        oarp->partition_solver = PartitionSolver::kMatching;
-        break;
-      case v1::PUSH_RELABEL:
-        oarp->partition_solver = PartitionSolver::kPushRelabel;
-        break;
-      default:
-        return absl::InvalidArgumentError(
-            absl::StrCat(prefix, "partition_solver: unknown value ", static_cast<int>(partition)));
-    }
-    switch (tour) {
-      case v1::TOUR_SOLVER_UNSPECIFIED:
-      case v1::GTSP:
-        oarp->tour_solver = TourSolver::kGtsp;
-        break;
-      case v1::GREEDY:
-        oarp->tour_solver = TourSolver::kGreedy;
-        break;
-      default:
-        return absl::InvalidArgumentError(
-            absl::StrCat(prefix, "tour_solver: unknown value ", static_cast<int>(tour)));
-    }
-    out.options = std::move(oarp);
+    ASSIGN_OR_RETURN(out.options, OarpOptionsFromProto(request, local));
   } else if (request.planner_options_case() == v1::PlanRequest::kBoustrophedon ||
              out.planner == "boustrophedon") {
     if (request.planner_options_case() != v1::PlanRequest::kBoustrophedon &&
@@ -307,51 +362,10 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
       return absl::InvalidArgumentError(
           "planner_options: planner 'boustrophedon' takes the boustrophedon options");
     }
-    const v1::BoustrophedonOptions& b = request.boustrophedon();
-    auto options_b = std::make_shared<BoustrophedonOptions>();
-    switch (b.sweep_axis()) {
-      case v1::SWEEP_AXIS_UNSPECIFIED:
-      case v1::SWEEP_AXIS_AUTO:
-        options_b->sweep_axis = BoustrophedonAxis::kAuto;
-        break;
-      case v1::SWEEP_AXIS_VERTICAL:
-        options_b->sweep_axis = BoustrophedonAxis::kVertical;
-        break;
-      case v1::SWEEP_AXIS_HORIZONTAL:
-        options_b->sweep_axis = BoustrophedonAxis::kHorizontal;
-        break;
-      default:
-        return absl::InvalidArgumentError(absl::StrCat("boustrophedon.sweep_axis: unknown value ",
-                                                       static_cast<int>(b.sweep_axis())));
-    }
-    switch (b.tour_solver()) {
-      case v1::TOUR_SOLVER_UNSPECIFIED:
-      case v1::GTSP:
-        options_b->tour_solver = TourSolver::kGtsp;
-        break;
-      case v1::GREEDY:
-        options_b->tour_solver = TourSolver::kGreedy;
-        break;
-      default:
-        return absl::InvalidArgumentError(absl::StrCat("boustrophedon.tour_solver: unknown value ",
-                                                       static_cast<int>(b.tour_solver())));
-    }
-    out.options = std::move(options_b);
+    ASSIGN_OR_RETURN(out.options, BoustrophedonOptionsFromProto(request));
   }
   if (request.has_battery()) {
-    const v1::Battery& b = request.battery();
-    if (!b.has_station()) return absl::InvalidArgumentError("battery.station is required");
-    BatteryOptions battery;
-    battery.capacity = b.capacity();
-    battery.reserve = b.reserve();
-    battery.station = Pose2{b.station().x(), b.station().y(), b.station().theta()};
-    if (b.energy().has_per_metre()) battery.energy.per_metre = b.energy().per_metre();
-    battery.energy.per_turn = b.energy().per_turn();
-    battery.energy.per_second = b.energy().per_second();
-    battery.interruptible_units = b.interruptible_units();
-    battery.atomic_units.assign(b.atomic_units().begin(), b.atomic_units().end());
-    RETURN_IF_ERROR(battery.Validate());
-    out.battery = battery;
+    ASSIGN_OR_RETURN(out.battery, BatteryFromProto(request));
   }
   if (request.planner_options_case() == v1::PlanRequest::kStc) {
     if (out.planner != "stc") {
@@ -371,17 +385,7 @@ absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request)
   return out;
 }
 
-EngineLimits EngineLimitsFor(const InputLimits& limits) {
-  EngineLimits e;
-  e.max_grid_cells = limits.max_grid_cells;
-  e.max_ranks = limits.max_ranks;
-  e.max_transition_bytes = limits.max_transition_bytes;
-  e.dense_transition_bytes = limits.dense_transition_bytes;
-  e.max_area_vertices = limits.max_area_vertices;
-  return e;
-}
-
-absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const InputLimits& limits) {
+absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const EngineLimits& limits) {
   if (map.source_case() == v1::Map::kPolygons) {
     const v1::PolygonMap& pm = map.polygons();
     if (pm.polygons().empty()) {
@@ -425,7 +429,7 @@ v1::MapInfo MapInfoFor(const SiteMap& site, const std::string& map_id) {
 }
 
 absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path, const MapFileOverrides& overrides,
-                                         const InputLimits& limits) {
+                                         const EngineLimits& limits) {
   v1::Map map;
   std::filesystem::path file(path);
   const std::string ext = absl::AsciiStrToLower(file.extension().string());

@@ -7,7 +7,7 @@
 // regions with no free cell) happens in the engine, whose messages name the
 // same fields. Bad input is InvalidArgument either way.
 //
-//   InputLimits limits;
+//   EngineLimits limits;  // planner/engine/limits.h
 //   ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), limits));
 //   ASSIGN_OR_RETURN(PlanRequest req, PlanRequestFromProto(request));
 //   ... engine.Plan(source, req) ...
@@ -33,22 +33,9 @@
 #include "planner/grid/occupancy_map.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"
+#include "planner/tour/gtsp/gtsp.h"
 
 namespace covplan {
-
-// Size limits on untrusted input.
-struct InputLimits {
-  int64_t max_image_bytes = 64ll << 20;             // encoded image size
-  int64_t max_map_pixels = 64'000'000;              // decoded width * height
-  int64_t max_grid_cells = 4'000'000;               // tool-width cells
-  int64_t max_ranks = 100'000;                      // coverage ranks (hard cap)
-  int64_t max_transition_bytes = int64_t{1} << 30;  // transition memory per plan
-  int64_t dense_transition_bytes = int64_t{4}
-                                   << 20;  // all-pairs table up to this (~100 ranks), sparse above
-  int64_t max_area_vertices = 100'000;     // per polygon map, regions or no_go
-
-  absl::Status Validate() const;
-};
 
 // Content-derived id: lowercase hex SHA-256 of a canonical encoding of the
 // image bytes, YAML text and explicitly set overrides, or of the polygon
@@ -61,17 +48,23 @@ absl::Status ValidateMapId(absl::string_view map_id);
 
 // Decodes and validates a map (image format, YAML, resolution, thresholds,
 // size limits, at least one free pixel).
-absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const InputLimits& limits);
+absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const EngineLimits& limits);
 
 // A raster or polygon map as the engine's SiteMap (polygons validated with
 // their field path, e.g. "map.polygons[2].outer").
-absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const InputLimits& limits);
+absl::StatusOr<SiteMap> SiteFromProto(const v1::Map& map, const EngineLimits& limits);
+
+// What `covplan plan --local` sets beyond the proto (the wire format
+// carries none of it), converted here like every other planner option.
+struct LocalPlanOptions {
+  std::optional<GtspEffort> oarp_tour_effort;  // OARP's tour search effort
+};
 
 // The engine request for a PlanRequest: planner, common options, the
-// planner's own options (oneof), regions and no-go zones.
-absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request);
-
-EngineLimits EngineLimitsFor(const InputLimits& limits);
+// planner's own options (oneof), regions and no-go zones. A request without
+// a time limit gets CommonOptions::kDefaultTimeLimitS.
+absl::StatusOr<PlanRequest> PlanRequestFromProto(const v1::PlanRequest& request,
+                                                 const LocalPlanOptions& local = {});
 
 void PolygonsToProto(const std::vector<PolygonInput>& polygons,
                      google::protobuf::RepeatedPtrField<v1::Polygon>* out);
@@ -118,7 +111,7 @@ struct MapFileOverrides {
   std::optional<double> free_thresh;
 };
 absl::StatusOr<v1::Map> MapProtoFromFile(const std::string& path, const MapFileOverrides& overrides,
-                                         const InputLimits& limits);
+                                         const EngineLimits& limits);
 
 }  // namespace covplan
 

@@ -8,13 +8,15 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <fstream>
 #include "absl/strings/str_format.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/map_io.h"
+#include "planner/oarp/oarp_planner.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/mincut_partitioner.h"
 #include "planner/plan/svg.h"
@@ -39,6 +41,14 @@ struct Args {
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// OARP's options for one run (PlanOptions::options).
+std::shared_ptr<const OarpOptions> OarpWith(TourSolver tour, GtspEffort effort) {
+  auto options = std::make_shared<OarpOptions>();
+  options->tour_solver = tour;
+  options->tour_effort = effort;
+  return options;
 }
 
 std::string Base(const std::string& p) {
@@ -72,7 +82,7 @@ int Run(const Args& a) {
     // The per-map artifacts once (kept for the reference search below).
     LocalArtifactCache cache;
     PlanOptions warm = po;
-    warm.tour_solver = TourSolver::kGreedy;
+    warm.options = OarpWith(TourSolver::kGreedy, GtspEffort::kDefault);
     auto d = PlanCoverageWithArea(*map, warm, &cache, path);
     if (!d.ok()) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), std::string(d.status().message()).c_str());
@@ -114,7 +124,7 @@ int Run(const Args& a) {
     if (a.reference_s > 0) {
       PlanOptions ro = po;
       ro.time_limit_s = a.reference_s;
-      ro.tour_effort = GtspEffort::kThorough;
+      ro.options = OarpWith(TourSolver::kGtsp, GtspEffort::kThorough);
       auto ref = PlanCoverage(*map, ro, &cache, path);
       if (ref.ok()) reference = ref->stats.estimated_duration_s;
     }
@@ -123,9 +133,8 @@ int Run(const Args& a) {
       absl::StatusOr<CoveragePlan> last = absl::UnknownError("no run");
       for (int r = 0; r < a.runs; ++r) {
         PlanOptions o = po;
-        o.tour_solver = ts;
+        o.options = OarpWith(ts, a.effort);
         o.time_limit_s = a.time_limit;
-        o.tour_effort = a.effort;
         o.seed = 1 + r;
         // Full pipeline from the map, as a fresh request would run it.
         last = PlanCoverage(*map, o);

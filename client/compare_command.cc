@@ -14,7 +14,9 @@
 #include "absl/time/clock.h"
 #include "api/convert.h"
 #include "client/args.h"
+#include "client/local_engine.h"
 #include "client/map_flags.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/common/status_macros.h"
 
 namespace covplan {
@@ -32,8 +34,6 @@ constexpr char kUsage[] =
     "--markdown prints a markdown table (with a map column named NAME, default the\n"
     "file name; --no-header leaves out the header rows). --json writes the rows.\n";
 
-constexpr double kDefaultBudgetS = 2.0;  // as covplan plan --local
-
 std::string TerminationText(const Termination& t) {
   if (!t.limit_reached()) return "converged";
   return absl::StrCat("limit: ", TerminationLimitName(t.limit));
@@ -48,9 +48,9 @@ absl::Status Run(const std::vector<std::string>& args) {
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   const std::string map_path = *a.Get("map");
   ASSIGN_OR_RETURN(const MapFileOverrides overrides, MapFileOverridesFromFlags(a));
-  InputLimits limits;
+  EngineLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(map_path, overrides, limits));
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   std::vector<std::string> planners = registry.Names();
   if (auto list = a.Get("algorithms")) {
     std::vector<std::string> named = absl::StrSplit(*list, ',', absl::SkipWhitespace());
@@ -61,14 +61,11 @@ absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
   request.common.robot.tool_width_m = tool.value_or(0.8);
   ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
-  request.common.time_limit_s = limit.value_or(kDefaultBudgetS);
+  if (limit) request.common.time_limit_s = *limit;
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
   if (seed) request.common.seed = static_cast<uint64_t>(*seed);
-  MapSource source;
-  source.map_id = ComputeMapId(map);
-  source.load = [&]() { return SiteFromProto(map, limits); };
   ASSIGN_OR_RETURN(std::vector<ComparisonRow> rows,
-                   ComparePlanners(registry, source, planners, request, EngineLimitsFor(limits)));
+                   ComparePlanners(registry, MapSourceFor(map, limits), planners, request, limits));
   if (a.Has("markdown")) {
     std::string name = a.Get("name").value_or(map_path.substr(map_path.find_last_of('/') + 1));
     std::fputs(ComparisonMarkdown(rows, name, !a.Has("no-header")).c_str(), stdout);
@@ -129,13 +126,12 @@ absl::StatusOr<std::vector<ComparisonRow>> ComparePlanners(const PlannerRegistry
   }
   std::vector<ComparisonRow> rows;
   for (const std::string& name : planners) {
-    LocalArtifactCache cache;  // each planner pays for its own grid and artifacts
-    const PlanningEngine engine(&registry, &cache, limits);
+    const LocalEngine local(limits, registry);  // each planner pays for its own grid and artifacts
     PlanRequest r = request;
     r.planner = name;
     r.options = nullptr;
     const absl::Time t0 = absl::Now();
-    absl::StatusOr<EngineResult> result = engine.Plan(source, r);
+    absl::StatusOr<EngineResult> result = local.engine().Plan(source, r);
     const double ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
     if (!result.ok()) {
       return absl::Status(result.status().code(),

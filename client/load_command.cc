@@ -15,6 +15,7 @@
 #include "absl/time/clock.h"
 #include "api/convert.h"
 #include "client/args.h"
+#include "client/local_engine.h"
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
 #include "planner/engine/engine.h"
@@ -44,16 +45,12 @@ constexpr char kUsage[] =
 // The centres of the cells a robot of `tool` width can reach on `map`: the
 // engine's own drive grid, built locally.
 absl::StatusOr<std::vector<Point2>> ReachableCellCentres(const v1::Map& map, double tool) {
-  ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(map, InputLimits()));
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  LocalArtifactCache cache;
-  const PlanningEngine engine(&registry, &cache, EngineLimitsFor(InputLimits()));
-  MapSource source;
-  source.map_id = "load";
-  source.load = [&]() -> absl::StatusOr<SiteMap> { return site; };
+  const EngineLimits limits;
+  const LocalEngine local(limits);
   PlanRequest request;
   request.common.robot.tool_width_m = tool;
-  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area, engine.AreaFor(source, request));
+  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area,
+                   local.engine().AreaFor(MapSourceFor(map, limits), request));
   std::vector<Point2> centres;
   const Grid& drive = *area->drive;
   for (int r = 0; r < drive.rows(); ++r) {
@@ -158,7 +155,7 @@ absl::Status Run(const std::vector<std::string>& args) {
   std::vector<v1::PlanRequest> requests;
   std::vector<std::string> acknowledged;
   for (const std::string& file : files) {
-    ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, overrides, InputLimits()));
+    ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, overrides, EngineLimits()));
     if (random_start) {
       ASSIGN_OR_RETURN(std::vector<Point2> cells, ReachableCellCentres(map, tool.value_or(0.8)));
       start_cells.push_back(std::move(cells));

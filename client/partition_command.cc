@@ -12,9 +12,9 @@
 #include "absl/time/clock.h"
 #include "api/convert.h"
 #include "client/args.h"
+#include "client/local_engine.h"
 #include "client/map_flags.h"
 #include "planner/common/status_macros.h"
-#include "planner/engine/artifact_cache.h"
 #include "planner/engine/engine.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/matching_partitioner.h"
@@ -75,19 +75,15 @@ absl::StatusOr<std::string> PartitionCommandJson(const std::vector<std::string>&
         absl::StrFormat("--repeat must be in [1, 1000], got %d", *repeat));
   }
   ASSIGN_OR_RETURN(const MapFileOverrides overrides, MapFileOverridesFromFlags(a));
-  InputLimits limits;
+  EngineLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(map_path, overrides, limits));
   PlanRequest request;
   ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
   request.common.robot.tool_width_m = tool.value_or(0.8);
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  LocalArtifactCache cache;
-  const PlanningEngine engine(&registry, &cache, EngineLimitsFor(limits));
-  MapSource source;
-  source.map_id = ComputeMapId(map);
-  source.load = [&]() { return SiteFromProto(map, limits); };
+  const LocalEngine local(limits);
   const absl::Time g0 = absl::Now();
-  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area, engine.AreaFor(source, request));
+  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area,
+                   local.engine().AreaFor(MapSourceFor(map, limits), request));
   const double grid_ms = absl::ToDoubleMilliseconds(absl::Now() - g0);
   const Grid& grid = *area->cover;
   std::vector<double> runs;

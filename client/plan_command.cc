@@ -16,20 +16,16 @@
 #include "absl/strings/str_split.h"
 #include "api/geojson.h"
 #include "client/args.h"
+#include "client/local_engine.h"
 #include "client/map_flags.h"
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
-#include "planner/engine/artifact_cache.h"
 #include "planner/engine/engine.h"
 #include "planner/grid/grid.h"
-#include "planner/oarp/oarp_planner.h"
 #include "planner/plan/svg.h"
 
 namespace covplan {
 namespace {
-
-// --local without --time-limit: the same tour budget as the server default.
-constexpr double kLocalDefaultBudgetS = 2.0;
 
 const char* PlanSourceText(v1::PlanSource s) {
   switch (s) {
@@ -386,7 +382,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
 }
 
 absl::StatusOr<v1::PlanResponse> Execute(const PlanCommand& c, const v1::Map& map,
-                                         const InputLimits& limits) {
+                                         const EngineLimits& limits) {
   if (c.local) {
     v1::PlanRequest request = c.request;
     *request.mutable_map() = map;
@@ -416,7 +412,7 @@ absl::Status Run(const std::vector<std::string>& args) {
         absl::StrCat(parsed.status().message(), " (see covplan plan --help)"));
   }
   const PlanCommand& c = *parsed;
-  InputLimits limits;
+  EngineLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(c.map_path, c.overrides, limits));
   ASSIGN_OR_RETURN(v1::PlanResponse response, Execute(c, map, limits));
   std::fputs(FormatPlanSummary(response).c_str(), stdout);
@@ -439,27 +435,18 @@ absl::Status Run(const std::vector<std::string>& args) {
 }  // namespace
 
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits, int num_threads,
+                                             const EngineLimits& limits, int num_threads,
                                              std::optional<GtspEffort> tour_effort) {
   if (!request.has_map()) return absl::InvalidArgumentError("local planning needs an inline map");
-  ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
+  LocalPlanOptions local_options;
+  local_options.oarp_tour_effort = tour_effort;
+  ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request, local_options));
   plan_request.common.num_threads = std::max(1, num_threads);
-  if (tour_effort) {
-    const auto* oarp = dynamic_cast<const OarpOptions*>(plan_request.options.get());
-    if (plan_request.planner != "oarp")
-      return absl::InvalidArgumentError("--tour-effort needs --planner oarp");
-    auto options = std::make_shared<OarpOptions>(oarp != nullptr ? *oarp : OarpOptions());
-    options->tour_effort = *tour_effort;
-    plan_request.options = std::move(options);
-  }
-  if (request.time_limit_s() <= 0) plan_request.common.time_limit_s = kLocalDefaultBudgetS;
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  LocalArtifactCache cache;
-  const PlanningEngine engine(&registry, &cache, EngineLimitsFor(limits));
-  MapSource source;
-  source.map_id = ComputeMapId(request.map());
-  source.load = [&]() { return SiteFromProto(request.map(), limits); };
-  ASSIGN_OR_RETURN(EngineResult result, engine.Plan(source, plan_request));
+  if (tour_effort && plan_request.planner != "oarp")
+    return absl::InvalidArgumentError("--tour-effort needs --planner oarp");
+  const LocalEngine local(limits);
+  const MapSource source = MapSourceFor(request.map(), limits);
+  ASSIGN_OR_RETURN(EngineResult result, local.engine().Plan(source, plan_request));
   RetainedPlan retained;
   retained.plan_id = absl::StrFormat("local-%016x", std::random_device{}() * 0x9e3779b97f4a7c15ull);
   retained.map_id = source.map_id;

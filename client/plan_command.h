@@ -28,7 +28,7 @@ int RunPlanCommand(const std::vector<std::string>& args);
 // `num_threads`: worker threads of the planning core (server: 1 per call);
 // `tour_effort` (OARP only, not in the API): the tour search's effort.
 absl::StatusOr<v1::PlanResponse> PlanLocally(const v1::PlanRequest& request,
-                                             const InputLimits& limits, int num_threads = 1,
+                                             const EngineLimits& limits, int num_threads = 1,
                                              std::optional<GtspEffort> tour_effort = std::nullopt);
 
 // The human summary printed to stdout.

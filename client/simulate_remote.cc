@@ -159,7 +159,7 @@ absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(
   overrides.free_thresh = flags.free_thresh;
   overrides.occupied_thresh = flags.occupied_thresh;
   if (flags.negate) overrides.negate = true;
-  ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(known_map_path, overrides, InputLimits()));
+  ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(known_map_path, overrides, EngineLimits()));
   return std::unique_ptr<PlanSource>(
       new ServerPlanSource(RemotePlanner::Connect(server), std::move(map), options));
 }

@@ -1,10 +1,8 @@
 #include "server/request_limits.h"
 
-#include <cmath>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 #include "google/protobuf/descriptor.h"
 
 namespace covplan {
@@ -13,10 +11,6 @@ namespace {
 using ::google::protobuf::FieldDescriptor;
 using ::google::protobuf::Message;
 using ::google::protobuf::Reflection;
-
-constexpr double kMinResolution = 1e-4;  // metres per pixel
-constexpr double kMaxResolution = 1000.0;
-constexpr double kMaxCoordinate = 1e7;  // metres from the map frame's origin
 
 absl::Status TooLong(const std::string& path, size_t size, size_t limit) {
   return absl::InvalidArgumentError(
@@ -97,26 +91,6 @@ size_t StringLimitFor(const std::string& full_field_name) {
 
 absl::Status CheckRequestStrings(const google::protobuf::Message& request) {
   return CheckMessage(request, "");
-}
-
-absl::Status CheckSiteGeometry(const SiteMap& site) {
-  if (site.raster == nullptr) return absl::InvalidArgumentError("map has no raster");
-  const double resolution = site.raster->resolution();
-  if (!std::isfinite(resolution) || resolution < kMinResolution || resolution > kMaxResolution) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("map resolution %g m/px is outside [%g, %g] m/px", resolution,
-                        kMinResolution, kMaxResolution));
-  }
-  const Point2 corners[2] = {site.min_corner(), site.max_corner()};
-  for (const Point2& p : corners) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || std::abs(p.x) > kMaxCoordinate ||
-        std::abs(p.y) > kMaxCoordinate) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("map origin/extent (%g, %g) m is beyond %g m from the map frame's origin",
-                          p.x, p.y, kMaxCoordinate));
-    }
-  }
-  return absl::OkStatus();
 }
 
 std::string QuotePrefix(absl::string_view text, size_t max_chars) {

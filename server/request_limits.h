@@ -1,15 +1,15 @@
-// Bounds on what a request may carry, checked before any work is queued, and
-// the geometry a stored map must have to be plannable.
+// Bounds on what a request may carry, checked before any work is queued.
+// (The geometry a map must have to be plannable is the engine's:
+// CheckSiteGeometry in planner/engine/site.h.)
 //
 //   if (absl::Status s = CheckRequestStrings(*request); !s.ok()) Reject(s);
 //   // "name is 10485760 bytes; the limit is 256 bytes"
-//   RETURN_IF_ERROR(CheckSiteGeometry(site));
 //
 // Every string field of every message (nested and repeated ones included) is
 // bounded: a few known fields have their own limit (kStringLimits), all others
 // kDefaultStringLimit. Bytes fields (images) are bounded elsewhere
-// (InputLimits). QuotePrefix is how errors quote user input: at most a short
-// prefix, so a reply never repeats megabytes back.
+// (EngineLimits, planner/engine/limits.h). QuotePrefix is how errors quote user input: at most a
+// short prefix, so a reply never repeats megabytes back.
 //
 // Thread-safety: stateless functions.
 #ifndef COVPLAN_SERVER_REQUEST_LIMITS_H_
@@ -21,7 +21,6 @@
 #include "absl/status/status.h"
 #include "absl/strings/string_view.h"
 #include "google/protobuf/message.h"
-#include "planner/engine/site.h"
 
 namespace covplan {
 
@@ -38,11 +37,6 @@ size_t StringLimitFor(const std::string& full_field_name);
 // InvalidArgument naming the first over-long string field by its path in
 // the request (e.g. "plan.request.map.raster.yaml") and its limit.
 absl::Status CheckRequestStrings(const google::protobuf::Message& request);
-
-// InvalidArgument unless the map's resolution and extent are finite and of
-// a size a robot can plan on (resolution 0.1 mm .. 1 km per pixel, every
-// corner within 10,000 km of the origin).
-absl::Status CheckSiteGeometry(const SiteMap& site);
 
 // `text` if short, else its first `max_chars` bytes and "...(N bytes)".
 std::string QuotePrefix(absl::string_view text, size_t max_chars = 64);

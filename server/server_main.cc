@@ -51,7 +51,8 @@ ABSL_FLAG(
     "request searches from scratch");
 ABSL_FLAG(int64_t, cache_mb, 256,
           "Per-map artifact cache budget in MiB (grids, coverage areas, partitions, transitions)");
-ABSL_FLAG(double, default_budget_s, 2.0, "Tour search budget for calls without a deadline");
+ABSL_FLAG(double, default_budget_s, covplan::CommonOptions::kDefaultTimeLimitS,
+          "Tour search budget for calls without a deadline");
 ABSL_FLAG(int, deadline_margin_ms, 25, "Part of a call's deadline kept for sending the reply");
 ABSL_FLAG(int, plan_ttl_s, 600, "How long plans stay addressable by plan_id");
 ABSL_FLAG(int, max_retained_plans, 256, "Most plans kept for GetPlan");

@@ -1,4 +1,5 @@
 #include "server/service.h"
+#include "planner/assembly/builtin_planners.h"
 
 #include <malloc.h>
 #include <sys/random.h>
@@ -29,7 +30,7 @@ namespace {
 constexpr char kEstimatorFile[] = "replan_estimator.txt";
 
 EngineLimits EngineLimitsWithMemory(const ServiceOptions& options) {
-  EngineLimits limits = EngineLimitsFor(options.limits);
+  EngineLimits limits = options.limits;
   limits.plan_memory = options.plan_memory;
   return limits;
 }
@@ -205,7 +206,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       tokens_(tokens),
       metrics_(metrics),
       cache_(options.cache_budget_bytes, metrics),
-      registry_(PlannerRegistry::WithBuiltins()),
+      registry_(BuiltinPlanners()),
       engine_(&registry_, &cache_, EngineLimitsWithMemory(options)),
       plans_(options.plan_ttl, options.max_retained_plans),
       sessions_(options.max_sessions, options.session_idle),
@@ -605,8 +606,7 @@ MapSource CoveragePlannerService::SourceFor(const std::string& map_id,
     }
     ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(inline_map != nullptr ? *inline_map : stored.map(),
                                                  options_.limits));
-    RETURN_IF_ERROR(CheckSiteGeometry(site));
-    return site;
+    return site;  // the engine checks its geometry (CheckSiteGeometry)
   };
   return source;
 }

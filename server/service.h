@@ -57,14 +57,15 @@
 namespace covplan {
 
 struct ServiceOptions {
-  InputLimits limits;
+  EngineLimits limits;
   int worker_threads = 2;
   int max_queue = 16;                        // waiting requests beyond the workers
   size_t cache_budget_bytes = 256ull << 20;  // per-map artifact cache
   // Remember plans in that cache (planner/engine/plan_memory.h): identical
   // requests answered at once, new start poses warm-started.
   bool plan_memory = true;
-  double default_budget_s = 2.0;  // tour search budget without a deadline
+  double default_budget_s =
+      CommonOptions::kDefaultTimeLimitS;  // tour search budget without a deadline
   // Without a deadline, the whole call (artifacts included) stops after
   // this long with DEADLINE_EXCEEDED rather than holding a worker forever.
   absl::Duration max_request_time = absl::Seconds(120);

@@ -27,10 +27,7 @@ absl::Status BoustrophedonOptions::Validate() const {
       sweep_axis != BoustrophedonAxis::kHorizontal) {
     return absl::InvalidArgumentError("boustrophedon.sweep_axis: unknown axis");
   }
-  if (tour_solver != TourSolver::kGreedy && tour_solver != TourSolver::kGtsp) {
-    return absl::InvalidArgumentError("boustrophedon.tour_solver: unknown solver");
-  }
-  return absl::OkStatus();
+  return CheckTourSolver(tour_solver, "boustrophedon.tour_solver");
 }
 
 std::string BoustrophedonOptions::CacheText() const {

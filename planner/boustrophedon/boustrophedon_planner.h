@@ -24,7 +24,8 @@
 #include "planner/boustrophedon/decomposition.h"
 #include "planner/boustrophedon/ox_plow.h"
 #include "planner/engine/planner.h"
-#include "planner/oarp/oarp_planner.h"
+#include "planner/tour/gtsp/gtsp.h"
+#include "planner/tour/tour_solver.h"
 
 namespace covplan {
 

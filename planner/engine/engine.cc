@@ -78,7 +78,8 @@ std::vector<std::string> PlannerRegistry::Names() const {
 
 absl::StatusOr<PlanningEngine::Resolved> PlanningEngine::Resolve(const PlanRequest& request) const {
   Resolved r;
-  r.planner = registry_->Find(request.planner);
+  r.planner =
+      registry_->Find(request.planner.empty() ? registry_->default_name() : request.planner);
   if (r.planner == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrFormat("planner: unknown planner '%s'; registered: %s", request.planner,

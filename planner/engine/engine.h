@@ -10,7 +10,7 @@
 // differs only in start/end pose or seed (plan_memory.h; the outcome is
 // PlanStats::plan_source).
 //
-//   PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+//   PlannerRegistry registry = BuiltinPlanners();  // planner/assembly
 //   LocalArtifactCache cache;
 //   PlanningEngine engine(&registry, &cache, EngineLimits{});
 //   MapSource source{map_id, [&] { return LoadSite(...); }};
@@ -26,6 +26,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -38,18 +39,21 @@
 
 namespace covplan {
 
-// Planners by name.
+// Planners by name, filled by the host's assembly (the shipped set:
+// planner/assembly/builtin_planners.h); the engine knows none by name.
 class PlannerRegistry {
  public:
-  // Every planner this build ships (see registry.cc).
-  static PlannerRegistry WithBuiltins();
   void Register(std::unique_ptr<Planner> planner);
+  // The planner a request without a planner name gets (PlanRequest::planner
+  // empty).
+  void SetDefault(std::string name) { default_ = std::move(name); }
+  const std::string& default_name() const { return default_; }
   const Planner* Find(std::string_view name) const;
   std::vector<std::string> Names() const;
-  static constexpr const char* kDefault = "oarp";
 
  private:
   std::map<std::string, std::shared_ptr<const Planner>, std::less<>> planners_;
+  std::string default_;
 };
 
 // Where a map comes from: its content id (all cache keys derive from it) and
@@ -60,7 +64,7 @@ struct MapSource {
 };
 
 struct PlanRequest {
-  std::string planner = PlannerRegistry::kDefault;
+  std::string planner;  // a registered name; empty: the registry's default
   CommonOptions common;
   std::shared_ptr<const PlannerOptions> options;  // null: the planner's defaults
   std::vector<PolygonInput> regions;

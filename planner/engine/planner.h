@@ -7,8 +7,8 @@
 // own detail. The engine fills the statistics that follow from the path.
 //
 // A new planner is a folder under planner/ with a Planner subclass and an
-// options struct, plus one line in planner/engine/registry.cc (and, for the
-// API, its options message in the proto's oneof).
+// options struct, plus one line in planner/assembly/builtin_planners.cc
+// (and, for the API, its options message in the proto's oneof).
 //
 //   class MyPlanner final : public Planner {
 //     std::string_view name() const override { return "mine"; }
@@ -30,6 +30,7 @@
 #include "absl/status/statusor.h"
 #include "planner/common/stop_token.h"
 #include "planner/engine/artifact_cache.h"
+#include "planner/engine/limits.h"
 #include "planner/engine/site.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/tour/robot_model.h"
@@ -41,7 +42,11 @@ namespace covplan {
 struct CommonOptions {
   RobotModel robot;
   double min_free_fraction = 0.5;
-  double time_limit_s = 1.0;  // search budget (also bounded by `stop`)
+  // The search budget of a request that sets none, the same at every entry
+  // point (covplan-server's --default_budget_s default, `covplan plan
+  // --local`, `covplan compare`).
+  static constexpr double kDefaultTimeLimitS = 2.0;
+  double time_limit_s = kDefaultTimeLimitS;  // search budget (also bounded by `stop`)
   uint64_t seed = 1;
   int num_threads = 1;
   StopToken stop;  // deadline / cancellation of the whole request
@@ -60,28 +65,6 @@ class PlannerOptions {
   // Every field, as stable text for cache keys (remembered plans): two
   // options with equal text must give equal plans.
   virtual std::string CacheText() const = 0;
-};
-
-// Limits of the host (server flags) that planners must respect.
-struct EngineLimits {
-  int64_t max_grid_cells = 4'000'000;
-  // OARP: hard cap on coverage ranks. The transitions are bounded by memory
-  // (below), not by this count.
-  int64_t max_ranks = 100'000;
-  // Memory budget of the transitions of one plan (OARP: the exact all-pairs
-  // table and dense GTSP, or the sparse candidate graph with its search
-  // scratch; boustrophedon: its all-pairs table). Above it: RESOURCE_EXHAUSTED.
-  int64_t max_transition_bytes = int64_t{1} << 30;
-  // OARP uses the exact all-pairs table and the dense GTSP while they fit in
-  // this many bytes (about 100 ranks at the default), the sparse candidate
-  // graph and tour search above (planner/tour/sparse_tour.h): on the IPA
-  // buildings the sparse tours were within 0.2 % of the dense ones from 80
-  // ranks up and 3-8x faster (docs/benchmarks.md §14).
-  int64_t dense_transition_bytes = int64_t{4} << 20;
-  int64_t max_area_vertices = 100'000;  // per regions / no_go / polygon map
-  // Remember plans in the artifact cache (planner/engine/plan_memory.h);
-  // false: every request searches from scratch.
-  bool plan_memory = true;
 };
 
 struct PlanContext {

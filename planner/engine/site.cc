@@ -13,6 +13,10 @@
 namespace covplan {
 namespace {
 
+constexpr double kMinResolution = 1e-4;  // metres per pixel
+constexpr double kMaxResolution = 1000.0;
+constexpr double kMaxCoordinate = 1e7;  // metres from the map frame's origin
+
 double MsSince(absl::Time t) { return absl::ToDoubleMilliseconds(absl::Now() - t); }
 
 uint64_t Fnv1a(const std::string& text) {
@@ -55,9 +59,30 @@ absl::StatusOr<SiteMap> SiteFromPolygons(std::shared_ptr<const Area> free_space,
   return site;
 }
 
+absl::Status CheckSiteGeometry(const SiteMap& site) {
+  if (site.raster == nullptr) return absl::InvalidArgumentError("map has no raster");
+  const double resolution = site.raster->resolution();
+  if (!std::isfinite(resolution) || resolution < kMinResolution || resolution > kMaxResolution) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("map resolution %g m/px is outside [%g, %g] m/px", resolution,
+                        kMinResolution, kMaxResolution));
+  }
+  const Point2 corners[2] = {site.min_corner(), site.max_corner()};
+  for (const Point2& p : corners) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || std::abs(p.x) > kMaxCoordinate ||
+        std::abs(p.y) > kMaxCoordinate) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("map origin/extent (%g, %g) m is beyond %g m from the map frame's origin",
+                          p.x, p.y, kMaxCoordinate));
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<std::shared_ptr<const GridArtifact>> BuildGridArtifact(const SiteMap& site,
                                                                       const GridOptions& options) {
   if (site.raster == nullptr) return absl::InternalError("site map without raster");
+  RETURN_IF_ERROR(CheckSiteGeometry(site));
   const absl::Time start = absl::Now();
   const OccupancyMap& map = *site.raster;
   ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(map, options));

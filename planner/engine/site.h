@@ -11,7 +11,7 @@
 //                      parent's key + the zones, so a zone-less request for
 //                      the same map still shares the grid
 //
-//   ASSIGN_OR_RETURN(auto grid, BuildGridArtifact(site, grid_options));
+//   ASSIGN_OR_RETURN(auto grid, BuildGridArtifact(site, grid_options));  // checks the site
 //   ASSIGN_OR_RETURN(auto area, BuildCoverageArea(*grid, zones, min_free_fraction));
 //
 // Thread-safety: all artifacts are immutable after construction; the
@@ -51,6 +51,13 @@ struct SiteMap {
 absl::StatusOr<SiteMap> SiteFromPolygons(std::shared_ptr<const Area> free_space, double resolution,
                                          int64_t max_pixels);
 
+// InvalidArgument unless the map's resolution and extent are finite and of
+// a size a robot can plan on (resolution 0.1 mm .. 1 km per pixel, every
+// corner within 10,000 km of the origin). BuildGridArtifact checks it, so
+// every entry point refuses such a map alike; a host that stores maps calls
+// it before storing one.
+absl::Status CheckSiteGeometry(const SiteMap& site);
+
 class GridArtifact final : public Artifact {
  public:
   std::shared_ptr<const Grid> grid;  // every free cell, all components
@@ -63,6 +70,7 @@ class GridArtifact final : public Artifact {
   }
 };
 
+// Checks the site first (CheckSiteGeometry).
 absl::StatusOr<std::shared_ptr<const GridArtifact>> BuildGridArtifact(const SiteMap& site,
                                                                       const GridOptions& options);
 

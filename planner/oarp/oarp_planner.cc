@@ -46,10 +46,7 @@ absl::Status OarpOptions::Validate() const {
       partition_solver != PartitionSolver::kPushRelabel) {
     return absl::InvalidArgumentError("oarp.partition_solver: unknown solver");
   }
-  if (tour_solver != TourSolver::kGreedy && tour_solver != TourSolver::kGtsp) {
-    return absl::InvalidArgumentError("oarp.tour_solver: unknown solver");
-  }
-  return absl::OkStatus();
+  return CheckTourSolver(tour_solver, "oarp.tour_solver");
 }
 
 std::string OarpOptions::CacheText() const {

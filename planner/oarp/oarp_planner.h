@@ -23,11 +23,10 @@
 #include "planner/partition/rank.h"
 #include "planner/tour/endpoint_graph.h"
 #include "planner/tour/gtsp/gtsp.h"
+#include "planner/tour/tour_solver.h"
 #include "planner/tour/transitions.h"
 
 namespace covplan {
-
-enum class TourSolver { kGreedy, kGtsp };
 
 struct OarpOptions final : PlannerOptions {
   PartitionSolver partition_solver =

@@ -46,7 +46,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/occupancy_map.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"

@@ -8,6 +8,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/boustrophedon/decomposition.h"
 #include "planner/boustrophedon/ox_plow.h"
@@ -189,7 +190,7 @@ MapSource SourceOf(const OccupancyMap& map, const std::string& id) {
 }
 
 TEST(BoustrophedonPlanner, SweepsEveryCellToCoverAndKeepsCellsWhole) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   for (const std::string name :
        {"small_rooms.yaml", "sample_office.yaml", "sample_office_furnished.yaml"}) {
     SCOPED_TRACE(name);
@@ -229,7 +230,7 @@ TEST(BoustrophedonPlanner, SweepsEveryCellToCoverAndKeepsCellsWhole) {
 }
 
 TEST(BoustrophedonPlanner, PlansCanBeReplannedAroundNewObstacles) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   const OccupancyMap map = testing::LoadShippedMap("sample_office.yaml");
   LocalArtifactCache cache;
   PlanningEngine engine(&registry, &cache, EngineLimits{});
@@ -260,7 +261,7 @@ TEST(BoustrophedonPlanner, PlansCanBeReplannedAroundNewObstacles) {
 }
 
 TEST(BoustrophedonPlanner, RefusesForeignOptions) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   const Planner* p = registry.Find("boustrophedon");
   ASSERT_NE(p, nullptr);
   EXPECT_EQ(p->CheckOptions(OarpOptions()).code(), absl::StatusCode::kInvalidArgument);

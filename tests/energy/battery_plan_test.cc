@@ -15,6 +15,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/energy/battery.h"
 #include "planner/engine/engine.h"
 #include "planner/plan/svg.h"
@@ -68,7 +69,7 @@ class BatteryPlans : public ::testing::Test {
   }
 
   OccupancyMap map_;
-  PlannerRegistry registry_ = PlannerRegistry::WithBuiltins();
+  PlannerRegistry registry_ = BuiltinPlanners();
   LocalArtifactCache cache_;
   PlanningEngine engine_;
 };

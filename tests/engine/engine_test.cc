@@ -6,8 +6,8 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/engine/engine.h"
-#include "planner/engine/plan_coverage.h"
 #include "planner/grid/map_io.h"
 #include "tests/testing/plan_conformance.h"
 #include "tests/testing/shipped_maps.h"
@@ -41,7 +41,7 @@ PlanRequest Request(const std::string& planner, double tool) {
 class EveryPlanner : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(EveryPlanner, ConformsOnShippedMapsWithAndWithoutZones) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   for (const std::string map_name : {"small_rooms.yaml", "sample_office_furnished.yaml"}) {
     const OccupancyMap map = Load(map_name);
     for (double tool : {0.5, 0.9}) {
@@ -66,11 +66,10 @@ TEST_P(EveryPlanner, ConformsOnShippedMapsWithAndWithoutZones) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Registry, EveryPlanner,
-                         ::testing::ValuesIn(PlannerRegistry::WithBuiltins().Names()));
+INSTANTIATE_TEST_SUITE_P(Registry, EveryPlanner, ::testing::ValuesIn(BuiltinPlanners().Names()));
 
 TEST(Registry, SelectsByNameAndRefusesUnknownPlannersAndForeignOptions) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   EXPECT_THAT(registry.Names(), ::testing::Contains("oarp"));
   LocalArtifactCache cache;
   PlanningEngine engine(&registry, &cache, EngineLimits{});
@@ -99,7 +98,7 @@ TEST(Registry, SelectsByNameAndRefusesUnknownPlannersAndForeignOptions) {
 }
 
 TEST(Termination, SaysWhetherTheSearchConvergedOrWhichLimitStoppedIt) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   LocalArtifactCache cache;
   PlanningEngine engine(&registry, &cache, EngineLimits{});
   const OccupancyMap map = Load("sample_office.yaml");
@@ -133,7 +132,7 @@ TEST(Termination, SaysWhetherTheSearchConvergedOrWhichLimitStoppedIt) {
 }
 
 TEST(Artifacts, AreBuiltOnceAndPrepareWarmsThem) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   LocalArtifactCache cache;
   PlanningEngine engine(&registry, &cache, EngineLimits{});
   const OccupancyMap map = Load("small_rooms.yaml");
@@ -169,6 +168,20 @@ TEST(Artifacts, AreBuiltOnceAndPrepareWarmsThem) {
   missing.load = []() -> absl::StatusOr<SiteMap> { return absl::NotFoundError("map gone"); };
   EXPECT_EQ(engine.Plan(missing, r).status().code(), absl::StatusCode::kNotFound);
   EXPECT_EQ(cache.size(), 6u);  // the 4 artifacts + the remembered tour and plan
+}
+
+// The site checks are the engine's, so every entry point (the server,
+// `covplan plan --local`, PlanCoverage) refuses such maps alike.
+TEST(Engine, RefusesMapsNoRobotCanPlanOn) {
+  PlanOptions o;
+  o.robot.tool_width_m = 0.8;
+  const absl::Status coarse = PlanCoverage(OccupancyMap(4, 4, 5000.0, {0.0, 0.0}), o).status();
+  EXPECT_EQ(coarse.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(coarse.message(), "map resolution 5000 m/px is outside [0.0001, 1000] m/px");
+  const absl::Status far = PlanCoverage(OccupancyMap(40, 40, 0.1, {2e7, 0.0}), o).status();
+  EXPECT_EQ(far.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(far.message(),
+            "map origin/extent (2e+07, 0) m is beyond 1e+07 m from the map frame's origin");
 }
 
 }  // namespace

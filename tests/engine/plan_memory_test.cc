@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/engine/engine.h"
 #include "planner/engine/plan_memory.h"
 #include "planner/oarp/oarp_planner.h"
@@ -56,7 +57,7 @@ class PlanMemoryTest : public ::testing::Test {
     }
   }
 
-  const PlannerRegistry registry_ = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry_ = BuiltinPlanners();
   OccupancyMap map_;
 };
 

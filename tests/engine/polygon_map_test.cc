@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/engine/engine.h"
 #include "planner/engine/site.h"
 #include "planner/geometry/area.h"
@@ -100,7 +101,7 @@ TEST(PolygonMap, MatchesItsRasterisedTwinUpToRasterisationCells) {
 }
 
 TEST(PolygonMap, PlansConformAndDriveLinesStayInTheFreeSpace) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   LocalArtifactCache cache;
   PlanningEngine engine(&registry, &cache, EngineLimits{});
   MapSource source;

@@ -7,9 +7,10 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/geometry/area.h"
 #include "planner/grid/map_io.h"
+#include "tests/testing/oarp_options.h"
 #include "tests/testing/plan_conformance.h"
 
 namespace covplan {
@@ -35,7 +36,8 @@ PolygonInput Box(double x0, double y0, double x1, double y1) {
 PlanOptions Options() {
   PlanOptions o;
   o.robot.tool_width_m = 0.8;
-  o.tour_solver = TourSolver::kGreedy;  // fast; the tour is not what is tested here
+  o.options =
+      testing::OarpOptionsWith(TourSolver::kGreedy);  // fast; the tour is not what is tested here
   return o;
 }
 

@@ -1,10 +1,11 @@
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 
 #include <cmath>
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "planner/plan/svg.h"
+#include "tests/testing/oarp_options.h"
 #include "tests/testing/plan_conformance.h"
 
 namespace covplan {
@@ -67,7 +68,7 @@ TEST(BuildGrid, NonIntegerCellSizeUsesFractionalOverlap) {
 TEST(PlanCoverage, OfficeMapConforms) {
   for (TourSolver tour : {TourSolver::kGreedy, TourSolver::kGtsp}) {
     PlanOptions opt;
-    opt.tour_solver = tour;
+    opt.options = testing::OarpOptionsWith(tour);
     opt.time_limit_s = 0.3;
     auto result = PlanCoverageWithArea(OfficeMap(), opt);
     ASSERT_TRUE(result.ok()) << result.status();
@@ -87,10 +88,10 @@ TEST(PlanCoverage, OfficeMapConforms) {
 
 TEST(PlanCoverage, ExactSolversGiveSameRankCount) {
   PlanOptions a, b, c, d;  // a: the default (push-relabel)
-  a.tour_solver = b.tour_solver = c.tour_solver = d.tour_solver = TourSolver::kGreedy;
-  b.partition_solver = PartitionSolver::kLp;
-  c.partition_solver = PartitionSolver::kMinCut;
-  d.partition_solver = PartitionSolver::kMatching;
+  a.options = testing::OarpOptionsWith(TourSolver::kGreedy);
+  b.options = testing::OarpOptionsWith(TourSolver::kGreedy, PartitionSolver::kLp);
+  c.options = testing::OarpOptionsWith(TourSolver::kGreedy, PartitionSolver::kMinCut);
+  d.options = testing::OarpOptionsWith(TourSolver::kGreedy, PartitionSolver::kMatching);
   auto pa = PlanCoverage(OfficeMap(), a);
   auto pb = PlanCoverage(OfficeMap(), b);
   auto pc = PlanCoverage(OfficeMap(), c);
@@ -134,7 +135,7 @@ TEST(PlanCoverage, DisconnectedAreasAreReportedNotPlanned) {
   for (int r = 0; r < 160; ++r)
     for (int c = 150; c < 182; ++c) m.set(r, c, CellState::kOccupied);
   PlanOptions opt;
-  opt.tour_solver = TourSolver::kGreedy;
+  opt.options = testing::OarpOptionsWith(TourSolver::kGreedy);
   auto plan = PlanCoverageWithArea(m, opt);
   ASSERT_TRUE(plan.ok()) << plan.status();
   EXPECT_GT(plan->plan.stats.unreachable_free_cells, 0);
@@ -168,7 +169,7 @@ TEST(BuildGrid, ThinWallBecomesBarrier) {
   EXPECT_EQ(BuildGrid(m, opt)->CountBarriers(), 0);
 
   PlanOptions po;
-  po.tour_solver = TourSolver::kGreedy;
+  po.options = testing::OarpOptionsWith(TourSolver::kGreedy);
   auto plan = PlanCoverageWithArea(m, po);
   ASSERT_TRUE(plan.ok()) << plan.status();
   EXPECT_EQ(testing::CheckOarpConformance(*plan, po.robot), "");

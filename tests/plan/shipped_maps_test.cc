@@ -4,7 +4,7 @@
 #include <string>
 
 #include "gtest/gtest.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/map_io.h"
 #include "planner/partition/lp_partitioner.h"
 #include "planner/partition/matching_partitioner.h"

@@ -13,8 +13,9 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/map_io.h"
+#include "tests/testing/oarp_options.h"
 #include "tests/testing/plan_conformance.h"
 #include "tests/testing/shipped_maps.h"
 
@@ -72,7 +73,7 @@ RobotProgress Early(const CoveragePlan& plan) {
 absl::StatusOr<RetainedPlan> GreedyPlanWithMetreTool(const OccupancyMap& map) {
   PlanOptions o;
   o.robot.tool_width_m = 1.0;
-  o.tour_solver = TourSolver::kGreedy;
+  o.options = testing::OarpOptionsWith(TourSolver::kGreedy);
   absl::StatusOr<EngineResult> r = PlanCoverageWithArea(map, o);
   if (!r.ok()) return r.status();
   RetainedPlan old;

@@ -56,7 +56,7 @@ TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
                         Case{"maps/sample_yard.geojson", v1::GTSP, true}}) {
     SCOPED_TRACE(absl::StrCat(c.map, c.zones ? " with zones" : ""));
     const std::string path = absl::StrCat(COVPLAN_SOURCE_DIR, "/", c.map);
-    absl::StatusOr<v1::Map> map = MapProtoFromFile(path, MapFileOverrides(), InputLimits());
+    absl::StatusOr<v1::Map> map = MapProtoFromFile(path, MapFileOverrides(), EngineLimits());
     ASSERT_TRUE(map.ok()) << map.status();
     v1::PlanRequest request;
     request.mutable_robot()->set_tool_width_m(0.8);
@@ -68,7 +68,7 @@ TEST(ClientPlanTest, LocalAndServerGiveTheSamePlanForShippedMaps) {
       AddBox(request.mutable_regions(), -0.5, 0.2, 21.0, 9.0);
     }
     *request.mutable_map() = *map;
-    absl::StatusOr<v1::PlanResponse> local = PlanLocally(request, InputLimits());
+    absl::StatusOr<v1::PlanResponse> local = PlanLocally(request, EngineLimits());
     ASSERT_TRUE(local.ok()) << local.status();
     EXPECT_GT(local->stats().num_ranks(), 0);
     EXPECT_GT(local->stats().covered_free_area_ratio(), 0.5);
@@ -263,7 +263,7 @@ TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
   // Through the RPC: a bad tree value and STC options for OARP.
   auto stub = v1::CoveragePlanner::NewStub(
       grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
-  absl::StatusOr<v1::Map> proto_map = MapProtoFromFile(map, MapFileOverrides(), InputLimits());
+  absl::StatusOr<v1::Map> proto_map = MapProtoFromFile(map, MapFileOverrides(), EngineLimits());
   ASSERT_TRUE(proto_map.ok());
   v1::PlanRequest request;
   *request.mutable_map() = *proto_map;

@@ -10,6 +10,7 @@
 #include "client/compare_command.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/grid/map_io.h"
 #include "planner/stc/stc_planner.h"
 
@@ -33,7 +34,7 @@ MapSource ShippedSource(const std::string& name) {
 }
 
 TEST(CompareCommand, RowsAgreeWithTheEnginesPlans) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   PlanRequest request;
   request.common.robot.tool_width_m = 0.8;
   request.common.time_limit_s = 30;  // OARP's default effort converges long before
@@ -87,7 +88,7 @@ TEST(CompareCommand, RedundantCellsCountCellsEnteredTwice) {
 }
 
 TEST(CompareCommand, UnknownAlgorithmsListTheRegisteredOnes) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   absl::StatusOr<std::vector<ComparisonRow>> rows =
       ComparePlanners(registry, ShippedSource("small_rooms.yaml"), {"oarp", "spiral"},
                       PlanRequest(), EngineLimits{});

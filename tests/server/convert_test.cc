@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/boustrophedon/boustrophedon_planner.h"
 #include "planner/engine/artifact_cache.h"
 #include "planner/grid/grid.h"
@@ -48,7 +49,7 @@ v1::PlanRequest RequestWithTool(double tool) {
 
 TEST(MapFromProtoTest, DecodesAsciiPgmWithRowsFlipped) {
   const std::string pgm = AsciiToPgm({"#..", "..."}, 2);
-  absl::StatusOr<OccupancyMap> map = MapFromProto(RasterMap(pgm, 0.1), InputLimits());
+  absl::StatusOr<OccupancyMap> map = MapFromProto(RasterMap(pgm, 0.1), EngineLimits());
   ASSERT_TRUE(map.ok()) << map.status();
   EXPECT_EQ(map->width(), 6);
   EXPECT_EQ(map->height(), 4);
@@ -65,21 +66,21 @@ TEST(MapFromProtoTest, YamlSuppliesResolutionAndOriginAndIgnoresImageKey) {
   map.mutable_raster()->set_yaml(
       "image: does_not_exist.pgm\nresolution: 0.5\norigin: [1.0, -2.0, 0.0]\n"
       "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n");
-  absl::StatusOr<OccupancyMap> decoded = MapFromProto(map, InputLimits());
+  absl::StatusOr<OccupancyMap> decoded = MapFromProto(map, EngineLimits());
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   EXPECT_DOUBLE_EQ(decoded->resolution(), 0.5);
   EXPECT_DOUBLE_EQ(decoded->origin().x, 1.0);
   EXPECT_DOUBLE_EQ(decoded->origin().y, -2.0);
   // An explicit override wins over the YAML.
   map.mutable_raster()->set_resolution(0.25);
-  decoded = MapFromProto(map, InputLimits());
+  decoded = MapFromProto(map, EngineLimits());
   ASSERT_TRUE(decoded.ok()) << decoded.status();
   EXPECT_DOUBLE_EQ(decoded->resolution(), 0.25);
 }
 
 TEST(MapFromProtoTest, RejectsBadMapsWithUsefulMessages) {
   const std::string pgm = AsciiToPgm(TwoRooms(), 4);
-  const InputLimits limits;
+  const EngineLimits limits;
   const auto kInvalid = absl::StatusCode::kInvalidArgument;
   EXPECT_THAT(MapFromProto(v1::Map(), limits), StatusIs(kInvalid, "no source"));
   EXPECT_THAT(MapFromProto(RasterMap("", 0.1), limits), StatusIs(kInvalid, "empty"));
@@ -117,31 +118,31 @@ TEST(MapProtoFromFileTest, ABareImageNeedsAResolution) {
       (std::filesystem::temp_directory_path() / absl::StrCat("covplan_bare_", getpid(), ".pgm"))
           .string();
   std::ofstream(path, std::ios::binary) << AsciiToPgm(TwoRooms(), 4);
-  absl::StatusOr<v1::Map> bare = MapProtoFromFile(path, MapFileOverrides(), InputLimits());
+  absl::StatusOr<v1::Map> bare = MapProtoFromFile(path, MapFileOverrides(), EngineLimits());
   EXPECT_THAT(bare, StatusIs(absl::StatusCode::kInvalidArgument,
                              "is a bare image: --resolution M (metres per pixel) is required"));
   EXPECT_THAT(bare.status().message(), HasSubstr(path));
   MapFileOverrides with;
   with.resolution = 0.1;
-  absl::StatusOr<v1::Map> ok = MapProtoFromFile(path, with, InputLimits());
+  absl::StatusOr<v1::Map> ok = MapProtoFromFile(path, with, EngineLimits());
   ASSERT_TRUE(ok.ok()) << ok.status();
   EXPECT_EQ(ok->raster().resolution(), 0.1);
-  EXPECT_TRUE(MapFromProto(*ok, InputLimits()).ok());
+  EXPECT_TRUE(MapFromProto(*ok, EngineLimits()).ok());
   std::filesystem::remove(path);
 }
 
 TEST(MapFromProtoTest, EnforcesSizeLimits) {
   const std::string pgm = AsciiToPgm(TwoRooms(), 4);  // 48 x 32 pixels
-  InputLimits limits;
+  EngineLimits limits;
   limits.max_image_bytes = 100;
   EXPECT_THAT(MapFromProto(RasterMap(pgm, 0.1), limits),
               StatusIs(absl::StatusCode::kInvalidArgument, "too large"));
-  limits = InputLimits();
+  limits = EngineLimits();
   limits.max_map_pixels = 1000;
   EXPECT_THAT(MapFromProto(RasterMap(pgm, 0.1), limits),
               StatusIs(absl::StatusCode::kInvalidArgument, "48 x 32 = 1536 pixels"));
   // A header claiming a huge image is rejected before any decoding.
-  EXPECT_THAT(MapFromProto(RasterMap("P5\n100000 100000\n255\n", 0.1), InputLimits()),
+  EXPECT_THAT(MapFromProto(RasterMap("P5\n100000 100000\n255\n", 0.1), EngineLimits()),
               StatusIs(absl::StatusCode::kInvalidArgument, "too large"));
 }
 
@@ -233,11 +234,11 @@ TEST(PlanRequestFromProtoTest, CarriesPlannerAndZones) {
 // conversion the server and the CLI use.
 TEST(EngineValidationTest, ToolMustFitPixelAndMapAndZonesTheMap) {
   const v1::Map map = RasterMap(AsciiToPgm(TwoRooms(), 4), 0.1);  // 4.8 m x 3.2 m
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
-  auto check = [&](double tool, const InputLimits& limits,
+  const PlannerRegistry registry = BuiltinPlanners();
+  auto check = [&](double tool, const EngineLimits& limits,
                    v1::PlanRequest request) -> absl::Status {
     LocalArtifactCache cache;
-    PlanningEngine engine(&registry, &cache, EngineLimitsFor(limits));
+    PlanningEngine engine(&registry, &cache, limits);
     request.mutable_robot()->set_tool_width_m(tool);
     request.set_time_limit_s(0.1);
     absl::StatusOr<PlanRequest> r = PlanRequestFromProto(request);
@@ -245,13 +246,13 @@ TEST(EngineValidationTest, ToolMustFitPixelAndMapAndZonesTheMap) {
     MapSource source{ComputeMapId(map), [&] { return SiteFromProto(map, limits); }};
     return engine.Plan(source, *r).status();
   };
-  const InputLimits limits;
+  const EngineLimits limits;
   EXPECT_TRUE(check(0.4, limits, {}).ok());
   EXPECT_THAT(absl::StatusOr<int>(check(0.05, limits, {})),
               StatusIs(absl::StatusCode::kInvalidArgument, "narrower than one map pixel"));
   EXPECT_THAT(absl::StatusOr<int>(check(3.5, limits, {})),
               StatusIs(absl::StatusCode::kInvalidArgument, "wider than the map"));
-  InputLimits tight;
+  EngineLimits tight;
   tight.max_grid_cells = 10;
   EXPECT_THAT(absl::StatusOr<int>(check(0.4, tight, {})),
               StatusIs(absl::StatusCode::kInvalidArgument, "above the limit"));

@@ -35,7 +35,7 @@ class DriveSessionTest : public ::testing::Test {
                .string();
     absl::StatusOr<v1::Map> map =
         MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
-                         MapFileOverrides(), InputLimits());
+                         MapFileOverrides(), EngineLimits());
     ASSERT_TRUE(map.ok()) << map.status();
     map_ = *map;
   }

@@ -15,7 +15,7 @@
 #include "client/partition_command.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/map_io.h"
 
 namespace covplan {

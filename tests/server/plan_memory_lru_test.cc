@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/engine/engine.h"
 #include "server/artifact_lru.h"
 #include "tests/testing/shipped_maps.h"
@@ -68,7 +69,7 @@ PlanRequest Request(uint64_t seed) {
 
 TEST(PlanMemoryBudgetTest, RememberedPlansAreAccountedAndEvicted) {
   const OccupancyMap map = testing::LoadShippedMap("sample_office.yaml");
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   const MapSource source = Office(&map);
 
   // How much the artifacts take, and how much one remembered plan adds.
@@ -109,7 +110,7 @@ TEST(PlanMemoryBudgetTest, RememberedPlansAreAccountedAndEvicted) {
 // converged search), and the one remembered afterwards is that plan.
 TEST(PlanMemoryBudgetTest, ConcurrentIdenticalRequestsShareOneAnswer) {
   const OccupancyMap map = testing::LoadShippedMap("sample_office.yaml");
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   const MapSource source = Office(&map);
   ArtifactLru cache(256 << 20);
   PlanningEngine engine(&registry, &cache, EngineLimits{});

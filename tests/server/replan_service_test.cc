@@ -31,7 +31,7 @@ class ReplanServiceTest : public ::testing::Test {
     Start();
     absl::StatusOr<v1::Map> map =
         MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
-                         MapFileOverrides(), InputLimits());
+                         MapFileOverrides(), EngineLimits());
     ASSERT_TRUE(map.ok()) << map.status();
     map_ = *map;
   }

@@ -41,7 +41,7 @@ using ::testing::HasSubstr;
 v1::Map OfficeMap() {
   absl::StatusOr<v1::Map> map =
       MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office_furnished.yaml"),
-                       MapFileOverrides(), InputLimits());
+                       MapFileOverrides(), EngineLimits());
   EXPECT_TRUE(map.ok()) << map.status();
   return map.ok() ? *map : v1::Map();
 }

@@ -103,7 +103,7 @@ class ServiceTest : public ::testing::Test {
   int worker_threads_ = 2;
   int max_queue_ = ServiceOptions().max_queue;
   int64_t max_ranks_ = 1000;
-  int64_t dense_transition_bytes_ = InputLimits().dense_transition_bytes;
+  int64_t dense_transition_bytes_ = EngineLimits().dense_transition_bytes;
   absl::Duration max_request_time_ = absl::Seconds(120);
   std::string dir_;
   std::unique_ptr<CovplanServer> server_;

@@ -21,6 +21,7 @@
 #include "planner/sim/simulator.h"
 #include "planner/tour/path_timing.h"
 #include "tests/sim/sim_checks.h"
+#include "tests/testing/oarp_options.h"
 #include "tests/testing/shipped_maps.h"
 
 namespace covplan {
@@ -35,7 +36,8 @@ SimulationOptions Options() {
   SimulationOptions o;
   o.plan.robot.tool_width_m = kTool;
   o.plan.time_limit_s = 0.2;
-  o.plan.tour_solver = TourSolver::kGreedy;  // deterministic: the test plans the same plan again
+  o.plan.options = testing::OarpOptionsWith(
+      TourSolver::kGreedy);  // deterministic: the test plans the same plan again
   return o;
 }
 

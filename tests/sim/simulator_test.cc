@@ -20,6 +20,7 @@
 #include "planner/grid/map_io.h"
 #include "planner/sim/clutter.h"
 #include "tests/sim/sim_checks.h"
+#include "tests/testing/oarp_options.h"
 #include "tests/testing/shipped_maps.h"
 
 namespace covplan {
@@ -121,7 +122,8 @@ INSTANTIATE_TEST_SUITE_P(Methods, EveryReplanMethod,
 TEST(Simulate, WithAPerfectMapNothingIsReplannedAndTheRunIsThePlan) {
   const OccupancyMap office = Load("sample_office.yaml");
   SimulationOptions o = Options(ReplanMethod::kAuto);
-  o.plan.tour_solver = TourSolver::kGreedy;  // deterministic: the plan below is the same one
+  o.plan.options = testing::OarpOptionsWith(
+      TourSolver::kGreedy);  // deterministic: the plan below is the same one
   absl::StatusOr<SimulationResult> r = Simulate(office, office, o);
   ASSERT_TRUE(r.ok()) << r.status();
   EXPECT_TRUE(r->completed);

@@ -6,6 +6,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/engine/engine.h"
 #include "planner/stc/stc_planner.h"
 #include "tests/testing/plan_conformance.h"
@@ -33,7 +34,7 @@ struct Variant {
 };
 
 TEST(StcEngine, ConformsOnShippedMapsWithZonesAndPoses) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   for (const std::string name :
        {"small_rooms.yaml", "sample_office.yaml", "sample_office_furnished.yaml"}) {
     const OccupancyMap map = testing::LoadShippedMap(name);
@@ -104,7 +105,7 @@ TEST(StcEngine, ConformsOnShippedMapsWithZonesAndPoses) {
 }
 
 TEST(StcEngine, BadOptionsAreInvalidArgument) {
-  const PlannerRegistry registry = PlannerRegistry::WithBuiltins();
+  const PlannerRegistry registry = BuiltinPlanners();
   LocalArtifactCache cache;
   PlanningEngine engine(&registry, &cache, EngineLimits{});
   const OccupancyMap map = testing::LoadShippedMap("small_rooms.yaml");

@@ -13,8 +13,8 @@
 #include <algorithm>
 #include "absl/strings/str_format.h"
 
+#include "planner/assembly/plan_coverage.h"
 #include "planner/engine/engine.h"
-#include "planner/engine/plan_coverage.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/plan/coverage_plan.h"
 #include "tests/testing/grid_fixtures.h"

@@ -9,7 +9,7 @@
 
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/partition/mincut_partitioner.h"
 #include "planner/tour/endpoint_graph.h"

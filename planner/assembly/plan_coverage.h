@@ -1,35 +1,41 @@
 // One call from a decoded map to a plan (OARP unless `planner` names another
-// registered planner), on the engine: for tests, benchmarks and small tools
-// that hold an OccupancyMap and want a plan. With `battery` the engine splits
-// the plan into charge cycles (planner/energy), whatever the planner.
+// shipped planner), on the engine over the shipped planners
+// (builtin_planners.h): for tests, benchmarks and small tools that hold an
+// OccupancyMap and want a plan. A planner's own options reach it as in any
+// request (PlanRequest::options). With `battery` the engine splits the plan
+// into charge cycles (planner/energy), whatever the planner.
 //
 //   PlanOptions o; o.robot.tool_width_m = 0.8; o.no_go = {...};
+//   auto oarp = std::make_shared<OarpOptions>(); oarp->tour_solver = TourSolver::kGreedy;
+//   o.options = oarp;
 //   ASSIGN_OR_RETURN(CoveragePlan plan, PlanCoverage(map, o));
 //
 // Pass a cache to reuse per-map artifacts across calls (same `map_id`).
 // Thread-safety: reentrant; thread-safe when the cache is.
-#ifndef COVPLAN_PLANNER_ENGINE_PLAN_COVERAGE_H_
-#define COVPLAN_PLANNER_ENGINE_PLAN_COVERAGE_H_
+#ifndef COVPLAN_PLANNER_ASSEMBLY_PLAN_COVERAGE_H_
+#define COVPLAN_PLANNER_ASSEMBLY_PLAN_COVERAGE_H_
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "planner/assembly/builtin_planners.h"
 #include "planner/engine/engine.h"
-#include "planner/oarp/oarp_planner.h"
 
 namespace covplan {
 
 struct PlanOptions {
-  std::string planner =
-      PlannerRegistry::kDefault;  // a registered name; OARP fields apply to "oarp"
+  std::string planner = kDefaultPlanner;  // a shipped planner's name
+  // That planner's own options (its type: OarpOptions for "oarp"); null: its
+  // defaults.
+  std::shared_ptr<const PlannerOptions> options;
   RobotModel robot;
-  PartitionSolver partition_solver = PartitionSolver::kPushRelabel;
-  TourSolver tour_solver = TourSolver::kGtsp;
   double min_free_fraction = 0.5;
+  // Shorter than a request's default (CommonOptions::kDefaultTimeLimitS):
+  // tests and tools plan many small maps.
   double time_limit_s = 1.0;
-  GtspEffort tour_effort = GtspEffort::kDefault;
   uint64_t seed = 1;
   int num_threads = 1;
   StopToken stop;
@@ -52,4 +58,4 @@ absl::StatusOr<CoveragePlan> PlanCoverage(const OccupancyMap& map, const PlanOpt
 
 }  // namespace covplan
 
-#endif  // COVPLAN_PLANNER_ENGINE_PLAN_COVERAGE_H_
+#endif  // COVPLAN_PLANNER_ASSEMBLY_PLAN_COVERAGE_H_

@@ -1,4 +1,4 @@
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 
 #include <memory>
 #include <utility>
@@ -16,13 +16,7 @@ PlanRequest PlanOptions::ToRequest() const {
   r.common.seed = seed;
   r.common.num_threads = num_threads;
   r.common.stop = stop;
-  if (planner == "oarp") {
-    auto oarp = std::make_shared<OarpOptions>();
-    oarp->partition_solver = partition_solver;
-    oarp->tour_solver = tour_solver;
-    oarp->tour_effort = tour_effort;
-    r.options = std::move(oarp);
-  }  // other planners: their defaults
+  r.options = options;
   r.regions = regions;
   r.no_go = no_go;
   r.battery = battery;
@@ -32,8 +26,7 @@ PlanRequest PlanOptions::ToRequest() const {
 absl::StatusOr<EngineResult> PlanCoverageWithArea(const OccupancyMap& map,
                                                   const PlanOptions& options, ArtifactCache* cache,
                                                   const std::string& map_id, EngineLimits limits) {
-  static const PlannerRegistry* const registry =
-      new PlannerRegistry(PlannerRegistry::WithBuiltins());
+  static const PlannerRegistry* const registry = new PlannerRegistry(BuiltinPlanners());
   LocalArtifactCache local;
   PlanningEngine engine(registry, cache != nullptr ? cache : &local, limits);
   MapSource source;
