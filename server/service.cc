@@ -14,8 +14,6 @@ EngineLimits EngineLimitsWithMemory(const ServiceOptions& options) {
 CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, MapRepository* store,
                                                ServerMetrics* metrics, const TenantTokens* tokens)
     : options_(options),
-      store_(store),
-      metrics_(metrics),
       cache_(options.cache_budget_bytes, metrics),
       registry_(PlannerRegistry::WithBuiltins()),
       engine_(&registry_, &cache_, EngineLimitsWithMemory(options)),
@@ -35,10 +33,10 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       // for solves that have released their slot but not yet returned.
       pool_(options.worker_threads, 2 * (options.worker_threads + options.max_queue)),
       warm_pool_(/*threads=*/1, /*max_queue=*/4) {
-  metrics_->worker_threads().Set(options.worker_threads);
-  metrics_->queue_capacity().Set(options.max_queue);
-  metrics_->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
-  metrics_->maps_stored().Set(static_cast<double>(store_->size()));
+  metrics->worker_threads().Set(options.worker_threads);
+  metrics->queue_capacity().Set(options.max_queue);
+  metrics->cache_budget_bytes().Set(static_cast<double>(options.cache_budget_bytes));
+  metrics->maps_stored().Set(static_cast<double>(store->size()));
 }
 
 CoveragePlannerService::~CoveragePlannerService() { Shutdown(); }

@@ -130,15 +130,13 @@ class CoveragePlannerService final
   // Runs what is queued (cancelled calls finish quickly) and joins workers.
   void Shutdown();
 
-  // For tests and the server's logs.
+  // For tests.
   const ArtifactLru& cache() const { return cache_; }
   const ReplanEstimator& estimator() const { return archive_.estimator(); }
   const SessionRegistry& sessions() const { return drive_.sessions(); }
 
  private:
   const ServiceOptions options_;
-  MapRepository* const store_;
-  ServerMetrics* const metrics_;
   ArtifactLru cache_;
   const PlannerRegistry registry_;
   const PlanningEngine engine_;
