@@ -6,17 +6,14 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
+#include "api/convert.h"
+#include "planner/replan/replanner.h"
+#include "server/grpc_status.h"
 #include "server/log.h"
 #include "server/request_limits.h"
-#include "server/service.h"
 
 namespace covplan {
 namespace {
-
-grpc::Status ToGrpcStatus(const absl::Status& status) {
-  if (status.ok()) return grpc::Status::OK;
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
-}
 
 int ObstacleItems(const v1::Obstacles& o) {
   return o.cells_size() + o.points_size() + o.polygons_size();
@@ -33,10 +30,10 @@ struct DriveSession::Actions {
   grpc::Status status;
 };
 
-DriveSession::DriveSession(CoveragePlannerService* service, grpc::CallbackServerContext* context,
+DriveSession::DriveSession(DriveHost* host, grpc::CallbackServerContext* context,
                            SessionRegistry* registry, std::string session_id,
                            std::string tenant_tag)
-    : service_(service),
+    : host_(host),
       context_(context),
       registry_(registry),
       session_id_(std::move(session_id)),
@@ -102,7 +99,7 @@ void DriveSession::OnCancel() {
 void DriveSession::OnDone() {
   LogLine("info", "drive session ended", {{"session", session_id_}});
   registry_->Remove(this);
-  service_->UpdateSessionGauge();
+  host_->UpdateSessionGauge();
   Unref();
 }
 
@@ -179,7 +176,7 @@ void DriveSession::HandleMessage(Actions* a) {
   if (absl::Status s = CheckRequestStrings(in_); !s.ok()) {
     if (!started_) {
       started_ = true;
-      EndLocked(ToGrpcStatus(s));
+      EndLocked(ToGrpcUnbounded(s));
     } else {
       PushError(seq, s, a);
     }
@@ -193,7 +190,7 @@ void DriveSession::HandleMessage(Actions* a) {
       return;
     }
     if (absl::StatusOr<ReplanMethod> m = ReplanMethodFromProto(in_.method()); !m.ok()) {
-      EndLocked(ToGrpcStatus(m.status()));
+      EndLocked(ToGrpcUnbounded(m.status()));
       return;
     }
     first_ = in_;
@@ -223,7 +220,7 @@ void DriveSession::HandleMessage(Actions* a) {
       if (plan_id.empty() && !plans_.empty()) plan_id = plans_.back();
       if (plan_id.empty() && first_.plan_ref_case() == v1::DriveRequest::kPlanId)
         plan_id = first_.plan_id();
-      if (!plan_id.empty()) service_->RecordProgress(plan_id, in_.progress());
+      if (!plan_id.empty()) host_->RecordProgress(plan_id, in_.progress());
     }
     return;
   }
@@ -283,7 +280,7 @@ void DriveSession::StartJob(Actions* a) {
   v1::Obstacles seen = seen_;
   Ref();  // held by the worker
   const bool queued =
-      service_->SubmitSolve([this, job, first = std::move(first), seen = std::move(seen), stop] {
+      host_->SubmitSolve([this, job, first = std::move(first), seen = std::move(seen), stop] {
         RunJob(job, first, seen, stop);
         Unref();
       });
@@ -294,7 +291,7 @@ void DriveSession::StartJob(Actions* a) {
         "server busy: no worker free for this session's replan; the obstacles are kept for the "
         "next one");
     if (job.start) {
-      EndLocked(ToGrpcStatus(busy));
+      EndLocked(ToGrpcUnbounded(busy));
     } else {
       PushError(job.sequence, busy, a);
     }
@@ -309,8 +306,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
   std::shared_ptr<const Grid> grid;
   std::string adopted;
   if (job.start) {
-    absl::StatusOr<CoveragePlannerService::AdoptedPlan> plan =
-        service_->AdoptPlan(first, stop, tenant_tag_);
+    absl::StatusOr<DriveHost::AdoptedPlan> plan = host_->AdoptPlan(first, stop, tenant_tag_);
     status = plan.status();
     if (plan.ok()) {
       adopted = plan->plan_id;
@@ -327,14 +323,8 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     *request.mutable_obstacles() = seen;
     request.set_method(job.method != v1::REPLAN_METHOD_UNSPECIFIED ? job.method : first.method());
     request.set_seed(first.seed());
-    CallInfo call;
-    call.method = "Drive.Replan";
-    call.start = absl::Now();
-    call.request_id = absl::StrCat(session_id_, "/", job.sequence);
-    call.tenant_tag = tenant_tag_;
-    status = service_->RunReplan(call, request, stop, event.mutable_replan());
-    service_->RecordCall(
-        call, status, status.ok() ? ReplanDetail(event.replan()) : std::string(status.message()));
+    status = host_->Replan(absl::StrCat(session_id_, "/", job.sequence), tenant_tag_, request, stop,
+                           event.mutable_replan());
   }
   Actions a;
   {
@@ -342,7 +332,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     running_ = false;
     if (job.start) {
       if (!status.ok()) {
-        EndLocked(ToGrpcStatus(status));
+        EndLocked(ToGrpcUnbounded(status));
       } else {
         adopted_ = true;
         grid_ = grid;
@@ -350,7 +340,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
         Push(std::move(event), &a);
       }
     } else if (pending_.has_value()) {
-      service_->CountSuperseded();  // a newer observation waits: this result is stale
+      host_->CountSuperseded();  // a newer observation waits: this result is stale
     } else if (!status.ok()) {
       PushError(job.sequence, status, &a);
     } else {

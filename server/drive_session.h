@@ -4,8 +4,9 @@
 //
 // One DriveSession per call, on gRPC's callback API: reads, writes and the
 // end of the call are driven by gRPC's reactions and by solves that run on
-// the service's worker pool (never on a gRPC thread). At most one replan of a
-// session runs at a time. An observation that arrives while one runs cancels
+// the host's worker pool (never on a gRPC thread); the session reaches the
+// service only through DriveHost (server/drive_host.h). At most one replan of
+// a session runs at a time. An observation that arrives while one runs cancels
 // it (its StopToken) and waits: when the worker returns, the newest
 // observation is replanned with every obstacle the session has seen, so a
 // superseded observation loses nothing; its replan is simply not pushed.
@@ -39,10 +40,10 @@
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "planner/common/stop_token.h"
 #include "planner/grid/grid.h"
+#include "server/drive_host.h"
 
 namespace covplan {
 
-class CoveragePlannerService;
 class SessionRegistry;
 
 class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent> {
@@ -52,8 +53,8 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   // Most plans of a session that later messages may name.
   static constexpr size_t kMaxSessionPlans = 64;
 
-  DriveSession(CoveragePlannerService* service, grpc::CallbackServerContext* context,
-               SessionRegistry* registry, std::string session_id, std::string tenant_tag);
+  DriveSession(DriveHost* host, grpc::CallbackServerContext* context, SessionRegistry* registry,
+               std::string session_id, std::string tenant_tag);
 
   // Starts reading (after the registry admitted the session).
   void Start();
@@ -103,7 +104,7 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   // Finishes the call once no replan runs and nothing is being written.
   void CheckFinish(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
-  CoveragePlannerService* const service_;
+  DriveHost* const host_;
   grpc::CallbackServerContext* const context_;
   SessionRegistry* const registry_;
   const std::string session_id_;

@@ -141,6 +141,45 @@ std::vector<std::string> ValidateFlags() {
   return errors;
 }
 
+// The server's configuration from the (validated) flags.
+covplan::ServerConfig ConfigFromFlags() {
+  covplan::ServerConfig config;
+  config.address = absl::GetFlag(FLAGS_address);
+  config.port = absl::GetFlag(FLAGS_port);
+  config.metrics_address = absl::GetFlag(FLAGS_metrics_address);
+  config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
+  config.store_dir = absl::GetFlag(FLAGS_store_dir);
+  config.map_store = absl::GetFlag(FLAGS_map_store);
+  config.pg_conninfo = absl::GetFlag(FLAGS_pg_conninfo);
+  config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
+  config.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  config.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  config.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
+  config.token_file = absl::GetFlag(FLAGS_token_file);
+  // The port opens at once; health says NOT_SERVING until the store is indexed.
+  config.index_in_background = true;
+  covplan::ServiceOptions& service = config.service;
+  service.worker_threads = absl::GetFlag(FLAGS_threads);
+  service.max_queue = absl::GetFlag(FLAGS_max_queue);
+  service.cache_budget_bytes = static_cast<size_t>(absl::GetFlag(FLAGS_cache_mb)) << 20;
+  service.limits.plan_memory = absl::GetFlag(FLAGS_plan_memory);
+  service.default_budget_s = absl::GetFlag(FLAGS_default_budget_s);
+  service.deadline_margin = absl::Milliseconds(absl::GetFlag(FLAGS_deadline_margin_ms));
+  service.plan_ttl = absl::Seconds(absl::GetFlag(FLAGS_plan_ttl_s));
+  service.max_retained_plans = static_cast<size_t>(absl::GetFlag(FLAGS_max_retained_plans));
+  service.limits.max_image_bytes = absl::GetFlag(FLAGS_max_image_mb) << 20;
+  service.limits.max_map_pixels = absl::GetFlag(FLAGS_max_map_pixels);
+  service.limits.max_grid_cells = absl::GetFlag(FLAGS_max_grid_cells);
+  service.limits.max_ranks = absl::GetFlag(FLAGS_max_ranks);
+  service.limits.max_transition_bytes = absl::GetFlag(FLAGS_max_transition_mb) << 20;
+  service.limits.dense_transition_bytes = absl::GetFlag(FLAGS_dense_transition_mb) << 20;
+  service.max_request_time = absl::Seconds(absl::GetFlag(FLAGS_max_request_s));
+  // Room for the image plus YAML and the rest of the request.
+  config.max_message_bytes =
+      static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));
+  return config;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -211,41 +250,7 @@ int main(int argc, char** argv) {
   // of up to 8 per core: each arena keeps its own high-water mark.
   mallopt(M_ARENA_MAX, absl::GetFlag(FLAGS_threads) + 4);
 
-  covplan::ServerConfig config;
-  config.address = absl::GetFlag(FLAGS_address);
-  config.port = absl::GetFlag(FLAGS_port);
-  config.metrics_address = absl::GetFlag(FLAGS_metrics_address);
-  config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
-  config.store_dir = absl::GetFlag(FLAGS_store_dir);
-  config.map_store = absl::GetFlag(FLAGS_map_store);
-  config.pg_conninfo = absl::GetFlag(FLAGS_pg_conninfo);
-  config.drain_notice = absl::Seconds(absl::GetFlag(FLAGS_drain_notice_s));
-  config.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
-  config.tls_key_file = absl::GetFlag(FLAGS_tls_key);
-  config.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
-  config.token_file = absl::GetFlag(FLAGS_token_file);
-  // The port opens at once; health says NOT_SERVING until the store is indexed.
-  config.index_in_background = true;
-  covplan::ServiceOptions& service = config.service;
-  service.worker_threads = absl::GetFlag(FLAGS_threads);
-  service.max_queue = absl::GetFlag(FLAGS_max_queue);
-  service.cache_budget_bytes = static_cast<size_t>(absl::GetFlag(FLAGS_cache_mb)) << 20;
-  service.plan_memory = absl::GetFlag(FLAGS_plan_memory);
-  service.default_budget_s = absl::GetFlag(FLAGS_default_budget_s);
-  service.deadline_margin = absl::Milliseconds(absl::GetFlag(FLAGS_deadline_margin_ms));
-  service.plan_ttl = absl::Seconds(absl::GetFlag(FLAGS_plan_ttl_s));
-  service.max_retained_plans = static_cast<size_t>(absl::GetFlag(FLAGS_max_retained_plans));
-  service.limits.max_image_bytes = absl::GetFlag(FLAGS_max_image_mb) << 20;
-  service.limits.max_map_pixels = absl::GetFlag(FLAGS_max_map_pixels);
-  service.limits.max_grid_cells = absl::GetFlag(FLAGS_max_grid_cells);
-  service.limits.max_ranks = absl::GetFlag(FLAGS_max_ranks);
-  service.limits.max_transition_bytes = absl::GetFlag(FLAGS_max_transition_mb) << 20;
-  service.limits.dense_transition_bytes = absl::GetFlag(FLAGS_dense_transition_mb) << 20;
-  service.max_request_time = absl::Seconds(absl::GetFlag(FLAGS_max_request_s));
-  // Room for the image plus YAML and the rest of the request.
-  config.max_message_bytes =
-      static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));
-
+  const covplan::ServerConfig config = ConfigFromFlags();
   absl::StatusOr<std::unique_ptr<covplan::CovplanServer>> server =
       covplan::CovplanServer::Start(config);
   if (!server.ok()) {

@@ -19,8 +19,9 @@
 #include "client/remote.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "server/admission.h"
 #include "server/covplan_server.h"
-#include "server/service.h"
+#include "server/served_replies.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/test_maps.h"
 
@@ -513,7 +514,7 @@ TEST(ServedPlanReplyTest, TheCallsStatsOverrideTheStoredReply) {
   first.mutable_stats()->set_planning_ms(5.0);
   first.mutable_stats()->set_decomposition_cached(true);
   first.mutable_stats()->set_plan_source(v1::PLAN_SOURCE_CACHE_HIT);
-  std::shared_ptr<const CoveragePlannerService::ServedBody> body = ServedBodyFor(first);
+  std::shared_ptr<const ServedBody> body = ServedBodyFor(first);
   ASSERT_NE(body, nullptr);
   for (const auto& [ms, cached] : {std::pair{0.0, false}, std::pair{0.25, true}}) {
     v1::PlanResponse call;

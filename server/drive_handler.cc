@@ -1,0 +1,97 @@
+#include "server/drive_handler.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "server/grpc_status.h"
+#include "server/log.h"
+
+namespace covplan {
+namespace {
+
+// Ends a Drive call at once (draining, or too many sessions).
+class RefusedDrive final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent> {
+ public:
+  explicit RefusedDrive(const grpc::Status& status) { Finish(status); }
+  void OnDone() override { delete this; }
+};
+
+}  // namespace
+
+DriveHandler::DriveHandler(const ServiceOptions& options, ServerMetrics* metrics, CallGate* gate,
+                           SolveAdmission* admission, ReplanWork* work, ProgressLog* progress)
+    : options_(options),
+      metrics_(metrics),
+      gate_(gate),
+      admission_(admission),
+      work_(work),
+      progress_(progress),
+      sessions_(options.max_sessions, options.session_idle) {}
+
+grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* DriveHandler::Drive(
+    grpc::CallbackServerContext* context) {
+  // A session is not a unary call the drain waits for: StartDraining ends it.
+  const CallInfo call = gate_->StartStream(context, "Drive");
+  if (!call.auth.ok()) {
+    gate_->Record(call, call.auth);
+    return new RefusedDrive(ToGrpc(call.auth));
+  }
+  if (gate_->draining()) {
+    metrics_->RecordRequest("Drive", "UNAVAILABLE", 0.0);
+    return new RefusedDrive(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
+  }
+  auto* session = new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id),
+                                   call.tenant_tag);
+  if (!sessions_.Add(session)) {
+    session->Unref();
+    metrics_->RecordRequest("Drive", "RESOURCE_EXHAUSTED", 0.0);
+    LogLine("warn", "drive session refused",
+            {{"request_id", call.request_id}, {"detail", "too many sessions"}});
+    return new RefusedDrive(grpc::Status(
+        grpc::StatusCode::RESOURCE_EXHAUSTED,
+        absl::StrFormat("too many drive sessions (%d open, --max_sessions); retry later",
+                        options_.max_sessions)));
+  }
+  UpdateSessionGauge();
+  LogLine("info", "drive session started", {{"request_id", call.request_id}});
+  session->Start();
+  return session;
+}
+
+absl::StatusOr<DriveHost::AdoptedPlan> DriveHandler::AdoptPlan(const v1::DriveRequest& first,
+                                                               const StopToken& stop,
+                                                               const std::string& tenant_tag) {
+  return work_->AdoptPlan(first, stop, tenant_tag);
+}
+
+absl::Status DriveHandler::Replan(const std::string& request_id, const std::string& tenant_tag,
+                                  const v1::ReplanRequest& request, const StopToken& stop,
+                                  v1::ReplanResponse* response) {
+  CallInfo call;
+  call.method = "Drive.Replan";
+  call.start = absl::Now();
+  call.request_id = request_id;
+  call.tenant_tag = tenant_tag;
+  const absl::Status status = work_->RunReplan(call, request, stop, response);
+  gate_->Record(call, status,
+                status.ok() ? ReplanDetail(*response) : std::string(status.message()));
+  return status;
+}
+
+bool DriveHandler::SubmitSolve(std::function<void()> work) {
+  if (gate_->draining() || !admission_->Admit().ok()) return false;
+  SolveAdmission::Task task;
+  task.solve = std::move(work);
+  return admission_->Submit(std::move(task));
+}
+
+void DriveHandler::RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) {
+  progress_->Record(plan_id, progress);
+}
+
+void DriveHandler::CountSuperseded() { metrics_->drive_superseded().Increment(); }
+
+void DriveHandler::UpdateSessionGauge() { metrics_->drive_sessions().Set(sessions_.size()); }
+
+}  // namespace covplan

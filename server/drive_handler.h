@@ -1,0 +1,65 @@
+// The Drive call (a bidi stream per robot) and the service side of its
+// sessions: DriveHandler admits a session (the gate's token and drain
+// checks, the bound on open sessions) and is the DriveHost every session
+// talks to, adopting plans, replanning through ReplanWork under the solve
+// admission, and keeping progress for Resume.
+//
+//   DriveHandler drive(options, metrics, &gate, &admission, &work, &progress);
+//   return drive.Drive(context);  // from the service's override
+//   drive.EndAll();               // draining
+//
+// Thread-safety: all methods are thread-safe.
+#ifndef COVPLAN_SERVER_DRIVE_HANDLER_H_
+#define COVPLAN_SERVER_DRIVE_HANDLER_H_
+
+#include <functional>
+#include <string>
+
+#include "covplan/v1/covplan.grpc.pb.h"
+#include "server/admission.h"
+#include "server/call_gate.h"
+#include "server/drive_host.h"
+#include "server/drive_session.h"
+#include "server/metrics.h"
+#include "server/progress_log.h"
+#include "server/replan_work.h"
+#include "server/service_options.h"
+
+namespace covplan {
+
+class DriveHandler final : public DriveHost {
+ public:
+  // Every pointer outlives this.
+  DriveHandler(const ServiceOptions& options, ServerMetrics* metrics, CallGate* gate,
+               SolveAdmission* admission, ReplanWork* work, ProgressLog* progress);
+
+  grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* Drive(
+      grpc::CallbackServerContext* context);
+  // Ends every open session with UNAVAILABLE (the server is draining).
+  void EndAll() { sessions_.EndAll(); }
+  const SessionRegistry& sessions() const { return sessions_; }
+
+ private:
+  // DriveHost, for the sessions only.
+  absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first, const StopToken& stop,
+                                        const std::string& tenant_tag) override;
+  absl::Status Replan(const std::string& request_id, const std::string& tenant_tag,
+                      const v1::ReplanRequest& request, const StopToken& stop,
+                      v1::ReplanResponse* response) override;
+  bool SubmitSolve(std::function<void()> work) override;
+  void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) override;
+  void CountSuperseded() override;
+  void UpdateSessionGauge() override;
+
+  const ServiceOptions& options_;
+  ServerMetrics* const metrics_;
+  CallGate* const gate_;
+  SolveAdmission* const admission_;
+  ReplanWork* const work_;
+  ProgressLog* const progress_;
+  SessionRegistry sessions_;
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_SERVER_DRIVE_HANDLER_H_

@@ -1,0 +1,60 @@
+// What a Drive session (server/drive_session.h) needs from the service that
+// hosts it, and nothing more: adopt the plan its first message names, replan
+// on a worker, queue work under the solve admission, keep the robot's
+// progress, and count what the session's metrics show. The service side
+// implements it (server/drive_handler.h); tests may fake it.
+//
+//   class Host final : public DriveHost { ... };
+//   auto* session = new DriveSession(&host, context, &registry, "s-1", tenant_tag);
+//
+// Thread-safety: implementations must be thread-safe; sessions call them
+// from gRPC reactions and from workers.
+#ifndef COVPLAN_SERVER_DRIVE_HOST_H_
+#define COVPLAN_SERVER_DRIVE_HOST_H_
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "covplan/v1/covplan.pb.h"
+#include "planner/common/stop_token.h"
+#include "planner/grid/grid.h"
+
+namespace covplan {
+
+class DriveHost {
+ public:
+  // A plan named by a session's first message, found (plan_id) or rebuilt
+  // and retained (inline), with its grid.
+  struct AdoptedPlan {
+    std::string plan_id;
+    std::shared_ptr<const Grid> grid;
+  };
+
+  virtual ~DriveHost() = default;
+
+  virtual absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first,
+                                                const StopToken& stop,
+                                                const std::string& tenant_tag) = 0;
+  // Runs one replan of a session (on a worker), logged and counted as a
+  // "Drive.Replan" call with this request id.
+  virtual absl::Status Replan(const std::string& request_id, const std::string& tenant_tag,
+                              const v1::ReplanRequest& request, const StopToken& stop,
+                              v1::ReplanResponse* response) = 0;
+  // Runs `work` on the solve pool under the same admission bound as unary
+  // solves; false (and `work` dropped) when the server is full or draining.
+  virtual bool SubmitSolve(std::function<void()> work) = 0;
+  // The robot's latest progress on a plan, kept for Resume.
+  virtual void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) = 0;
+  // A replan whose result a newer observation made stale.
+  virtual void CountSuperseded() = 0;
+  // Sets the open-sessions gauge (a session ended).
+  virtual void UpdateSessionGauge() = 0;
+};
+
+}  // namespace covplan
+
+#endif  // COVPLAN_SERVER_DRIVE_HOST_H_

@@ -1,0 +1,358 @@
+#include "server/plan_handlers.h"
+
+#include <algorithm>
+#include <string>
+#include <utility>
+
+#include <grpcpp/impl/codegen/proto_utils.h>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "api/convert.h"
+#include "planner/common/status_macros.h"
+#include "planner/engine/plan_memory.h"
+#include "server/log.h"
+#include "server/map_sources.h"
+#include "server/not_found.h"
+#include "server/request_limits.h"
+#include "server/tenant_tokens.h"
+
+namespace covplan {
+namespace {
+
+// A Plan stopped by its deadline before a first plan is overload
+// (RESOURCE_EXHAUSTED), not a too-short deadline, when it spent more than this
+// share of its deadline in the queue.
+constexpr double kQueueShareForOverload = 0.1;
+
+bool IsStop(const absl::Status& status) {
+  return absl::IsDeadlineExceeded(status) || absl::IsCancelled(status);
+}
+
+// The status for work that stopped early: the client's cancellation wins,
+// otherwise the deadline was too short for even a first plan.
+absl::Status StoppedStatus(const absl::Status& status, const StopToken& cancel,
+                           const CallInfo& call, absl::Time started,
+                           absl::Duration max_request_time) {
+  if (cancel.cancelled())
+    return absl::CancelledError("call cancelled (by the client, or by the server's drain)");
+  // A call that spent a real share of its deadline waiting for a worker was
+  // refused by overload, not by its own deadline: say so with the code a
+  // client retries on (elsewhere).
+  if (call.deadline != absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
+    const absl::Duration waited = started - call.start;
+    if (waited > kQueueShareForOverload * (call.deadline - call.start)) {
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "server busy: the call waited %d ms of its %d ms deadline for a worker and had no time "
+          "left for a first plan; retry later or elsewhere",
+          absl::ToInt64Milliseconds(waited),
+          absl::ToInt64Milliseconds(call.deadline - call.start)));
+    }
+  }
+  if (call.deadline == absl::InfiniteFuture() && absl::IsDeadlineExceeded(status)) {
+    return absl::DeadlineExceededError(
+        absl::StrFormat("no plan within the server's limit of %g s per call without a deadline "
+                        "(--max_request_s) (%s); use a wider tool or a smaller map",
+                        absl::ToDoubleSeconds(max_request_time), status.message()));
+  }
+  if (absl::IsDeadlineExceeded(status) || call.deadline != absl::InfiniteFuture()) {
+    return absl::DeadlineExceededError(
+        absl::StrFormat("deadline of %d ms too short for a first plan (%s)",
+                        absl::ToInt64Milliseconds(call.deadline - call.start), status.message()));
+  }
+  return status;
+}
+
+}  // namespace
+
+PlanHandlers::PlanHandlers(const ServiceOptions& options, MapRepository* store,
+                           ServerMetrics* metrics, const PlanningEngine* engine, CallGate* gate,
+                           SolveAdmission* admission, ServedReplies* served, PlanArchive* archive,
+                           WorkerPool* warm_pool, StopToken background_stop)
+    : options_(options),
+      store_(store),
+      metrics_(metrics),
+      engine_(engine),
+      gate_(gate),
+      admission_(admission),
+      served_(served),
+      archive_(archive),
+      warm_pool_(warm_pool),
+      background_stop_(std::move(background_stop)) {}
+
+void PlanHandlers::WarmInBackground(const MapSource& source, PlanRequest request) {
+  if (gate_->draining()) return;
+  const bool queued = warm_pool_->TrySubmit([this, source, request]() mutable {
+    const absl::Time start = absl::Now();
+    request.common.stop = background_stop_.WithEarlierDeadline(start + options_.max_request_time);
+    const absl::Status built = engine_->Prepare(source, request);
+    LogLine(built.ok() ? "info" : "warn", "background artifacts finished",
+            {{"map", source.map_id.substr(0, 12)},
+             {"tool_m", absl::StrFormat("%g", request.common.robot.tool_width_m)},
+             {"ms", absl::StrFormat("%.1f", absl::ToDoubleMilliseconds(absl::Now() - start))},
+             {"result", built.ok() ? "cached" : std::string(built.message())}});
+  });
+  if (!queued) {
+    LogLine("warn", "background artifacts dropped: queue full",
+            {{"map", source.map_id.substr(0, 12)}});
+  }
+}
+
+absl::StatusOr<PlanRequest> PlanHandlers::EngineRequestFor(const CallInfo& call,
+                                                           const v1::PlanRequest& request,
+                                                           const StopToken& cancel,
+                                                           absl::Time start) const {
+  if (admission_->drain_cut())
+    return absl::UnavailableError("server is shutting down; retry on another");
+  if (cancel.ShouldStop()) return absl::CancelledError("call cancelled before it started");
+  ASSIGN_OR_RETURN(PlanRequest plan_request, PlanRequestFromProto(request));
+  CommonOptions& options = plan_request.common;
+
+  // The budget: the request's time limit (or the server default), and never
+  // past the call's deadline minus the margin kept for sending the reply.
+  double budget_s = request.time_limit_s() > 0 ? request.time_limit_s() : options_.default_budget_s;
+  StopToken stop = cancel;
+  if (call.deadline != absl::InfiniteFuture()) {
+    const absl::Time reply_by = call.deadline - options_.deadline_margin;
+    if (reply_by <= start && call.start + options_.deadline_margin < call.deadline) {
+      // The budget was there on arrival and went into the queue: overload.
+      return absl::ResourceExhaustedError(absl::StrFormat(
+          "server busy: the call waited %d ms for a worker and has no time left to plan",
+          absl::ToInt64Milliseconds(start - call.start)));
+    }
+    if (reply_by <= start) {
+      return absl::DeadlineExceededError(
+          absl::StrFormat("deadline of %d ms leaves no time to plan",
+                          absl::ToInt64Milliseconds(call.deadline - call.start)));
+    }
+    stop = cancel.WithEarlierDeadline(reply_by);
+    budget_s = std::min(budget_s, absl::ToDoubleSeconds(reply_by - start));
+  } else {
+    stop = cancel.WithEarlierDeadline(start + options_.max_request_time);
+  }
+  options.time_limit_s = std::max(budget_s, 1e-3);
+  options.stop = stop;
+  return plan_request;
+}
+
+absl::StatusOr<MapSource> PlanHandlers::PlanMapSource(const CallInfo& call,
+                                                      const v1::PlanRequest& request) {
+  std::string map_id;
+  std::shared_ptr<const v1::Map> inline_map;
+  switch (request.map_ref_case()) {
+    case v1::PlanRequest::kMapId:
+      RETURN_IF_ERROR(ValidateMapId(request.map_id()));
+      map_id = request.map_id();
+      if (!OwnsMap(call.tenant_tag, map_id)) return MapNotFound(map_id);
+      // A deleted map, or one found damaged, is not planned from the cache.
+      if (absl::Status s = store_->Check(map_id); !s.ok()) {
+        return absl::IsNotFound(s) ? MapNotFound(map_id) : s;
+      }
+      break;
+    case v1::PlanRequest::kMap:
+      map_id = ComputeMapId(request.map());
+      inline_map = std::make_shared<const v1::Map>(request.map());
+      break;
+    default:
+      return absl::InvalidArgumentError("PlanRequest needs map_id or an inline map");
+  }
+  return MapSourceFor(store_, options_.limits, map_id, inline_map);
+}
+
+std::shared_ptr<const ServedBody> PlanHandlers::ServedReply(
+    const std::string& tenant_tag, const std::shared_ptr<const RememberedPlan>& entry) {
+  std::optional<ServedReplies::Served> served = served_->Find(tenant_tag, entry);
+  if (!served.has_value()) return nullptr;
+  // Expired from the retained plans (GetPlan would not find it): a new id.
+  if (archive_->Get(served->plan_id) == nullptr) return nullptr;
+  return served->reply;
+}
+
+absl::Status PlanHandlers::RunPlan(const CallInfo& call, const v1::PlanRequest& request,
+                                   const StopToken& cancel, v1::PlanResponse* response,
+                                   std::shared_ptr<const ServedBody>* served) {
+  const absl::Time start = absl::Now();
+  ASSIGN_OR_RETURN(PlanRequest plan_request, EngineRequestFor(call, request, cancel, start));
+  ASSIGN_OR_RETURN(const MapSource source, PlanMapSource(call, request));
+  const std::string& map_id = source.map_id;
+  absl::StatusOr<EngineResult> result = engine_->Plan(source, plan_request);
+  if (!result.ok()) {
+    if (IsStop(result.status()) && !cancel.cancelled() && call.deadline != absl::InfiniteFuture()) {
+      // Cut off by this call's deadline: finish the artifacts in the
+      // background so the next call finds them cached. (A call without a
+      // deadline that hit --max_request_s already had that long.)
+      WarmInBackground(source, plan_request);
+    }
+    if (IsStop(result.status()) && admission_->drain_cut()) {
+      return absl::UnavailableError(
+          "server shut down before a first plan was found; retry on another");
+    }
+    return IsStop(result.status())
+               ? StoppedStatus(result.status(), cancel, call, start, options_.max_request_time)
+               : result.status();
+  }
+  if (result->answered_by != nullptr) {
+    if (std::shared_ptr<const ServedBody> reply =
+            ServedReply(call.tenant_tag, result->answered_by)) {
+      *served = std::move(reply);
+      response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
+      response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
+      RecordPlanSolve(start, result->plan.stats);
+      return absl::OkStatus();
+    }
+  }
+  auto retained = std::make_shared<RetainedPlan>();
+  retained->plan_id = NewPlanId(call.tenant_tag);
+  retained->map_id = map_id;
+  retained->plan = std::move(result->plan);
+  retained->area = std::move(result->area);
+  retained->request = std::move(plan_request);
+  retained->request.common.stop = StopToken();  // the call's token ends with the call
+  RetainedPlanToProto(*retained, response);
+  if (admission_->drain_cut() && response->termination().limit() == v1::LIMIT_CANCELLED) {
+    response->mutable_termination()->set_detail(absl::StrCat(
+        "cut short by the server's drain (shutting down); ", response->termination().detail()));
+  }
+  if (request.map_ref_case() == v1::PlanRequest::kMapId) archive_->Persist(request, *response);
+  RecordPlanSolve(start, retained->plan.stats);
+  archive_->Put(std::move(retained));
+  archive_->PublishRetainedCount();
+  // Only plans the store keeps too: a repeated hit is neither retained nor
+  // persisted again, so its id must stay resolvable (inline maps are not).
+  if (result->answered_by != nullptr && request.map_ref_case() == v1::PlanRequest::kMapId) {
+    served_->Remember(call.tenant_tag, *result, *response);
+  }
+  return absl::OkStatus();
+}
+
+bool PlanHandlers::ServeRecalledHit(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
+                                    const v1::PlanRequest& request, const StopToken& cancel,
+                                    grpc::ByteBuffer* response_bytes) {
+  const absl::Time start = absl::Now();
+  absl::StatusOr<PlanRequest> plan_request = EngineRequestFor(call, request, cancel, start);
+  if (!plan_request.ok()) return false;
+  absl::StatusOr<MapSource> source = PlanMapSource(call, request);
+  if (!source.ok()) return false;
+  absl::StatusOr<std::optional<Recalled>> recalled = engine_->Recall(*source, *plan_request);
+  if (!recalled.ok() || !recalled->has_value()) return false;
+  std::shared_ptr<const ServedBody> served = ServedReply(call.tenant_tag, (*recalled)->entry);
+  if (served == nullptr) return false;
+  // As RunPlan answers a repeated hit: the served bytes, then this call's stats.
+  v1::PlanResponse response;
+  response.mutable_stats()->set_planning_ms((*recalled)->lookup_ms);
+  response.mutable_stats()->set_decomposition_cached(true);
+  PlanStats solve;  // what the solve metrics read
+  solve.plan_source = PlanOrigin::kCacheHit;
+  solve.tour_cut_short = (*recalled)->entry->plan.stats.tour_cut_short;
+  RecordPlanSolve(start, solve, /*queued=*/false);
+  metrics_->hits_without_worker().Increment();
+  const std::string detail = absl::StrCat(served->detail, " cached=1");
+  gate_->Finish(reactor, call, SerializePlanReply(response, std::move(served), response_bytes),
+                detail);
+  return true;
+}
+
+void PlanHandlers::RecordPlanSolve(absl::Time start, const PlanStats& stats, bool queued) {
+  const int64_t solve_us = absl::ToInt64Microseconds(absl::Now() - start);
+  metrics_->RecordSolve(solve_us * 1e-6, stats.tour_cut_short);
+  metrics_->RecordPlanSource(PlanOriginName(stats.plan_source));
+  if (!queued) return;
+  admission_->RecordPlanTime(absl::Microseconds(solve_us),
+                             stats.plan_source == PlanOrigin::kCacheHit);
+}
+
+grpc::ServerUnaryReactor* PlanHandlers::Plan(grpc::CallbackServerContext* context,
+                                             const grpc::ByteBuffer* request_bytes,
+                                             grpc::ByteBuffer* response_bytes) {
+  auto* reactor = new CancellableReactor();
+  const CallInfo call = gate_->Start(context, "Plan");
+  // Parsed first, as gRPC parses the other methods' requests before their
+  // handlers (and their auth checks) run.
+  auto request = std::make_shared<v1::PlanRequest>();
+  {
+    grpc::ByteBuffer bytes = *request_bytes;  // shares the slices; Deserialize consumes it
+    if (!grpc::SerializationTraits<v1::PlanRequest>::Deserialize(&bytes, request.get()).ok()) {
+      gate_->Finish(reactor, call,
+                    absl::InvalidArgumentError(absl::StrCat(
+                        "request is not a valid ", v1::PlanRequest::descriptor()->full_name(),
+                        " protobuf message")));
+      return reactor;
+    }
+  }
+  if (!gate_->Admit(reactor, call, *request, WhileDraining::kRefuse)) return reactor;
+  // The request's bytes, tagged with the tenant: a repeat of a request that
+  // was answered from memory is expected to be answered from memory again.
+  const std::optional<uint64_t> hit_key =
+      ServedReplies::HitKey(call.tenant_tag, *request, *request_bytes);
+  const bool likely_hit = hit_key.has_value() && served_->IsHitRequest(*hit_key);
+  // A repeat whose reply was served before takes microseconds: answered
+  // here, it neither waits behind searches nor costs a thread hand-off.
+  if (likely_hit && ServeRecalledHit(reactor, call, *request, reactor->cancel(), response_bytes)) {
+    return reactor;
+  }
+  if (absl::Status admitted = admission_->AdmitPlan(call, likely_hit); !admitted.ok()) {
+    gate_->Finish(reactor, call, admitted);
+    return reactor;
+  }
+  auto outcome = std::make_shared<Outcome>();
+  SolveAdmission::Task task;
+  task.solve = [this, reactor, call, request, outcome] {
+    admission_->UpdateQueueGauge();
+    outcome->status =
+        RunPlan(call, *request, reactor->cancel(), &outcome->response, &outcome->served);
+  };
+  task.reply = [this, reactor, call, hit_key, outcome, response_bytes] {
+    ReplyPlan(reactor, call, hit_key, outcome.get(), response_bytes);
+  };
+  task.cut_short = reactor->cancel();
+  task.likely_hit = likely_hit;
+  const bool queued = admission_->Submit(std::move(task));
+  admission_->UpdateQueueGauge();
+  if (!queued) gate_->Finish(reactor, call, admission_->Full());
+  return reactor;
+}
+
+void PlanHandlers::ReplyPlan(CancellableReactor* reactor, const CallInfo& call,
+                             std::optional<uint64_t> hit_key, Outcome* outcome,
+                             grpc::ByteBuffer* response_bytes) {
+  absl::Status status = outcome->status;
+  const v1::PlanResponse& response = outcome->response;
+  if (status.ok() && hit_key.has_value()) {
+    // Remembered while it is answered from memory; forgotten once it is
+    // not (the plan or its map was evicted or deleted).
+    served_->NoteHitRequest(
+        *hit_key,
+        outcome->served != nullptr || response.stats().plan_source() == v1::PLAN_SOURCE_CACHE_HIT);
+  }
+  std::string detail;
+  if (status.ok()) {
+    detail =
+        absl::StrCat(outcome->served != nullptr ? outcome->served->detail : PlanDetail(response),
+                     " cached=", response.stats().decomposition_cached() ? 1 : 0);
+    status = SerializePlanReply(response, std::move(outcome->served), response_bytes);
+  }
+  gate_->Finish(reactor, call, status, detail);
+  admission_->TrimMemoryIfIdle(absl::Now() - call.start);
+}
+
+grpc::ServerUnaryReactor* PlanHandlers::GetPlan(grpc::CallbackServerContext* context,
+                                                const v1::GetPlanRequest* request,
+                                                v1::PlanResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  CallInfo call;
+  if (!gate_->Open(context, "GetPlan", reactor, *request, WhileDraining::kServe, &call)) {
+    return reactor;
+  }
+  std::shared_ptr<const RetainedPlan> plan =
+      OwnsPlan(call.tenant_tag, request->plan_id()) ? archive_->Get(request->plan_id()) : nullptr;
+  archive_->PublishRetainedCount();
+  if (plan == nullptr) {
+    gate_->Finish(reactor, call, PlanNotFound(request->plan_id()));
+    return reactor;
+  }
+  RetainedPlanToProto(*plan, response);  // in memory, no blocking
+  gate_->Finish(reactor, call, absl::OkStatus(), QuotePrefix(request->plan_id()));
+  return reactor;
+}
+
+}  // namespace covplan

@@ -1,0 +1,22 @@
+#include "server/service_options.h"
+
+namespace covplan {
+
+absl::Status ServiceOptions::Validate() const {
+  if (absl::Status s = limits.Validate(); !s.ok()) return s;
+  if (worker_threads < 1) return absl::InvalidArgumentError("worker_threads must be >= 1");
+  if (max_queue < 0) return absl::InvalidArgumentError("max_queue must be >= 0");
+  if (!(default_budget_s > 0)) return absl::InvalidArgumentError("default_budget_s must be > 0");
+  if (deadline_margin < absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("deadline_margin must be >= 0");
+  }
+  if (max_request_time <= absl::ZeroDuration()) {
+    return absl::InvalidArgumentError("max_request_time must be > 0");
+  }
+  if (max_sessions < 0) return absl::InvalidArgumentError("max_sessions must be >= 0");
+  if (session_idle <= absl::ZeroDuration())
+    return absl::InvalidArgumentError("session_idle must be > 0");
+  return absl::OkStatus();
+}
+
+}  // namespace covplan
