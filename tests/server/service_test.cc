@@ -16,6 +16,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "api/convert.h"
 #include "client/remote.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
