@@ -302,6 +302,17 @@ absl::StatusOr<LpSolution> SolveWithin(LinearProgram& lp, const StopToken& stop,
 
 }  // namespace
 
+int64_t Ilp1ColumnEstimate(const Grid& w) {
+  int64_t cols = 6 * w.CountFree();
+  for (Orientation o : {Orientation::kHorizontal, Orientation::kVertical}) {
+    ForEachRun(w, o, [&](const std::vector<CellIndex>& run) {
+      const int64_t n = static_cast<int64_t>(run.size());
+      cols += n * (n + 1) / 2;
+    });
+  }
+  return cols;
+}
+
 int64_t CountNewRanks(const std::vector<Rank>& ranks, const std::vector<Rank>& old_ranks) {
   std::vector<RankKey> old;
   old.reserve(old_ranks.size());

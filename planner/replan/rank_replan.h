@@ -82,6 +82,11 @@ struct RankReplanResult {
 absl::StatusOr<RankReplanResult> RankReplan(const RankReplanInput& input, RankReplanMethod method,
                                             const StopToken& stop);
 
+// The size of ILP-1 on W, without building it, for choosing between the two
+// programs: 6 per free cell plus one z per pair of cells of every maximal run
+// (n (n + 1) / 2 for a run of n), both orientations.
+int64_t Ilp1ColumnEstimate(const Grid& w);
+
 // The number of ranks in `ranks` that are not identical to one of `old_ranks`.
 int64_t CountNewRanks(const std::vector<Rank>& ranks, const std::vector<Rank>& old_ranks);
 

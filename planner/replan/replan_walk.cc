@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "absl/strings/str_format.h"
+#include "planner/common/status_macros.h"
 #include "planner/tour/grid_paths.h"
 #include "planner/tour/path_timing.h"
 
@@ -160,15 +161,33 @@ std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
   return legs;
 }
 
+bool NewlyClosed(const Grid& old_drive, const Grid& drive, int r, int c) {
+  if (!drive.InBounds(r, c)) return true;
+  return old_drive.IsFree(r, c) && !drive.IsFree(r, c);
+}
+
+absl::StatusOr<bool> AppendRoute(const Grid& drive, Point2 from, const Pose2& to,
+                                 const StopToken& stop, std::vector<Waypoint>* path) {
+  if (std::hypot(from.x - to.x, from.y - to.y) < kMinSegmentM) return true;
+  ASSIGN_OR_RETURN(CellIndex a, JoinCell(drive, Pose2{from.x, from.y, 0}, "start"));
+  ASSIGN_OR_RETURN(CellIndex b, JoinCell(drive, to, "end"));
+  AnyAngleSearch search(drive);
+  if (!search.Run(a, stop)) return false;
+  std::vector<Point2> pts;
+  for (const CellIndex& cell : search.PathTo(b)) pts.push_back(drive.CellCenter(cell));
+  pts.push_back({to.x, to.y});
+  Point2 at = from;
+  for (const Point2& p : pts) {
+    if (std::hypot(p.x - at.x, p.y - at.y) < kMinSegmentM) continue;
+    path->push_back({p.x, p.y, std::atan2(p.y - at.y, p.x - at.x), SegmentKind::kTransition, -1});
+    at = p;
+  }
+  return true;
+}
+
 Walk GreedyWalk(const Grid& old_drive, const Grid& drive, const std::vector<Leg>& legs,
                 Point2 robot, double heading) {
-  // A cell the walk must not touch: free on the old drive grid, not on the
-  // new one (a new obstacle, or cut off by one). Cells that were never free
-  // (a dock's cell, which the old path left by its join move) stay open.
-  auto closed = [&](int r, int c) {
-    if (!drive.InBounds(r, c)) return true;
-    return old_drive.IsFree(r, c) && !drive.IsFree(r, c);
-  };
+  auto closed = [&](int r, int c) { return NewlyClosed(old_drive, drive, r, c); };
   Walk w;
   w.swept.assign(static_cast<size_t>(drive.size()), 0);
   w.path.push_back({robot.x, robot.y, heading, SegmentKind::kStart, -1});

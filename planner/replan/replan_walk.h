@@ -1,7 +1,8 @@
 // The geometry of replanning (internal to planner/replan): where the robot is
 // on its plan, which cells the new obstacles block, the remainder of the old
-// path as legs, and the greedy walk that drives that remainder with a detour
-// around every blocked stretch (finishing interrupted ranks after it).
+// path as legs, the greedy walk that drives that remainder with a detour
+// around every blocked stretch (finishing interrupted ranks after it), and
+// the route over the new drive grid that joins a path to a pose.
 //
 // Thread-safety: plain functions over immutable inputs.
 #ifndef COVPLAN_PLANNER_REPLAN_REPLAN_WALK_H_
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "planner/common/stop_token.h"
 #include "planner/engine/site.h"
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"
@@ -48,6 +50,19 @@ std::vector<Leg> RemainingLegs(const CoveragePlan& plan, const Located& at,
                                std::vector<uint8_t>* covered);
 
 using ::covplan::SegmentTouches;  // planner/tour/grid_paths.h
+
+// A cell a replanned path must not touch: free on the old drive grid, not on
+// the new one (a new obstacle, or cut off by one), or off the grid. Cells
+// that were never free (a dock's cell, which the old path left by its join
+// move) stay open.
+bool NewlyClosed(const Grid& old_drive, const Grid& drive, int r, int c);
+
+// Appends transitions from `from` to `to` over `drive` (an any-angle search
+// between the cells both join the grid at); false when `stop` ended the
+// search. InvalidArgument (JoinCell's, naming "start" or "end") when an end
+// is neither in nor next to a free cell.
+absl::StatusOr<bool> AppendRoute(const Grid& drive, Point2 from, const Pose2& to,
+                                 const StopToken& stop, std::vector<Waypoint>* path);
 
 // The greedy walk over `legs`: drives the old path and, around every
 // stretch that touches a cell the new obstacles closed (free on old_drive,

@@ -13,7 +13,7 @@
 //   ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o));
 //   r.total_time_s, r.stoppage_s, r.covered_free_area_ratio, r.driven ...
 //   ASSIGN_OR_RETURN(OfflineBound lb, OfflineLowerBound(truth, o.plan));  // OARP knowing
-//   everything
+//   everything (offline_bound.h, included here)
 //
 // Battery plans (options.plan.battery): the plan is split into charge
 // cycles on the known map (planner/energy; station legs are ordinary path
@@ -30,6 +30,11 @@
 // below_reserve report a cycle that no longer fits as it is (the simulated
 // robot drives on with a negative charge rather than stop, so the whole run
 // stays comparable). The station must lie in a free cell of the true map.
+//
+// Simulate sets the run up (the true grid, what the sensor can find, the
+// plan source) and measures the result against the true map; the run itself
+// is drive.h, its sensor sensor.h, the references it is compared with
+// offline_bound.h.
 //
 // Time is simulated; only the replans' compute time is measured (wall
 // clock), so stoppage, and with it the plans Algorithm 1 picks, varies a
@@ -51,6 +56,7 @@
 #include "planner/plan/coverage_plan.h"
 #include "planner/replan/replanner.h"
 #include "planner/sim/battery_run.h"
+#include "planner/sim/offline_bound.h"
 
 namespace covplan {
 
@@ -147,29 +153,6 @@ class PlanSource {
 absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
                                           const SimulationOptions& options,
                                           PlanSource* source = nullptr);
-
-// The offline lower bound of the evaluation: the plan (options.planner, with
-// options.battery when given) of the true map, as if the robot had known it
-// from the start.
-struct OfflineBound {
-  double duration_s = 0.0;  // the plan's estimated duration
-  double covered_free_area_ratio = 0.0;
-  int64_t num_ranks = 0;
-  // Battery plans: the offline plan's charge cycles (duration_s has no
-  // recharge time in it; add recharge_s for each).
-  int charge_cycles = 0;
-};
-absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth,
-                                               const PlanOptions& options);
-
-// The true map as the simulation sees it: `known` with every cell that is
-// free on the known grid but blocked on the true grid filled (grid of
-// options.robot.tool_width_m). OfflineLowerBound of this map is the bound of
-// the cell model the replanner works in (new thin obstacles ignored, as the
-// simulated robot ignores them). InvalidArgument as Simulate for maps that
-// do not match.
-absl::StatusOr<OccupancyMap> CellLevelTruth(const OccupancyMap& known, const OccupancyMap& truth,
-                                            const PlanOptions& options);
 
 }  // namespace covplan
 

@@ -472,5 +472,31 @@ TEST(RankReplan, TimingOnOfficeGrid) {
   }
 }
 
+// The estimate against a count of its own: 6 per free cell, and n (n + 1) / 2
+// for every maximal run of n linked free cells, walked cell by cell through
+// LeftLinked / BelowLinked.
+TEST(Ilp1ColumnEstimate, CountsCellsAndPairsOfEveryRun) {
+  for (uint32_t seed = 1; seed <= 20; ++seed) {
+    const Grid w = RandomWalledGrid(9, 13, 0.8, 0.15, seed);
+    int64_t expected = 6 * w.CountFree();
+    for (const bool horizontal : {true, false}) {
+      for (int outer = 0; outer < (horizontal ? w.rows() : w.cols()); ++outer) {
+        int64_t run = 0;
+        for (int inner = 0; inner < (horizontal ? w.cols() : w.rows()); ++inner) {
+          const int r = horizontal ? outer : inner, c = horizontal ? inner : outer;
+          const bool linked = horizontal ? w.LeftLinked(r, c) : w.BelowLinked(r, c);
+          if (!w.IsFree(r, c) || !linked) expected += run * (run + 1) / 2, run = 0;
+          if (w.IsFree(r, c)) ++run;
+        }
+        expected += run * (run + 1) / 2;
+      }
+    }
+    EXPECT_EQ(Ilp1ColumnEstimate(w), expected) << "seed " << seed;
+  }
+  // One row of three free cells: 18 + 6 (the row) + 3 (three vertical runs of one).
+  const Grid row(1, 3, 1.0, {0.0, 0.0}, std::vector<uint8_t>{1, 1, 1});
+  EXPECT_EQ(Ilp1ColumnEstimate(row), 27);
+}
+
 }  // namespace
 }  // namespace covplan

@@ -1,0 +1,437 @@
+#include "planner/sim/drive.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "planner/common/status_macros.h"
+#include "planner/sim/battery_run.h"
+#include "planner/tour/path_timing.h"
+
+namespace covplan::sim_internal {
+namespace {
+
+Point2 Lerp(Point2 a, Point2 b, double t) { return {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)}; }
+Point2 At(const Waypoint& w) { return {w.x, w.y}; }
+double Dist(Point2 a, Point2 b) { return std::hypot(b.x - a.x, b.y - a.y); }
+
+double Param(Point2 a, Point2 b, Point2 p) {
+  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+  if (len2 <= 0.0) return 0.0;
+  return std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0);
+}
+
+// Distance covered t seconds into a rest-to-rest straight of `length` m
+// (the profile behind RobotModel::StraightTime).
+double DistanceAt(const RobotModel& robot, double length, double t) {
+  const double total = robot.StraightTime(length);
+  if (t >= total) return length;
+  if (t <= 0.0) return 0.0;
+  const double a = robot.acceleration_mps2, v = robot.max_speed_mps;
+  const double ramp_t = std::min(v / a, total / 2);  // accelerating, and braking at the end
+  if (t <= ramp_t) return 0.5 * a * t * t;
+  if (t >= total - ramp_t) return length - 0.5 * a * (total - t) * (total - t);
+  return 0.5 * a * ramp_t * ramp_t + v * (t - ramp_t);
+}
+
+// Calls f(cell) for every grid cell whose interior the segment a -> b passes
+// through, in order, until f returns true. Points on cell borders belong to
+// no cell: a segment through a corner does not enter the two cells beside it,
+// one along a border enters neither side.
+template <typename F>
+bool TraverseCells(const Grid& g, Point2 a, Point2 b, F f) {
+  const double s = g.cell_size();
+  const double x0 = (a.x - g.origin().x) / s, y0 = (a.y - g.origin().y) / s;
+  const double dx = (b.x - a.x) / s, dy = (b.y - a.y) / s;
+  constexpr double kEps = 1e-9;
+  if (std::abs(dx) < kEps && std::abs(dy) < kEps) return false;
+  auto on_line = [&](double v) { return std::abs(v - std::round(v)) < kEps; };
+  if ((std::abs(dx) < kEps && on_line(x0)) || (std::abs(dy) < kEps && on_line(y0))) return false;
+  auto first = [&](double v, double d) {
+    return static_cast<int>(d > 0   ? std::floor(v + kEps)
+                            : d < 0 ? std::ceil(v - kEps) - 1
+                                    : std::floor(v));
+  };
+  int cx = first(x0, dx), cy = first(y0, dy);
+  const int sx = dx > 0 ? 1 : -1, sy = dy > 0 ? 1 : -1;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double step_x = std::abs(dx) >= kEps ? 1.0 / std::abs(dx) : kInf;
+  const double step_y = std::abs(dy) >= kEps ? 1.0 / std::abs(dy) : kInf;
+  double next_x = step_x < kInf ? (sx > 0 ? cx + 1 - x0 : x0 - cx) * step_x : kInf;
+  double next_y = step_y < kInf ? (sy > 0 ? cy + 1 - y0 : y0 - cy) * step_y : kInf;
+  for (int k = 0; k < 4 * (g.rows() + g.cols()) + 4; ++k) {
+    if (f(CellIndex{cy, cx})) return true;
+    const double next = std::min(next_x, next_y);
+    if (next >= 1.0 - kEps) break;
+    if (std::abs(next_x - next_y) < kEps) {  // through a corner: diagonally on
+      cx += sx, cy += sy, next_x += step_x, next_y += step_y;
+    } else if (next_x < next_y) {
+      cx += sx, next_x += step_x;
+    } else {
+      cy += sy, next_y += step_y;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void SimulatedDrive::Observe(CellIndex c) {
+  const int64_t i = Index(c);
+  if (found_[i]) return;
+  found_[i] = pending_flag_[i] = 1;
+  pending_.push_back(c);
+  pending_checked_ = false;
+  r_.obstacles_found.push_back(c);
+}
+
+void SimulatedDrive::Sense() {
+  for (const CellIndex& c : sensor_.Scan(pos_, candidate_, found_)) Observe(c);
+}
+
+template <typename F>
+bool SimulatedDrive::ScanRemaining(F f) const {
+  const double step = grid_.cell_size() / 8.0;
+  for (int i = seg_; i < static_cast<int>(path().size()); ++i) {
+    const Point2 a = i == seg_ ? pos_ : At(path()[i - 1]), b = At(path()[i]);
+    const int n = std::max(1, static_cast<int>(std::ceil(Dist(a, b) / step)));
+    for (int k = 0; k <= n; ++k) {
+      if (f(Lerp(a, b, static_cast<double>(k) / n), i, k, n)) return true;
+    }
+  }
+  return false;
+}
+
+// Pending cells on the path still to drive or among the cells still to sweep.
+bool SimulatedDrive::PendingOnPath() const {
+  const bool on_path = ScanRemaining([&](Point2 p, int, int, int) {
+    const CellIndex c = grid_.CellAt(p);
+    return grid_.InBounds(c.row, c.col) && pending_flag_[Index(c)] != 0;
+  });
+  if (on_path) return true;
+  for (const CoverageSweep& s : plan_.plan.sweeps) {
+    if (s.waypoint < seg_) continue;
+    for (const CellIndex& c : s.cells) {
+      if (pending_flag_[Index(c)] && !swept_[Index(c)]) return true;
+    }
+  }
+  return false;
+}
+
+// Drive time (robot model) from the robot to the first point where the path
+// enters a flagged cell; infinity when it never does.
+double SimulatedDrive::TimeToFirstEntry(const std::vector<uint8_t>& flags) const {
+  double time = 0.0, last_d = 0.0;
+  int last_segment = -1;
+  bool hit = false;
+  ScanRemaining([&](Point2 p, int i, int k, int n) {
+    const Point2 a = i == seg_ ? pos_ : At(path()[i - 1]);
+    if (i != last_segment) {
+      if (last_segment >= 0) time += robot_.StraightTime(last_d);
+      if (i != seg_ || d_seg_ <= 0.0)
+        time += robot_.TurnTime(HeadingChange(path()[i - 1].theta, path()[i].theta));
+      last_segment = i;
+    }
+    const CellIndex c = grid_.CellAt(p);
+    if (grid_.InBounds(c.row, c.col) && flags[Index(c)]) return hit = true;
+    last_d = Dist(a, p);
+    return false;
+  });
+  if (!hit) return std::numeric_limits<double>::infinity();
+  return time + robot_.StraightTime(last_d);
+}
+
+void SimulatedDrive::PushDriven(const Waypoint& w) {
+  std::vector<Waypoint>& d = r_.driven;
+  // A replan that continues straight on does not stop the robot.
+  if (junction_ && d.size() >= 2 && d.back().kind == w.kind &&
+      HeadingChange(d.back().theta, w.theta) <= kTurnEpsilonRad) {
+    d.back() = w;
+  } else {
+    d.push_back(w);
+  }
+  junction_ = false;
+}
+
+void SimulatedDrive::IndexSweeps() {
+  sweep_of_.assign(path().size(), -1);
+  for (size_t k = 0; k < plan_.plan.sweeps.size(); ++k) {
+    const int w = plan_.plan.sweeps[k].waypoint;
+    if (w >= 0 && w < static_cast<int>(sweep_of_.size())) sweep_of_[w] = static_cast<int>(k);
+  }
+}
+
+// Where the robot is, for Replan: a micrometre back along the way it came,
+// so that a robot standing on a cell border is in the free cell it came from
+// (the replanner takes the cell containing the position as the robot's).
+RobotProgress SimulatedDrive::Progress() const {
+  RobotProgress at;
+  at.waypoint = d_seg_ > 0.0 || seg_ == 1 ? seg_ : seg_ - 1;
+  at.position = pos_;
+  if (d_seg_ > 0.0 || seg_ > 1) {
+    const Point2 a = At(path()[at.waypoint - 1]), b = At(path()[at.waypoint]);
+    const double len = Dist(a, b);
+    constexpr double kBack = 1e-6;
+    if (len > 2 * kBack)
+      at.position = Point2{pos_.x - kBack * (b.x - a.x) / len, pos_.y - kBack * (b.y - a.y) / len};
+  }
+  return at;
+}
+
+absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
+  const Waypoint& a = path()[seg_ - 1];
+  const Waypoint& b = path()[seg_];
+  const bool mid_segment = d_seg_ > 0.0 && d_seg_ < Dist(At(a), At(b));
+  const RobotProgress at = Progress();
+  pos_ = *at.position;
+  Observations seen;
+  seen.cells = std::move(pending_);
+  pending_.clear();
+  std::vector<uint8_t> flags(found_.size(), 0);
+  for (const CellIndex& c : seen.cells) {
+    flags[Index(c)] = 1, pending_flag_[Index(c)] = 0, reported_[Index(c)] = 1;
+  }
+  pending_checked_ = true;
+
+  ReplanOptions ro;
+  ro.method = method;
+  ro.seed = options_.seed + r_.num_replans;
+  ro.tour_time_limit_s = options_.replan_tour_time_limit_s;
+  absl::Time t0 = absl::Now();
+  absl::StatusOr<ReplanResult> result = source_->Replan(plan_, at, seen, ro);
+  bool fell_back = false;
+  if (!result.ok() && method != ReplanMethod::kGreedyDetour) {
+    std::string cells;
+    for (const CellIndex& c : seen.cells) absl::StrAppendFormat(&cells, " (%d,%d)", c.row, c.col);
+    r_.problems.push_back(absl::StrFormat(
+        "replan %d (%s) failed, greedy detour instead: robot at (%.4f, %.4f) on segment %d of %d, "
+        "new cells%s: %s",
+        r_.num_replans, ReplanMethodName(method), pos_.x, pos_.y, at.waypoint, path().size() - 1,
+        cells, result.status().ToString()));
+    ro.method = ReplanMethod::kGreedyDetour;
+    result = source_->Replan(plan_, at, seen, ro);
+    fell_back = true;
+  }
+  const double compute_s = absl::ToDoubleSeconds(absl::Now() - t0);
+  if (!result.ok()) {
+    return absl::InternalError(
+        absl::StrFormat("replan %d failed even as greedy detour at (%.4f, %.4f), segment %d: %s",
+                        r_.num_replans, pos_.x, pos_.y, at.waypoint, result.status().ToString()));
+  }
+  const ReplanStats& st = result->stats;
+  // Stoppage: the compute time the robot cannot drive through.
+  double stoppage = 0.0;
+  if (st.method == "unchanged" || (method == ReplanMethod::kGreedyDetour && !fell_back)) {
+    stoppage = 0.0;  // a local move: no compute time charged
+  } else if (method == ReplanMethod::kFull && !fell_back) {
+    stoppage = compute_s;  // the new plan starts at the robot: it waits for all of it
+  } else if (st.replanned_encounter >= 0) {
+    stoppage = std::max(0.0, compute_s - st.time_to_encounter_s);
+  } else {
+    stoppage = std::max(0.0, compute_s - TimeToFirstEntry(flags));
+  }
+  r_.stoppage_s += stoppage;
+  ++r_.num_replans;
+  r_.num_encounters += st.num_encounters;
+  r_.num_greedy_detours += static_cast<int>(st.greedy_detours.size());
+  r_.replan_ms.push_back(1000.0 * compute_s);
+  r_.replan_points.push_back(pos_);
+  r_.replan_methods.push_back(st.method);
+
+  if (mid_segment) {
+    Waypoint cut = b;
+    cut.x = pos_.x, cut.y = pos_.y;
+    drive_s_ += robot_.StraightTime(d_seg_);
+    PushDriven(cut);
+    junction_ = true;
+  }
+  // Every replanned path is checked whole, not only the part the robot
+  // drives before the next replan.
+  if (std::optional<std::string> crossing = CrossesReported(result->plan.path)) {
+    r_.problems.push_back(
+        absl::StrFormat("the plan from replan %d (%s) %s", r_.num_replans, st.method, *crossing));
+  }
+  plan_.plan = std::move(result->plan);
+  plan_.area = std::move(result->area);
+  IndexSweeps();
+  seg_ = 1;
+  t_seg_ = d_seg_ = 0.0;
+  if (!path().empty()) pos_ = At(path()[0]);
+  return absl::OkStatus();
+}
+
+std::optional<std::string> SimulatedDrive::CrossesReported(
+    const std::vector<Waypoint>& path) const {
+  bool leaving = true;  // the path may start in the robot's cell, not come back to it
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Point2 a = At(path[i - 1]), b = At(path[i]);
+    std::optional<CellIndex> hit;
+    TraverseCells(grid_, a, b, [&](CellIndex c) {
+      if (leaving && c == here_) return false;
+      leaving = false;
+      if (!grid_.InBounds(c.row, c.col) || !reported_[Index(c)]) return false;
+      hit = c;
+      return true;
+    });
+    if (hit) {
+      return absl::StrFormat(
+          "crosses cell (%d, %d), reported blocked, on segment %d (%.4f, %.4f) -> (%.4f, %.4f)",
+          hit->row, hit->col, i, a.x, a.y, b.x, b.y);
+    }
+  }
+  return std::nullopt;
+}
+
+// The path enters a cell the replanner was told is blocked (or one its drive
+// grid never had free): a replanner problem. Record it and detour greedily
+// around it.
+absl::Status SimulatedDrive::HandleViolation(CellIndex cell) {
+  // Clutter on the end pose: every plan ends there (the replanner joins a
+  // blocked end pose from a free neighbour), the robot cannot. Once nothing
+  // is left to sweep, the run ends next to it.
+  bool sweeps_left = false;
+  for (size_t i = seg_; i < path().size(); ++i)
+    sweeps_left |= path()[i].kind == SegmentKind::kCoverage;
+  if (!sweeps_left && cell == grid_.CellAt(At(path().back()))) {
+    end_blocked_ = true;
+    return absl::OkStatus();
+  }
+  r_.problems.push_back(absl::StrFormat(
+      "the plan from replan %d (%s) enters cell (%d, %d), %s, from (%.4f, %.4f) on segment %d",
+      r_.num_replans, r_.replan_methods.empty() ? "initial" : r_.replan_methods.back(), cell.row,
+      cell.col, found_[Index(cell)] ? "reported blocked" : "blocked on the true grid", pos_.x,
+      pos_.y, seg_));
+  if (++violations_ > 100) {
+    r_.completed = false;
+    r_.termination = "stopped: more than 100 plans entered blocked cells";
+    return absl::OkStatus();
+  }
+  if (!found_[Index(cell)]) r_.obstacles_found.push_back(cell);
+  found_[Index(cell)] = 1;
+  pending_.push_back(cell);
+  return DoReplan(ReplanMethod::kGreedyDetour);
+}
+
+absl::StatusOr<SimulationResult> SimulatedDrive::Run() {
+  IndexSweeps();
+  r_.planned_duration_s = plan_.plan.stats.estimated_duration_s;
+  const int planned_cycles = static_cast<int>(plan_.plan.cycles.size());
+  const double planned_energy = plan_.plan.stats.energy_total;
+  const double time_cap = options_.max_time_factor * r_.planned_duration_s + 3600.0;
+  pos_ = At(path()[0]);
+  here_ = grid_.CellAt(pos_);
+  r_.driven.push_back(path()[0]);
+  Sense();
+  while (r_.completed) {
+    if (!pending_.empty() && !pending_checked_) {
+      if (PendingOnPath()) {
+        if (r_.num_replans >= options_.max_replans) {
+          r_.completed = false;
+          r_.termination = absl::StrFormat("stopped: %d replans", r_.num_replans);
+          break;
+        }
+        RETURN_IF_ERROR(DoReplan(method_));
+        continue;
+      }
+      pending_checked_ = true;
+    }
+    if (seg_ >= static_cast<int>(path().size())) break;
+    if (drive_s_ > time_cap) {
+      r_.completed = false;
+      r_.termination = absl::StrFormat("stopped: %.0f s of driving", drive_s_);
+      break;
+    }
+    const Waypoint& a = path()[seg_ - 1];
+    const Waypoint& b = path()[seg_];
+    const double length = Dist(At(a), At(b));
+    const double total = robot_.StraightTime(length);
+    const double t_next = std::min(total, t_seg_ + options_.step_s);
+    const double d_next = t_next >= total ? length : DistanceAt(robot_, length, t_next);
+    // What the move enters: a cell blocked on the true grid is either a candidate not
+    // found yet (touched: the sensor could not see it) or a planning error.
+    const Point2 to = length > 0.0 ? Lerp(At(a), At(b), d_next / length) : At(b);
+    std::optional<CellIndex> touch, violation, last;
+    TraverseCells(grid_, pos_, to, [&](CellIndex c) {
+      last = c;
+      if (c == here_ || !grid_.InBounds(c.row, c.col) || grid_.IsFree(c)) return false;
+      (candidate_[Index(c)] && !found_[Index(c)] ? touch : violation) = c;
+      return true;
+    });
+    if (touch) {
+      ++r_.num_touch_detections;
+      Observe(*touch);
+      continue;
+    }
+    if (violation) {
+      RETURN_IF_ERROR(HandleViolation(*violation));
+      if (end_blocked_) break;
+      continue;
+    }
+    if (last) here_ = *last;
+    if (b.kind == SegmentKind::kCoverage && sweep_of_[seg_] >= 0) {
+      const double t = length > 0.0 ? d_next / length : 1.0;
+      for (const CellIndex& c : plan_.plan.sweeps[sweep_of_[seg_]].cells) {
+        if (t >= 1.0 || Param(At(a), At(b), grid_.CellCenter(c)) <= t + 1e-9) swept_[Index(c)] = 1;
+      }
+    }
+    t_seg_ = t_next;
+    d_seg_ = d_next;
+    pos_ = to;
+    if (t_next >= total) {
+      drive_s_ += total + robot_.TurnTime(HeadingChange(a.theta, b.theta));
+      PushDriven(b);
+      ++seg_;
+      t_seg_ = d_seg_ = 0.0;
+      pos_ = At(b);
+    }
+    Sense();
+  }
+  if (end_blocked_) {
+    r_.termination = absl::StrFormat(
+        "completed: the end pose (%.3f, %.3f) lies in a blocked cell; stopped next to it at (%.3f, "
+        "%.3f)",
+        path().back().x, path().back().y, pos_.x, pos_.y);
+  } else if (r_.completed) {
+    r_.termination = "completed: the end of the plan was reached";
+  }
+  const PlanStats s = ComputePathStats(r_.driven, robot_);
+  r_.drive_time_s = s.estimated_duration_s;
+  r_.total_time_s = r_.drive_time_s + r_.stoppage_s;
+  if (options_.plan.battery) {
+    r_.battery = DriveBattery(r_.driven, *options_.plan.battery, robot_, options_.recharge_s);
+    r_.battery->charge_cycles_planned = planned_cycles;
+    r_.battery->energy_planned = planned_energy;
+    r_.total_time_s += r_.battery->recharge_time_s;
+  }
+  r_.num_turns = static_cast<int>(s.num_turns);
+  r_.path_length_m = s.coverage_length_m + s.transition_length_m;
+  return r_;
+}
+
+double LengthInObstacles(const OccupancyMap& map, const std::vector<Waypoint>& path) {
+  const double res = map.resolution();
+  auto blocked = [&](double x, double y) {
+    const int c = static_cast<int>(std::floor(x)), r = static_cast<int>(std::floor(y));
+    return c < 0 || r < 0 || c >= map.width() || r >= map.height() || !map.IsFree(r, c);
+  };
+  constexpr double kNudge = 1e-6;  // pixels
+  double inside = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Point2 a = At(path[i - 1]), b = At(path[i]);
+    const double len = Dist(a, b);
+    const int n = static_cast<int>(std::ceil(len / (res / 4)));
+    for (int k = 0; k < n; ++k) {
+      const Point2 p = Lerp(a, b, (k + 0.5) / n);
+      const double x = (p.x - map.origin().x) / res, y = (p.y - map.origin().y) / res;
+      if (blocked(x - kNudge, y - kNudge) && blocked(x + kNudge, y - kNudge) &&
+          blocked(x - kNudge, y + kNudge) && blocked(x + kNudge, y + kNudge)) {
+        inside += len / n;
+      }
+    }
+  }
+  return inside;
+}
+
+}  // namespace covplan::sim_internal

@@ -1,0 +1,114 @@
+// Driving a plan through the true map (internal to planner/sim): one
+// simulated run. The robot follows its plan under the robot model in steps of
+// options.step_s, senses after every step (sensor.h), and when the cells it
+// found cut the path still to drive, asks its PlanSource for a replan and
+// drives on along that. It accounts the drive time, the stoppage (replan
+// compute time the robot cannot drive through), the cells it swept, and the
+// problems of the replanner it worked around.
+//
+//   SimulatedDrive drive(truth, true_grid, options, std::move(plan), candidate, source);
+//   ASSIGN_OR_RETURN(SimulationResult r, drive.Run());
+//   drive.swept()  // per cell: swept
+//
+// Thread-safety: not thread-safe; one drive per thread (Simulate makes its own).
+#ifndef COVPLAN_PLANNER_SIM_DRIVE_H_
+#define COVPLAN_PLANNER_SIM_DRIVE_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "planner/engine/engine.h"
+#include "planner/grid/grid.h"
+#include "planner/grid/occupancy_map.h"
+#include "planner/replan/replanner.h"
+#include "planner/sim/sensor.h"
+#include "planner/sim/simulator.h"
+
+namespace covplan::sim_internal {
+
+class SimulatedDrive {
+ public:
+  // `candidate`: per cell, free on the plan's drive grid and blocked on
+  // `true_grid` (what the sensor can find). The maps, the options and the
+  // source must outlive the drive.
+  SimulatedDrive(const OccupancyMap& truth, const Grid& true_grid, const SimulationOptions& options,
+                 RetainedPlan plan, std::vector<uint8_t> candidate, PlanSource* source)
+      : source_(source),
+        grid_(true_grid),
+        sensor_(truth, true_grid, options.sensor_range_m),
+        options_(options),
+        robot_(options.plan.robot),
+        method_(options.plan.battery ? ReplanMethod::kGreedyDetour : options.method),
+        plan_(std::move(plan)),
+        candidate_(std::move(candidate)),
+        found_(candidate_.size(), 0),
+        pending_flag_(candidate_.size(), 0),
+        reported_(candidate_.size(), 0),
+        swept_(candidate_.size(), 0) {}
+
+  // Drives the plan to its end (or until a bound of the options stops it).
+  // The result has everything but the figures measured against the true map
+  // (truth_cleared_px, truth_used, covered_free_area_ratio,
+  // length_in_obstacles_m). Internal when
+  // a replan fails even as a greedy detour. Call once.
+  absl::StatusOr<SimulationResult> Run();
+  // Per cell of the grid: swept by the driven path.
+  const std::vector<uint8_t>& swept() const { return swept_; }
+
+ private:
+  const std::vector<Waypoint>& path() const { return plan_.plan.path; }
+  int64_t Index(CellIndex c) const { return grid_.Index(c.row, c.col); }
+  void Observe(CellIndex c);
+  void Sense();
+  // Calls f(sample) along the path still to drive until it returns true.
+  template <typename F>
+  bool ScanRemaining(F f) const;
+  bool PendingOnPath() const;
+  double TimeToFirstEntry(const std::vector<uint8_t>& flags) const;
+  RobotProgress Progress() const;
+  absl::Status DoReplan(ReplanMethod method);
+  absl::Status HandleViolation(CellIndex cell);
+  void PushDriven(const Waypoint& w);
+  void IndexSweeps();
+  // A problem line if `path` enters a cell already given to a replan.
+  std::optional<std::string> CrossesReported(const std::vector<Waypoint>& path) const;
+
+  PlanSource* const source_;
+  const Grid& grid_;  // the true grid (same frame as the plan's grid)
+  const RangeSensor sensor_;
+  const SimulationOptions& options_;
+  const RobotModel robot_;
+  // Battery plans keep their station legs only under the greedy detour.
+  const ReplanMethod method_;
+  RetainedPlan plan_;
+  std::vector<uint8_t> candidate_;     // free on the planned drive grid, blocked on the true one
+  std::vector<uint8_t> found_;         // candidates the robot has found
+  std::vector<uint8_t> pending_flag_;  // found, not yet given to a replan
+  std::vector<uint8_t> reported_;      // given to a replan
+  std::vector<CellIndex> pending_;
+  bool pending_checked_ = true;  // no pending cell added since PendingOnPath() said no
+  std::vector<uint8_t> swept_;
+  std::vector<int> sweep_of_;         // per waypoint: index into plan.sweeps or -1
+  int seg_ = 1;                       // segment path[seg_-1] -> path[seg_] being driven
+  double t_seg_ = 0.0, d_seg_ = 0.0;  // seconds / metres into it
+  Point2 pos_;
+  CellIndex here_;            // the cell the robot is in (borders are ambiguous)
+  bool end_blocked_ = false;  // the plan's end pose lies in a blocked cell
+  bool junction_ = false;     // driven.back() is where a replan cut a segment
+  double drive_s_ = 0.0;      // rough drive time, for the time bound
+  int violations_ = 0;
+  SimulationResult r_;
+};
+
+// Length of `path` inside the interior of the non-free pixels of `map`
+// (sampled every quarter pixel; faces and corners may be touched).
+double LengthInObstacles(const OccupancyMap& map, const std::vector<Waypoint>& path);
+
+}  // namespace covplan::sim_internal
+
+#endif  // COVPLAN_PLANNER_SIM_DRIVE_H_
