@@ -11,7 +11,7 @@
 #define COVPLAN_PLANNER_SIM_MAP_FRAME_H_
 
 #include "absl/status/status.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/grid.h"
 #include "planner/grid/occupancy_map.h"
 

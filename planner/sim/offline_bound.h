@@ -15,7 +15,7 @@
 #include <cstdint>
 
 #include "absl/status/statusor.h"
-#include "planner/engine/plan_coverage.h"
+#include "planner/assembly/plan_coverage.h"
 #include "planner/grid/occupancy_map.h"
 
 namespace covplan {
