@@ -91,8 +91,11 @@ TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExce
 // decoded, and GetMap does not wait behind decoding.
 TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNotWait) {
   StartServer();
-  testing::PngSpec spec{
-      .width = 3000, .height = 3000, .color_type = PNG_COLOR_TYPE_GRAY, .bit_depth = 16};
+  testing::PngSpec spec;
+  spec.width = 3000;
+  spec.height = 3000;
+  spec.color_type = PNG_COLOR_TYPE_GRAY;
+  spec.bit_depth = 16;
   spec.samples.assign(static_cast<size_t>(spec.width) * spec.height, 65535);
   const v1::Map big = RasterMap(testing::EncodePng(spec), 0.05);
   const std::string small_id = PutMapOk(Variant(0));
