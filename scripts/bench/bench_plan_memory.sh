@@ -6,10 +6,10 @@
 # `covplan load` at concurrency 1, 4 and 16 with identical requests and with
 # --random-start, then 40 random starts at concurrency 1 with one fixed seed
 # (the same poses in both modes: a paired duration comparison).
-#   scripts/bench_plan_memory.sh OUTDIR [MAP] [TOOL] [DEADLINE_MS] [SECONDS]
+#   scripts/bench/bench_plan_memory.sh OUTDIR [MAP] [TOOL] [DEADLINE_MS] [SECONDS]
 # Only 127.0.0.1 is contacted; every load run is bounded.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 OUT=$1
 MAP=${2:-maps/sample_office.yaml}
 TOOL=${3:-0.8}

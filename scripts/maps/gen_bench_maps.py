@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes N distinct occupancy maps for server benchmarks and robustness runs.
 
-    /usr/bin/python3 scripts/gen_bench_maps.py OUT_DIR N [WIDTH HEIGHT]
+    /usr/bin/python3 scripts/maps/gen_bench_maps.py OUT_DIR N [WIDTH HEIGHT]
 
 Each map k is a walled floor (default 600 x 400 px at 0.05 m: 30 m x 20 m)
 with 60 pieces of seeded random furniture: mK.pgm + mK.yaml (ROS map_server

@@ -2,16 +2,16 @@
 # Reproduces the planner comparison of docs/benchmarks.md: `covplan compare`
 # on every plain building of ../shared/data/maps/ipa (not the *_furnitures
 # variants; 0.05 m/px, IPA colour rule grey >= 250 is free, i.e.
-# free_thresh 0.021, tool 0.8 m, as scripts/bench_maps.sh), one markdown
+# free_thresh 0.021, tool 0.8 m, as scripts/bench/bench_maps.sh), one markdown
 # table for all maps on stdout (and in $OUT when set).
-#   scripts/compare_planners.sh [ALGORITHMS] [more covplan compare flags...]
+#   scripts/bench/compare_planners.sh [ALGORITHMS] [more covplan compare flags...]
 #   ALGORITHMS: comma-separated planner names, e.g. oarp,stc,boustrophedon
 #               (default: every planner the build registers)
 # COVPLAN_BIN runs an existing binary instead of building build-release/.
 # The maps are licensed for academic, non-commercial use: they are read in
 # place and never copied into this repository.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 IPA=${IPA_DIR:-../shared/data/maps/ipa}
 if [ ! -d "$IPA" ]; then
   echo "compare_planners: $IPA not found (the IPA maps live in ../shared/data, outside the repo)" >&2

@@ -6,8 +6,8 @@
 # reported blocked, and every driven step against the true map; each
 # violation is listed in the run's "problems" field. Uses only the repo.
 #
-#   scripts/sweep_replan.sh                          # 4 methods x 2 levels x 6 seeds
-#   SEEDS="1 2" METHODS="auto" LEVELS=20 scripts/sweep_replan.sh
+#   scripts/bench/sweep_replan.sh                          # 4 methods x 2 levels x 6 seeds
+#   SEEDS="1 2" METHODS="auto" LEVELS=20 scripts/bench/sweep_replan.sh
 #
 # Environment: BUILD_DIR (build), MAP (maps/sample_office.yaml), METHODS
 # ("auto ilp1 ilp2 greedy_detour"), LEVELS ("10 20"), SEEDS ("1 2 3 4 5 6"),
@@ -15,7 +15,7 @@
 # Prints one line per run and a summary; exits 1 when any run has a problem
 # or fails.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 BUILD_DIR=${BUILD_DIR:-build}
 MAP=${MAP:-maps/sample_office.yaml}
 METHODS=${METHODS:-"auto ilp1 ilp2 greedy_detour"}

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Draws the sample maps shipped in maps/ (deterministic, stdlib only).
 
-    /usr/bin/python3 scripts/gen_sample_maps.py [--out maps] [--preview DIR]
+    /usr/bin/python3 scripts/maps/gen_sample_maps.py [--out maps] [--preview DIR]
 
 Writes, in ROS map_server format (free 254, occupied 0, unknown 205):
   sample_office.pgm/.yaml            30 m x 20 m office floor, 0.05 m/px (600 x 400)
@@ -213,6 +213,8 @@ def scanner_noise(c, seed):
 
 def write_pgm(path, c):
     with open(path, "wb") as f:
+        # The header names the path this script had when the shipped maps were written; it stays
+        # so that regenerating reproduces maps/ byte for byte (their content ids included).
         f.write(b"P5\n# covplan sample map (scripts/gen_sample_maps.py)\n")
         f.write(b"%d %d\n255\n" % (c.width, c.height))
         for row in c.px:
@@ -285,7 +287,7 @@ def write_yaml(path, image, origin):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     here = os.path.dirname(os.path.abspath(__file__))
-    parser.add_argument("--out", default=os.path.join(here, "..", "maps"))
+    parser.add_argument("--out", default=os.path.join(here, "..", "..", "maps"))
     parser.add_argument("--preview", help="also write PNG previews into this directory")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)

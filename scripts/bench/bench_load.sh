@@ -2,10 +2,10 @@
 # Load run of docs/benchmarks.md: starts a Release covplan-server on loopback,
 # caches the sample map's decomposition with one Plan, then drives `covplan
 # load` at concurrency 1, 4 and 16 and samples the server's resident memory.
-#   scripts/bench_load.sh [--duration S] [--deadline-ms D] [--cache-mb M]
+#   scripts/bench/bench_load.sh [--duration S] [--deadline-ms D] [--cache-mb M]
 # Only 127.0.0.1 is contacted; every run is bounded by --duration.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 DURATION=10
 DEADLINE_MS=500
 CACHE_MB=64

@@ -4,19 +4,19 @@
 # tool (10^6 cells, ~1,100 ranks) and an IPA office at 0.3 m (lab_a_scan,
 # ~500 ranks) with `covplan plan --local`, each with a "before" binary and
 # the current one, and measures wall time and peak RSS (/usr/bin/time -v).
-#   BEFORE=/path/to/old/covplan AFTER=build-rel/bin/covplan scripts/bench_transitions.sh [OUT_DIR]
+#   BEFORE=/path/to/old/covplan AFTER=build-rel/bin/covplan scripts/bench/bench_transitions.sh [OUT_DIR]
 # Old binaries are run without --threads (they do not have it) and capped
 # with `timeout 300`. The 60 s rows run the new solver with
 # --tour-effort thorough (keeps searching for the whole budget).
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 OUT=${1:-/tmp/covplan-bench-transitions}
 AFTER=${AFTER:-build-rel/bin/covplan}
 BEFORE=${BEFORE:-}
 IPA=${IPA_DIR:-../shared/data/maps/ipa}
 mkdir -p "$OUT"
-/usr/bin/python3 scripts/gen_warehouse.py warehouse "$OUT"
-/usr/bin/python3 scripts/gen_warehouse.py lawn "$OUT"
+/usr/bin/python3 scripts/maps/gen_warehouse.py warehouse "$OUT"
+/usr/bin/python3 scripts/maps/gen_warehouse.py lawn "$OUT"
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(date -u +%FT%TZ)"
 
 run() {  # label binary args...

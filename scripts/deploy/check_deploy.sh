@@ -2,15 +2,15 @@
 # Offline checks of the deployment files, one per argument (the ctest tests
 # deploy.* call them). Exit 0 pass, 1 fail, 77 skipped because a tool is
 # not installed (the reason is printed).
-#   scripts/check_deploy.sh rules        # promtool check rules + test rules
-#   scripts/check_deploy.sh dashboard    # Grafana JSON vs exported metrics
-#   scripts/check_deploy.sh kubernetes   # kubectl kustomize every overlay, validate every object
-#   scripts/check_deploy.sh router       # haproxy -c on both router configs
+#   scripts/deploy/check_deploy.sh rules        # promtool check rules + test rules
+#   scripts/deploy/check_deploy.sh dashboard    # Grafana JSON vs exported metrics
+#   scripts/deploy/check_deploy.sh kubernetes   # kubectl kustomize every overlay, validate every object
+#   scripts/deploy/check_deploy.sh router       # haproxy -c on both router configs
 # Tools: promtool (Debian: prometheus), haproxy, kubectl (not in Debian 12:
 # its built-in kustomize renders), node + deploy/kubernetes/validator's npm
 # packages (npm ci --prefix deploy/kubernetes/validator).
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 skip() { echo "SKIPPED: $*"; exit 77; }
 
 case "${1:-}" in
@@ -20,11 +20,11 @@ case "${1:-}" in
     (cd deploy/prometheus && promtool test rules covplan-rules.test.yml) || exit 1
     ;;
   dashboard)
-    /usr/bin/python3 scripts/check_dashboard.py || exit 1
+    /usr/bin/python3 scripts/deploy/check_dashboard.py || exit 1
     # The checker must catch a metric the server does not export.
     tmp=$(mktemp)
     sed 's/covplan_worker_queue_depth/covplan_worker_queue_dpth/' deploy/grafana/covplan-dashboard.json >"$tmp"
-    if /usr/bin/python3 scripts/check_dashboard.py "$tmp" >/dev/null; then
+    if /usr/bin/python3 scripts/deploy/check_dashboard.py "$tmp" >/dev/null; then
       rm -f "$tmp"; echo "checker accepted an unknown metric"; exit 1
     fi
     rm -f "$tmp"

@@ -5,14 +5,14 @@
 # file of the data directory, at each time limit, with several seeds, and
 # prints a markdown table of gaps to the best-known values.
 #
-#   scripts/bench_gtsp.sh [--data DIR] [--limits "1 10"] [--seeds 5]
+#   scripts/bench/bench_gtsp.sh [--data DIR] [--limits "1 10"] [--seeds 5]
 #                         [--threads 1] [--bin "CMD"] [--raw FILE] [--only REGEX]
 #
 # The solver command defaults to `covplan gtsp` from the first build found
 # is built (build-release/ first, then build/).
 set -euo pipefail
 
-root="$(cd "$(dirname "$0")/.." && pwd)"
+root="$(cd "$(dirname "$0")/../.." && pwd)"
 data="$root/../shared/data/gtsp"
 limits="1 10"
 seeds=5

@@ -3,11 +3,11 @@
 # building of ../shared/data/maps/ipa (0.05 m/px, tool 0.8 m; IPA colour
 # rule grey >= 250 is free, i.e. free_thresh 0.021) with both partition
 # solvers and both tour solvers, and compares the tour with a 30 s search.
-#   scripts/bench_maps.sh [--time-limit S] [--runs N] [--reference-s S] [--no-lp]
+#   scripts/bench/bench_maps.sh [--time-limit S] [--runs N] [--reference-s S] [--no-lp]
 # The maps are licensed for academic, non-commercial use: they are read in
 # place and never copied into this repository.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 IPA=${IPA_DIR:-../shared/data/maps/ipa}
 if [ ! -d "$IPA" ]; then
   echo "bench_maps: $IPA not found (the IPA maps live in ../shared/data, outside the repo)" >&2

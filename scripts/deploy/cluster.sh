@@ -4,11 +4,11 @@
 # same replicas, for comparison), PostgreSQL as the shared map store, and
 # Prometheus scraping every replica with deploy/prometheus/covplan-rules.yml.
 #
-#   scripts/cluster.sh up         # start everything (idempotent per process)
-#   scripts/cluster.sh status     # what runs, health, where
-#   scripts/cluster.sh kill N     # SIGKILL replica N (1..3), for failure runs
-#   scripts/cluster.sh start N    # start replica N again
-#   scripts/cluster.sh down       # stop everything (SIGTERM: replicas drain)
+#   scripts/deploy/cluster.sh up         # start everything (idempotent per process)
+#   scripts/deploy/cluster.sh status     # what runs, health, where
+#   scripts/deploy/cluster.sh kill N     # SIGKILL replica N (1..3), for failure runs
+#   scripts/deploy/cluster.sh start N    # start replica N again
+#   scripts/deploy/cluster.sh down       # stop everything (SIGTERM: replicas drain)
 #
 # Environment: COVPLAN_CLUSTER_DIR (state, logs; default /tmp/covplan-cluster),
 # COVPLAN_CLUSTER_PORT (base port, default 56100: router BASE, round robin
@@ -21,7 +21,7 @@
 # Needs: haproxy, prometheus, postgresql (apt-get install haproxy prometheus
 # postgresql). Nothing here is used by the test suite or run_sample.sh.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 ROOT=$(pwd)
 DIR=${COVPLAN_CLUSTER_DIR:-/tmp/covplan-cluster}
 BASE=${COVPLAN_CLUSTER_PORT:-56100}

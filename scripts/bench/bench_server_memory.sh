@@ -3,11 +3,11 @@
 # generated maps in turn (each a new set of per-map artifacts) through one
 # server with a small --cache_mb, and prints RSS, the cache's byte gauge and
 # the high-water mark every 20 maps.
-#   scripts/bench_server_memory.sh [CACHE_MB] [N_MAPS]
+#   scripts/bench/bench_server_memory.sh [CACHE_MB] [N_MAPS]
 # Uses already-built binaries: BIN (default build-h/bin); SERVER_BIN
 # overrides the server (e.g. an older build for a before/after figure).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 CACHE_MB=${1:-16}
 N=${2:-280}
 THREADS=${THREADS:-2}
@@ -19,7 +19,7 @@ WORK=$(mktemp -d -t covplan-mem.XXXXXX)
 # 600 x 400: 30 m x 20 m) with seeded random furniture.
 WIDTH=${WIDTH:-600}
 HEIGHT=${HEIGHT:-400}
-/usr/bin/python3 scripts/gen_bench_maps.py "$WORK" "$N" "$WIDTH" "$HEIGHT"
+/usr/bin/python3 scripts/maps/gen_bench_maps.py "$WORK" "$N" "$WIDTH" "$HEIGHT"
 PORT=$(free_port); MPORT=$(free_port)
 "$SERVER_BIN" --port "$PORT" --metrics_port "$MPORT" --store_dir "$WORK/store" --threads "$THREADS" \
   --cache_mb "$CACHE_MB" 2>"$WORK/server.log" &

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Writes large deterministic maps for the transition-scaling benchmarks.
 
-    /usr/bin/python3 scripts/gen_warehouse.py warehouse OUT_DIR [WIDTH_M HEIGHT_M]
-    /usr/bin/python3 scripts/gen_warehouse.py lawn OUT_DIR [SIDE_M]
+    /usr/bin/python3 scripts/maps/gen_warehouse.py warehouse OUT_DIR [WIDTH_M HEIGHT_M]
+    /usr/bin/python3 scripts/maps/gen_warehouse.py lawn OUT_DIR [SIDE_M]
 
 warehouse: a walled hall (default 280 m x 180 m at 0.1 m per pixel) of
 shelf rows 1.2 m deep with 2.4 m aisles between them, cut into blocks by

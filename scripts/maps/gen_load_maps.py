@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes N distinct site maps for load runs (deterministic, stdlib only).
 
-    /usr/bin/python3 scripts/gen_load_maps.py --out /tmp/covplan-load-maps --count 24 [--seed 1]
+    /usr/bin/python3 scripts/maps/gen_load_maps.py --out /tmp/covplan-load-maps --count 24 [--seed 1]
 
 Each map is a walled rectangle of 12-20 m x 8-14 m at 0.05 m/px (ROS
 map_server PGM + YAML) with 3-8 random rectangular obstacles, so every map

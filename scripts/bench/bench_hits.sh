@@ -4,10 +4,10 @@
 # (cold) and once more (the first hit), then runs `covplan load` for 10 s at
 # concurrency 1, 4 and 16 with identical requests and prints one line each.
 #
-#   scripts/bench_hits.sh [BIN_DIR (build/bin)] [TOOL (0.8)] [PORT (50181)]
+#   scripts/bench/bench_hits.sh [BIN_DIR (build/bin)] [TOOL (0.8)] [PORT (50181)]
 # EXTRA="--full-replies" decodes every reply in the client.
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
+root="$(cd "$(dirname "$0")/../.." && pwd)"
 bin="${1:-$root/build/bin}"; tool="${2:-0.8}"; port="${3:-50181}"
 store="$(mktemp -d /tmp/bench_hits.XXXXXX)"
 "$bin/covplan-server" --port "$port" --metrics_port 0 --store_dir "$store/maps" > "$store/server.log" 2>&1 &

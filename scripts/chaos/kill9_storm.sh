@@ -4,10 +4,10 @@
 # Plan) over distinct maps, SIGKILL the server at a random moment, restart
 # it and check that every map whose PutMap was acknowledged (its plan.json
 # names the map_id) is indexed intact, and that nothing is corrupted.
-#   scripts/kill9_storm.sh [ROUNDS] [CLIENTS]
+#   scripts/chaos/kill9_storm.sh [ROUNDS] [CLIENTS]
 # Uses built binaries: BIN (default build-h/bin).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 ROUNDS=${1:-6}
 CLIENTS=${2:-4}
 BIN=${BIN:-build-h/bin}
@@ -15,7 +15,7 @@ WORK=$(mktemp -d -t covplan-storm.XXXXXX)
 STORE="$WORK/store"
 SERVER=
 trap '[ -n "$SERVER" ] && kill -9 $SERVER 2>/dev/null; rm -rf "$WORK"' EXIT
-/usr/bin/python3 scripts/gen_bench_maps.py "$WORK" 200 200 150
+/usr/bin/python3 scripts/maps/gen_bench_maps.py "$WORK" 200 200 150
 free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
 start_server() {
   PORT=$(free_port)

@@ -9,9 +9,9 @@
 #   levels     LEVEL_MAP at 2, 5, 10, 15, 20 % clutter, LEVEL_SEEDS seeds.
 # Robot and sensor as the thesis: tool 0.8 m, 1 m/s, 0.5 m/s^2, 30 deg/s, 5.6 m.
 #
-#   scripts/eval_replan.sh                 # about 20 min on 2 cores
-#   CLUTTER_MAPS=all scripts/eval_replan.sh  # clutter on every map too: about 35 min
-#   SEEDS=2 MAPS="lab_ipa lab_b_scan" CLUTTER_MAPS=all scripts/eval_replan.sh
+#   scripts/bench/eval_replan.sh                 # about 20 min on 2 cores
+#   CLUTTER_MAPS=all scripts/bench/eval_replan.sh  # clutter on every map too: about 35 min
+#   SEEDS=2 MAPS="lab_ipa lab_b_scan" CLUTTER_MAPS=all scripts/bench/eval_replan.sh
 #
 # Environment: IPA_DIR, BUILD_DIR (build-release), JOBS (parallel runs, 2),
 # MAPS (all plain maps), CLUTTER_MAPS (the maps of clutter10: "all" = MAPS; by
@@ -24,7 +24,7 @@
 # Prints the markdown tables on stdout. The maps are licensed for academic,
 # non-commercial use: they are read in place and never copied.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 IPA=${IPA_DIR:-../shared/data/maps/ipa}
 if [ ! -d "$IPA" ]; then
   echo "eval_replan: $IPA not found (the IPA maps live in ../shared/data, outside the repo)" >&2

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Checks the Grafana dashboard against what covplan-server exports.
 
-    /usr/bin/python3 scripts/check_dashboard.py [DASHBOARD] [--rules RULES] [--source DIR]
+    /usr/bin/python3 scripts/deploy/check_dashboard.py [DASHBOARD] [--rules RULES] [--source DIR]
         [--prometheus http://127.0.0.1:56190]
 
 Structure: a JSON object with a uid, a title, panels each with a unique id,
@@ -11,7 +11,7 @@ names registered in server/*.cc, with _bucket/_sum/_count for histograms),
 a recording rule defined in the rules file, or Prometheus' own `up`.
 Also the panels cover the required topics (latency, throughput, deadline
 misses, cache hit rate, queue depth, memory). With --prometheus (a live
-one, e.g. scripts/cluster.sh's), every query is also run there and must
+one, e.g. scripts/deploy/cluster.sh's), every query is also run there and must
 return data. Exits 1 naming each problem.
 """
 
@@ -24,7 +24,7 @@ import urllib.parse
 import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+ROOT = os.path.dirname(os.path.dirname(HERE))
 
 # PromQL words that look like identifiers but are not metric names.
 PROMQL_WORDS = {

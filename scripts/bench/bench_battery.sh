@@ -11,11 +11,11 @@
 # station (the same for both planners) is the first of the unconstrained
 # OARP plan's coverage waypoints not on an obstacle pixel (the engine refuses
 # those).
-#   scripts/bench_battery.sh [CAPACITY_A CAPACITY_B]     (default 400 200)
+#   scripts/bench/bench_battery.sh [CAPACITY_A CAPACITY_B]     (default 400 200)
 # The maps are licensed for academic, non-commercial use: they are read in
 # place and never copied into this repository.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 IPA=${IPA_DIR:-../shared/data/maps/ipa}
 if [ ! -d "$IPA" ]; then
   echo "bench_battery: $IPA not found (the IPA maps live in ../shared/data, outside the repo)" >&2

@@ -7,15 +7,15 @@
 # corrupted and the two intact maps indexed, the FIFO and symlink are
 # skipped, the temporary file is gone; one `covplan plan` (PutMap) of a
 # damaged map repairs it.
-#   scripts/corrupt_store.sh        (BIN default build-h/bin)
+#   scripts/chaos/corrupt_store.sh        (BIN default build-h/bin)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 BIN=${BIN:-build-h/bin}
 WORK=$(mktemp -d -t covplan-corrupt.XXXXXX)
 STORE="$WORK/store"
 SERVER=
 trap '[ -n "$SERVER" ] && kill -9 $SERVER 2>/dev/null; rm -rf "$WORK"' EXIT
-/usr/bin/python3 scripts/gen_bench_maps.py "$WORK" 8 200 150
+/usr/bin/python3 scripts/maps/gen_bench_maps.py "$WORK" 8 200 150
 free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
 start_server() {
   : > "$WORK/server.log"

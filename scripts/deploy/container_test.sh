@@ -14,12 +14,12 @@
 #      the reply is checked;
 #   4. prints the image size, user and health check.
 #
-#   sudo bash scripts/container_test.sh        # root, or rootless buildah
+#   sudo bash scripts/deploy/container_test.sh        # root, or rootless buildah
 # Exit 0 pass, 1 fail, 77 skipped (no buildah / debootstrap: apt-get install
 # buildah debootstrap). Not part of scripts/test.sh: it compiles the whole
 # project inside the build stage (tens of minutes on 2 cores), see docs/deploy.md.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 for tool in buildah debootstrap; do
   command -v "$tool" >/dev/null || { echo "SKIPPED: $tool not installed (apt-get install buildah debootstrap)"; exit 77; }
 done

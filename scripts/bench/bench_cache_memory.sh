@@ -3,9 +3,9 @@
 # decompositions of the sample map (one per tool width) through a Release
 # covplan-server with a small --cache_mb and prints, after each plan, the RSS
 # and the cache's own byte gauge and eviction counter from /metrics.
-#   scripts/bench_cache_memory.sh [CACHE_MB]
+#   scripts/bench/bench_cache_memory.sh [CACHE_MB]
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 CACHE_MB=${1:-16}
 BUILD_DIR=${BUILD_DIR:-build-release}
 BUILD_TYPE=Release BUILD_DIR="$BUILD_DIR" bash scripts/build.sh -DCOVPLAN_BUILD_TESTS=OFF >/dev/null

@@ -6,8 +6,8 @@
 # the estimated duration against a REF_S s `--tour-effort thorough` search
 # of the same binary. With BEFORE set, the same run measures an older
 # binary too (its --threads flag is used only if it has one).
-#   AFTER=build/bin/covplan BEFORE=/tmp/old/covplan scripts/bench_buildings.sh
-#   TOOL=0.1 REF_S=60 RUNS=1 MAPS=../shared/data/maps/ipa/lab_f_scan.png scripts/bench_buildings.sh
+#   AFTER=build/bin/covplan BEFORE=/tmp/old/covplan scripts/bench/bench_buildings.sh
+#   TOOL=0.1 REF_S=60 RUNS=1 MAPS=../shared/data/maps/ipa/lab_f_scan.png scripts/bench/bench_buildings.sh
 # Environment: AFTER (build/bin/covplan), BEFORE (unset), RUNS (3),
 # BEFORE_RUNS (RUNS; runs of the before binary), REF_S
 # (30; 0 skips the reference), TOOL (0.8), IPA_DIR, MAPS (all), SEEDS (unset:
@@ -17,7 +17,7 @@
 # peak RSS of each binary's runs. The IPA maps are read in place, never
 # copied.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 AFTER=${AFTER:-build/bin/covplan}
 BEFORE=${BEFORE:-}
 RUNS=${RUNS:-3}

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Cache locality and failover through the map-affine router, on the
-# one-machine cluster (scripts/cluster.sh). Prints one JSON line per phase
+# one-machine cluster (scripts/deploy/cluster.sh). Prints one JSON line per phase
 # and a per-replica hit-rate table; docs/benchmarks.md §11 quotes a run.
 #
-#   COVPLAN_BIN=build-rel/bin bash scripts/bench_cluster.sh
+#   COVPLAN_BIN=build-rel/bin bash scripts/bench/bench_cluster.sh
 #
 # Phases (each starts every replica fresh, so caches are cold):
 #   direct    one cached map straight to replica 1 vs through the router:
@@ -18,7 +18,7 @@
 # DEADLINE_MS (1000), TOOL (0.4 m), CACHE_MB (3 per replica: below the
 # working set of all maps, above a third of it), KILL_AT (10), RESTART_AT (20).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 export COVPLAN_BIN=${COVPLAN_BIN:-$PWD/build/bin}
 export COVPLAN_CLUSTER_DIR=${COVPLAN_CLUSTER_DIR:-/tmp/covplan-cluster}
 export CLUSTER_CACHE_MB=${CACHE_MB:-3}
@@ -32,10 +32,10 @@ TOOL=${TOOL:-0.4}
 KILL_AT=${KILL_AT:-10}
 RESTART_AT=${RESTART_AT:-20}
 MAP_DIR=$COVPLAN_CLUSTER_DIR/load-maps
-CLUSTER="bash scripts/cluster.sh"
+CLUSTER="bash scripts/deploy/cluster.sh"
 COVPLAN=$COVPLAN_BIN/covplan
 
-/usr/bin/python3 scripts/gen_load_maps.py --out "$MAP_DIR" --count "$MAPS" --seed 1
+/usr/bin/python3 scripts/maps/gen_load_maps.py --out "$MAP_DIR" --count "$MAPS" --seed 1
 $CLUSTER up >/dev/null
 
 restart_replicas() {
