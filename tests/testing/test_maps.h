@@ -5,8 +5,8 @@
 //   v1::Map map = RasterMap(pgm, /*resolution=*/0.1);
 //
 // Thread-safety: stateless.
-#ifndef COVPLAN_TESTS_SERVER_TEST_MAPS_H_
-#define COVPLAN_TESTS_SERVER_TEST_MAPS_H_
+#ifndef COVPLAN_TESTS_TESTING_TEST_MAPS_H_
+#define COVPLAN_TESTS_TESTING_TEST_MAPS_H_
 
 #include <string>
 #include <vector>
@@ -34,4 +34,4 @@ v1::PlanRequest PlanRequestFor(const std::string& map_id, double tool_width_m);
 
 }  // namespace covplan::testing
 
-#endif  // COVPLAN_TESTS_SERVER_TEST_MAPS_H_
+#endif  // COVPLAN_TESTS_TESTING_TEST_MAPS_H_

@@ -1,4 +1,4 @@
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 #include <random>
 

@@ -17,7 +17,7 @@
 #include "planner/grid/grid.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/stc/stc_planner.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {

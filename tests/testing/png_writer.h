@@ -6,8 +6,8 @@
 //   std::string bytes = EncodePng(spec);
 //
 // Thread-safety: stateless; safe to call concurrently.
-#ifndef COVPLAN_TESTS_GRID_PNG_WRITER_H_
-#define COVPLAN_TESTS_GRID_PNG_WRITER_H_
+#ifndef COVPLAN_TESTS_TESTING_PNG_WRITER_H_
+#define COVPLAN_TESTS_TESTING_PNG_WRITER_H_
 
 #include <array>
 #include <cstdint>
@@ -37,4 +37,4 @@ std::string EncodePng(const PngSpec& spec);
 
 }  // namespace covplan::testing
 
-#endif  // COVPLAN_TESTS_GRID_PNG_WRITER_H_
+#endif  // COVPLAN_TESTS_TESTING_PNG_WRITER_H_

@@ -1,4 +1,4 @@
-#include "tests/grid/png_writer.h"
+#include "tests/testing/png_writer.h"
 
 #include <png.h>
 

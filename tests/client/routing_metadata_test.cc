@@ -14,7 +14,7 @@
 #include "client/remote.h"
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "gtest/gtest.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {
