@@ -2,7 +2,7 @@
 # run on a slim Debian 12 as a non-root user. The final stage holds the two
 # binaries (covplan-server, covplan) and their runtime libraries only.
 #
-#   scripts/deploy/container_test.sh              # no daemon: buildah + debootstrap'ed bases
+#   scripts/deploy/container_test.sh       # no daemon: buildah + debootstrap'ed bases
 #   docker build -t covplan-server .       # with a registry: debian:12 / debian:12-slim
 #   docker run -p 50051:50051 -p 9464:9464 covplan-server
 #
