@@ -2,11 +2,11 @@
 # run on a slim Debian 12 as a non-root user. The final stage holds the two
 # binaries (covplan-server, covplan) and their runtime libraries only.
 #
-#   scripts/container_test.sh              # no daemon: buildah + debootstrap'ed bases
+#   scripts/deploy/container_test.sh       # no daemon: buildah + debootstrap'ed bases
 #   docker build -t covplan-server .       # with a registry: debian:12 / debian:12-slim
 #   docker run -p 50051:50051 -p 9464:9464 covplan-server
 #
-# BASE / RUNTIME_BASE name the two base images; scripts/container_test.sh
+# BASE / RUNTIME_BASE name the two base images; scripts/deploy/container_test.sh
 # passes local images made by debootstrap (there is no registry here).
 ARG BASE=docker.io/library/debian:12
 ARG RUNTIME_BASE=docker.io/library/debian:12-slim

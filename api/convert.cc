@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/numeric/int128.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -173,7 +174,9 @@ absl::StatusOr<OccupancyMap> MapFromProto(const v1::Map& map, const EngineLimits
         "map.raster.image is neither a PGM (P2/P5) nor a PNG image (corrupt or unsupported data)");
   }
   if (auto dims = SniffDimensions(r.image())) {
-    const int64_t pixels = dims->first * dims->second;
+    // A header may claim any size: the product of two claims (each below 2^63)
+    // is taken in 128 bits, so it never overflows.
+    const absl::int128 pixels = absl::int128(dims->first) * dims->second;
     if (pixels > limits.max_map_pixels) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "map.raster.image is too large: %d x %d = %d pixels, above the limit of %d pixels",

@@ -1,8 +1,11 @@
 #!/usr/bin/python3
-"""Writes the seed corpus for map_reader_fuzzer into fuzz/corpus/ (stdlib only).
+"""Writes the seed corpora of map_reader_fuzzer into fuzz/corpus/ and of
+plan_request_fuzzer into fuzz/corpus/plan_request/ (stdlib only).
 
-Each file starts with the selector byte the fuzzer reads (see
+Each map reader seed starts with the selector byte the fuzzer reads (see
 map_reader_fuzzer.cc): 0 image, 1 YAML, 2 YAML + NUL + image, 3 image negated.
+The plan request seeds are covplan.v1.PlanRequest messages in the protobuf
+wire format, encoded here by hand so that no protobuf module is needed.
 """
 
 import os
@@ -54,12 +57,83 @@ SEEDS = {
 }
 
 
-def main():
-    out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus")
+def varint(n):
+    out = b""
+    while True:
+        low = n & 0x7F
+        n >>= 7
+        if n:
+            out += bytes([low | 0x80])
+        else:
+            return out + bytes([low])
+
+
+def field_varint(number, n):
+    return varint(number << 3) + varint(n)
+
+
+def field_double(number, x):
+    return varint(number << 3 | 1) + struct.pack("<d", x)
+
+
+def field_bytes(number, data):
+    return varint(number << 3 | 2) + varint(len(data)) + data
+
+
+def pose(x, y, theta):
+    return field_double(1, x) + field_double(2, y) + field_double(3, theta)
+
+
+def polygon(points, holes=()):
+    """A Polygon of closed rings (the first point repeated at the end)."""
+    def ring(pts):
+        pts = list(pts) + [pts[0]]
+        return b"".join(field_bytes(1, field_double(1, x) + field_double(2, y)) for x, y in pts)
+    return field_bytes(1, ring(points)) + b"".join(field_bytes(2, ring(h)) for h in holes)
+
+
+SQUARE = [(0.0, 0.0), (10.0, 0.0), (10.0, 8.0), (0.0, 8.0)]
+POST = [(4.0, 3.0), (5.0, 3.0), (5.0, 4.0), (4.0, 4.0)]
+ROBOT = field_double(1, 0.5) + field_double(2, 0.8) + field_bytes(5, pose(1.0, 1.0, 0.0))
+POLYGON_MAP = field_bytes(2, field_bytes(2, field_bytes(1, polygon(SQUARE, [POST])) +
+                                         field_double(2, 0.05)))
+RASTER_MAP = field_bytes(2, field_bytes(1, field_bytes(1, P5) + field_double(3, 0.5)))
+MAP_ID = field_bytes(1, b"0" * 64)
+
+PLAN_REQUEST_SEEDS = {
+    # oarp with its nested options, a region and a no-go zone on a polygon map
+    "oarp_polygon_zones": POLYGON_MAP + field_bytes(3, ROBOT) + field_double(6, 0.5) +
+    field_varint(7, 3) + field_bytes(9, b"oarp") + field_bytes(10, field_varint(1, 2) +
+                                                               field_varint(2, 2)) +
+    field_bytes(11, polygon([(1.0, 1.0), (9.0, 1.0), (9.0, 7.0), (1.0, 7.0)])) +
+    field_bytes(12, polygon([(6.0, 5.0), (7.0, 5.0), (7.0, 6.0), (6.0, 6.0)])),
+    # the top-level solver fields of the default planner, a raster map
+    "default_raster": RASTER_MAP + field_bytes(3, field_double(1, 0.5)) + field_varint(4, 1) +
+    field_varint(5, 1) + field_double(8, 0.6),
+    # boustrophedon by stored map id, with a battery
+    "boustrophedon_battery": MAP_ID + field_bytes(3, ROBOT) + field_bytes(9, b"boustrophedon") +
+    field_bytes(14, field_varint(1, 2) + field_varint(2, 2)) +
+    field_bytes(15, field_double(1, 200.0) + field_bytes(2, pose(0.5, 0.5, 0.0)) +
+                field_double(3, 10.0) + field_bytes(4, field_double(1, 1.0) +
+                                                    field_double(2, 0.5))),
+    # stc with every option set, improve_remembered
+    "stc_options": MAP_ID + field_bytes(3, ROBOT) + field_bytes(9, b"stc") +
+    field_bytes(13, field_varint(1, 2) + field_varint(2, 1) + field_varint(3, 2)) +
+    field_varint(16, 1),
+}
+
+
+def write(out, seeds):
     os.makedirs(out, exist_ok=True)
-    for name, data in SEEDS.items():
+    for name, data in seeds.items():
         with open(os.path.join(out, name), "wb") as f:
             f.write(data)
+
+
+def main():
+    out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus")
+    write(out, SEEDS)
+    write(os.path.join(out, "plan_request"), PLAN_REQUEST_SEEDS)
 
 
 if __name__ == "__main__":

@@ -11,8 +11,14 @@ PKGS=(
   prometheus-cpp-dev libpq-dev curl python3
   openssl  # test certificates for server_tls_test
 )
-# Optional tools for fuzzing / sanitizer builds (clang + libFuzzer runtime).
-OPTIONAL=(clang libclang-rt-14-dev)
+# Tools of the checks CI runs (scripts/test.sh with CI=true): clang + the libFuzzer runtime for
+# the fuzz run, clang-format 14 for the format test. Required in CI, optional elsewhere (the
+# format test skips and scripts/check/fuzz.sh cannot run without them).
+OPTIONAL=(clang libclang-rt-14-dev clang-format)
+if [ "${CI:-}" = true ]; then
+  PKGS+=("${OPTIONAL[@]}")
+  OPTIONAL=()
+fi
 # COVPLAN_MINIMAL=1 (the container's build stage): only what the build needs.
 [ "${COVPLAN_MINIMAL:-0}" = 1 ] && OPTIONAL=()
 # Optional tools for the deploy checks (tests deploy.*: promtool, haproxy -c,
@@ -46,7 +52,7 @@ $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${PKGS[@]}" >/dev/null
 # Optional packages: do not fail the install if unavailable.
 [ ${#OPTIONAL[@]} -eq 0 ] || $SUDO apt-get install -y -qq --no-install-recommends "${OPTIONAL[@]}" >/dev/null || \
-  echo "install-deps: optional packages (${OPTIONAL[*]}) not installed; fuzz target disabled"
+  echo "install-deps: optional packages (${OPTIONAL[*]}) not installed; no fuzzing, format test skips"
 [ ${#DEPLOY_TOOLS[@]} -eq 0 ] || $SUDO apt-get install -y -qq --no-install-recommends "${DEPLOY_TOOLS[@]}" >/dev/null || \
   echo "install-deps: ${DEPLOY_TOOLS[*]} not installed; the deploy.rules and deploy.router checks skip"
 echo "install-deps: done"

@@ -18,7 +18,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// The office of scripts/gen_sample_maps.py in map coordinates (origin
+// The office of scripts/maps/gen_sample_maps.py in map coordinates (origin
 // (-1, -0.5), image y flipped): corridor y 8.5..10.5 m across the building;
 // office 2 north of it spans x 5.5..10, y 10.5..18.5 with one 0.9 m door at
 // x 7.0..7.9.

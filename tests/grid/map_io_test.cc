@@ -14,7 +14,7 @@
 #include "gtest/gtest.h"
 #include "planner/grid/map_io.h"
 #include "tests/grid/map_test_util.h"
-#include "tests/grid/png_writer.h"
+#include "tests/testing/png_writer.h"
 
 namespace covplan {
 namespace {

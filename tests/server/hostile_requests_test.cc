@@ -5,7 +5,7 @@
 // echo), and the server must still plan afterwards.
 //
 //   COVPLAN_HOSTILE_COUNT=2000 COVPLAN_HOSTILE_SEED=3 bin/hostile_requests_test
-//   (scripts/hostile_requests.sh runs it so)
+//   (scripts/chaos/hostile_requests.sh runs it so)
 #include <grpcpp/grpcpp.h>
 
 #include <cmath>
@@ -22,7 +22,7 @@
 #include "gtest/gtest.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "api/convert.h"
 #include "gtest/gtest.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {

@@ -17,7 +17,7 @@
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
 #include "tests/server/pg_test_cluster.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {

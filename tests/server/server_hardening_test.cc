@@ -23,11 +23,11 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "png.h"
-#include "tests/grid/png_writer.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/hardening_fixture.h"
 #include "tests/server/server_process.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/png_writer.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {

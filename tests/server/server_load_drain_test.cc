@@ -19,11 +19,11 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "png.h"
-#include "tests/grid/png_writer.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/hardening_fixture.h"
 #include "tests/server/server_process.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/png_writer.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {
@@ -91,8 +91,11 @@ TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExce
 // decoded, and GetMap does not wait behind decoding.
 TEST_F(ServerHardeningTest, QueuedPutMapsPastTheirDeadlineAreDroppedAndReadsDoNotWait) {
   StartServer();
-  testing::PngSpec spec{
-      .width = 3000, .height = 3000, .color_type = PNG_COLOR_TYPE_GRAY, .bit_depth = 16};
+  testing::PngSpec spec;
+  spec.width = 3000;
+  spec.height = 3000;
+  spec.color_type = PNG_COLOR_TYPE_GRAY;
+  spec.bit_depth = 16;
   spec.samples.assign(static_cast<size_t>(spec.width) * spec.height, 65535);
   const v1::Map big = RasterMap(testing::EncodePng(spec), 0.05);
   const std::string small_id = PutMapOk(Variant(0));

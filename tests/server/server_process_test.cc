@@ -23,7 +23,7 @@
 #include "gtest/gtest.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {

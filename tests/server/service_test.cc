@@ -24,7 +24,7 @@
 #include "server/covplan_server.h"
 #include "server/served_replies.h"
 #include "tests/server/grpc_probe.h"
-#include "tests/server/test_maps.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {
