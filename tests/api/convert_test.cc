@@ -146,9 +146,9 @@ TEST(MapFromProtoTest, EnforcesSizeLimits) {
               StatusIs(absl::StatusCode::kInvalidArgument, "too large"));
   // Claims whose product overflows 64 bits (found by plan_request_fuzzer) are
   // refused the same way, with the product in the message.
-  EXPECT_THAT(MapFromProto(RasterMap("P5\n400000000000000 800000400\n255\n", 0.1), EngineLimits()),
+  EXPECT_THAT(MapFromProto(RasterMap("P5\n400000000000 800000400\n255\n", 0.1), EngineLimits()),
               StatusIs(absl::StatusCode::kInvalidArgument,
-                       "400000000000000 x 800000400 = 320000160000000000000000 pixels"));
+                       "400000000000 x 800000400 = 320000160000000000000 pixels"));
 }
 
 TEST(PlanRequestFromProtoTest, ValidatesRobotAndSolvers) {
