@@ -22,8 +22,8 @@ void Check(const absl::Status& s, const char* what) {
   }
 }
 
-covplan::InputLimits FuzzLimits() {
-  covplan::InputLimits limits;
+covplan::EngineLimits FuzzLimits() {
+  covplan::EngineLimits limits;
   limits.max_image_bytes = 1 << 16;
   limits.max_map_pixels = 1 << 18;
   limits.max_area_vertices = 2000;
@@ -52,7 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   if (proto.has_map()) {
-    static const covplan::InputLimits limits = FuzzLimits();
+    static const covplan::EngineLimits limits = FuzzLimits();
     Check(covplan::SiteFromProto(proto.map(), limits).status(), "SiteFromProto");
     (void)covplan::ComputeMapId(proto.map());
   } else {
