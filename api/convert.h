@@ -84,6 +84,10 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response);
 // happen in the replanner, with the same field names.
 absl::StatusOr<ReplanMethod> ReplanMethodFromProto(v1::ReplanMethod method);
 absl::StatusOr<RobotProgress> ProgressFromProto(const v1::RobotProgress& progress);
+// The inverses, for a client that sends a replan and reads its statistics.
+v1::ReplanMethod ReplanMethodToProto(ReplanMethod method);
+void ProgressToProto(const RobotProgress& progress, v1::RobotProgress* out);
+ReplanStats ReplanStatsFromProto(const v1::ReplanStats& stats);
 Observations ObstaclesFromProto(const v1::Obstacles& obstacles);
 // `retained` is the new plan as the server keeps it (plan_id set).
 void ReplanToProto(const ReplanResult& result, const RetainedPlan& retained,

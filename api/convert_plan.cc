@@ -104,6 +104,202 @@ PlanOrigin PlanOriginFromProto(v1::PlanSource s) {
   }
 }
 
+// The grid's rows, checked for shape and '0'/'1' cells.
+absl::StatusOr<std::shared_ptr<const Grid>> GridFromProto(const v1::Grid& g) {
+  if (g.rows() <= 0 || g.cols() <= 0 || g.free_cells_size() != g.rows()) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("plan grid is inconsistent: %d rows x %d cols with %d row strings",
+                        g.rows(), g.cols(), g.free_cells_size()));
+  }
+  if (!std::isfinite(g.cell_size_m()) || g.cell_size_m() <= 0.0) {
+    return absl::InvalidArgumentError("plan grid cell_size_m must be positive");
+  }
+  std::vector<uint8_t> free;
+  free.reserve(static_cast<size_t>(g.rows()) * g.cols());
+  for (const std::string& row : g.free_cells()) {
+    if (static_cast<int>(row.size()) != g.cols()) {
+      return absl::InvalidArgumentError("plan grid row length differs from cols");
+    }
+    for (char c : row) {
+      if (c != '0' && c != '1') return absl::InvalidArgumentError("plan grid rows must be '0'/'1'");
+      free.push_back(c == '1');
+    }
+  }
+  return std::make_shared<const Grid>(g.rows(), g.cols(), g.cell_size_m(),
+                                      Point2{g.origin_x_m(), g.origin_y_m()}, std::move(free));
+}
+
+// The OARP detail: the oneof, or (older servers) the top-level rank fields;
+// null when the response has neither.
+absl::StatusOr<std::shared_ptr<const PlannerDetail>> OarpDetailFromProto(
+    const v1::PlanResponse& response, const Grid& grid) {
+  const bool has_oarp = response.has_oarp();
+  const auto& ranks = has_oarp ? response.oarp().ranks() : response.ranks();
+  const auto& order = has_oarp ? response.oarp().rank_order() : response.rank_order();
+  const auto& reversed = has_oarp ? response.oarp().rank_reversed() : response.rank_reversed();
+  if (!has_oarp && ranks.empty()) return std::shared_ptr<const PlannerDetail>();
+  auto detail = std::make_shared<OarpDetail>();
+  for (const v1::Rank& r : ranks) {
+    Rank rank;
+    if (r.orientation() != v1::HORIZONTAL && r.orientation() != v1::VERTICAL) {
+      return absl::InvalidArgumentError("plan rank has no orientation");
+    }
+    rank.orientation =
+        r.orientation() == v1::HORIZONTAL ? Orientation::kHorizontal : Orientation::kVertical;
+    rank.first = {r.first_cell().row(), r.first_cell().col()};
+    rank.last = {r.last_cell().row(), r.last_cell().col()};
+    if (!grid.InBounds(rank.first.row, rank.first.col) ||
+        !grid.InBounds(rank.last.row, rank.last.col)) {
+      return absl::InvalidArgumentError("plan rank lies outside the grid");
+    }
+    detail->ranks.push_back(rank);
+  }
+  for (int32_t index : order) {
+    if (index < 0 || index >= static_cast<int>(detail->ranks.size())) {
+      return absl::InvalidArgumentError("plan rank_order refers to a missing rank");
+    }
+    detail->rank_order.push_back(index);
+  }
+  detail->rank_reversed.assign(reversed.begin(), reversed.end());
+  return std::shared_ptr<const PlannerDetail>(std::move(detail));
+}
+
+absl::StatusOr<std::shared_ptr<const PlannerDetail>> BoustrophedonDetailFromProto(
+    const v1::BoustrophedonDetail& b, const Grid& grid) {
+  auto detail = std::make_shared<BoustrophedonDetail>();
+  for (const v1::BoustrophedonCell& c : b.cells()) {
+    if (c.row_lo_size() != c.row_hi_size() || c.first_col() < 0 ||
+        c.first_col() + c.row_lo_size() > grid.cols()) {
+      return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
+    }
+    BoustrophedonCellInfo info;
+    info.cell.first_col = c.first_col();
+    for (int k = 0; k < c.row_lo_size(); ++k) {
+      if (c.row_lo(k) < 0 || c.row_lo(k) > c.row_hi(k) || c.row_hi(k) >= grid.rows()) {
+        return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
+      }
+      info.cell.columns.push_back({c.row_lo(k), c.row_hi(k)});
+    }
+    info.axis =
+        c.axis() == v1::SWEEP_AXIS_HORIZONTAL ? SweepAxis::kHorizontal : SweepAxis::kVertical;
+    info.num_lines = c.num_lines();
+    detail->cells.push_back(std::move(info));
+  }
+  for (int32_t index : b.cell_order()) {
+    if (index < 0 || index >= static_cast<int>(detail->cells.size())) {
+      return absl::InvalidArgumentError("plan cell_order refers to a missing cell");
+    }
+    detail->cell_order.push_back(index);
+  }
+  detail->cell_reversed.assign(b.cell_reversed().begin(), b.cell_reversed().end());
+  detail->cell_mirrored.assign(b.cell_mirrored().begin(), b.cell_mirrored().end());
+  return std::shared_ptr<const PlannerDetail>(std::move(detail));
+}
+
+// The path, then the sweeps (which refer to its waypoints), into `plan`.
+absl::Status PathFromProto(const v1::PlanResponse& response, CoveragePlan* plan) {
+  for (const v1::Waypoint& p : response.path()) {
+    Waypoint w;
+    w.x = p.x();
+    w.y = p.y();
+    w.theta = p.theta();
+    absl::StatusOr<SegmentKind> kind = KindFromProto(p.kind());
+    if (!kind.ok()) return kind.status();
+    w.kind = *kind;
+    w.rank = p.rank();
+    plan->path.push_back(w);
+  }
+  for (const v1::CoverageSweep& s : response.sweeps()) {
+    if (s.waypoint() < 0 || s.waypoint() >= static_cast<int>(plan->path.size())) {
+      return absl::InvalidArgumentError("plan sweep refers to a missing waypoint");
+    }
+    CoverageSweep sweep;
+    sweep.waypoint = s.waypoint();
+    for (int32_t cell : s.cells()) {
+      if (cell < 0 || cell >= plan->grid->size()) {
+        return absl::InvalidArgumentError("plan sweep cell lies outside the grid");
+      }
+      sweep.cells.push_back(plan->grid->FromIndex(cell));
+    }
+    plan->sweeps.push_back(std::move(sweep));
+  }
+  return absl::OkStatus();
+}
+
+Termination TerminationFromProto(const v1::Termination& t) {
+  Termination out;
+  out.reason = t.reason() == v1::FEASIBLE_LIMIT_REACHED ? TerminationReason::kFeasibleLimitReached
+                                                        : TerminationReason::kConverged;
+  switch (t.limit()) {
+    case v1::LIMIT_TIME:
+      out.limit = TerminationLimit::kTime;
+      break;
+    case v1::LIMIT_DEADLINE:
+      out.limit = TerminationLimit::kDeadline;
+      break;
+    case v1::LIMIT_CANCELLED:
+      out.limit = TerminationLimit::kCancelled;
+      break;
+    default:
+      out.limit = TerminationLimit::kNone;
+      break;
+  }
+  out.detail = t.detail();
+  return out;
+}
+
+PlanStats PlanStatsFromProto(const v1::PlanStats& s) {
+  PlanStats o;
+  o.num_ranks = s.num_ranks();
+  o.num_turns = s.num_turns();
+  o.coverage_length_m = s.coverage_length_m();
+  o.transition_length_m = s.transition_length_m();
+  o.covered_free_area_ratio = s.covered_free_area_ratio();
+  o.estimated_duration_s = s.estimated_duration_s();
+  o.turning_time_s = s.turning_time_s();
+  o.planning_ms = s.planning_ms();
+  o.grid_ms = s.grid_ms();
+  o.partition_ms = s.partition_ms();
+  o.transitions_ms = s.transitions_ms();
+  o.tour_ms = s.tour_ms();
+  o.free_cells = s.free_cells();
+  o.grid_rows = s.grid_rows();
+  o.grid_cols = s.grid_cols();
+  o.map_free_area_m2 = s.map_free_area_m2();
+  o.tour_cut_short = s.tour_cut_short();
+  o.decomposition_cached = s.decomposition_cached();
+  o.plan_source = PlanOriginFromProto(s.plan_source());
+  o.partition_solver = s.partition_solver();
+  o.tour_solver = s.tour_solver();
+  o.unreachable_free_cells = s.unreachable_free_cells();
+  o.covered_cells = s.covered_cells();
+  o.no_go_cells = s.no_go_cells();
+  o.mission_covered_cells = s.mission_covered_cells();
+  o.mission_cut_off_cells = s.mission_cut_off_cells();
+  o.mission_obstructed_cells = s.mission_obstructed_cells();
+  o.charge_cycles = s.charge_cycles();
+  o.energy_total = s.energy_total();
+  o.energy_unconstrained = s.energy_unconstrained();
+  o.energy_lower_bound = s.energy_lower_bound();
+  return o;
+}
+
+// The charge cycles, checked against the path's length.
+absl::StatusOr<std::vector<ChargeCycle>> CyclesFromProto(const v1::PlanResponse& response,
+                                                         int num_waypoints) {
+  std::vector<ChargeCycle> cycles;
+  for (const v1::ChargeCycle& c : response.cycles()) {
+    for (int w : {c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint()}) {
+      if (w < 0 || w >= num_waypoints)
+        return absl::InvalidArgumentError("plan charge cycle refers to a missing waypoint");
+    }
+    cycles.push_back({c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(),
+                      c.leave_waypoint(), c.energy(), c.energy_at_leave(), c.resume_unit(),
+                      c.resumes_mid_unit()});
+  }
+  return cycles;
+}
+
 }  // namespace
 
 void PolygonsToProto(const std::vector<PolygonInput>& polygons,
@@ -263,182 +459,21 @@ void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
 }
 
 absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
-  const v1::Grid& g = response.grid();
-  if (g.rows() <= 0 || g.cols() <= 0 || g.free_cells_size() != g.rows()) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("plan grid is inconsistent: %d rows x %d cols with %d row strings",
-                        g.rows(), g.cols(), g.free_cells_size()));
-  }
-  if (!std::isfinite(g.cell_size_m()) || g.cell_size_m() <= 0.0) {
-    return absl::InvalidArgumentError("plan grid cell_size_m must be positive");
-  }
-  std::vector<uint8_t> free;
-  free.reserve(static_cast<size_t>(g.rows()) * g.cols());
-  for (const std::string& row : g.free_cells()) {
-    if (static_cast<int>(row.size()) != g.cols()) {
-      return absl::InvalidArgumentError("plan grid row length differs from cols");
-    }
-    for (char c : row) {
-      if (c != '0' && c != '1') return absl::InvalidArgumentError("plan grid rows must be '0'/'1'");
-      free.push_back(c == '1');
-    }
-  }
   CoveragePlan plan;
+  ASSIGN_OR_RETURN(plan.grid, GridFromProto(response.grid()));
   plan.planner = response.planner();
-  plan.grid = std::make_shared<const Grid>(g.rows(), g.cols(), g.cell_size_m(),
-                                           Point2{g.origin_x_m(), g.origin_y_m()}, std::move(free));
-  // OARP detail: the oneof, or (older servers) the top-level rank fields.
-  const bool has_oarp = response.has_oarp();
-  const auto& ranks = has_oarp ? response.oarp().ranks() : response.ranks();
-  const auto& order = has_oarp ? response.oarp().rank_order() : response.rank_order();
-  const auto& reversed = has_oarp ? response.oarp().rank_reversed() : response.rank_reversed();
-  if (has_oarp || !ranks.empty()) {
-    auto detail = std::make_shared<OarpDetail>();
-    for (const v1::Rank& r : ranks) {
-      Rank rank;
-      if (r.orientation() != v1::HORIZONTAL && r.orientation() != v1::VERTICAL) {
-        return absl::InvalidArgumentError("plan rank has no orientation");
-      }
-      rank.orientation =
-          r.orientation() == v1::HORIZONTAL ? Orientation::kHorizontal : Orientation::kVertical;
-      rank.first = {r.first_cell().row(), r.first_cell().col()};
-      rank.last = {r.last_cell().row(), r.last_cell().col()};
-      if (!plan.grid->InBounds(rank.first.row, rank.first.col) ||
-          !plan.grid->InBounds(rank.last.row, rank.last.col)) {
-        return absl::InvalidArgumentError("plan rank lies outside the grid");
-      }
-      detail->ranks.push_back(rank);
-    }
-    for (int32_t index : order) {
-      if (index < 0 || index >= static_cast<int>(detail->ranks.size())) {
-        return absl::InvalidArgumentError("plan rank_order refers to a missing rank");
-      }
-      detail->rank_order.push_back(index);
-    }
-    detail->rank_reversed.assign(reversed.begin(), reversed.end());
-    plan.detail = std::move(detail);
-  }
+  ASSIGN_OR_RETURN(plan.detail, OarpDetailFromProto(response, *plan.grid));
   if (response.has_boustrophedon()) {
-    const v1::BoustrophedonDetail& b = response.boustrophedon();
-    auto detail = std::make_shared<BoustrophedonDetail>();
-    for (const v1::BoustrophedonCell& c : b.cells()) {
-      if (c.row_lo_size() != c.row_hi_size() || c.first_col() < 0 ||
-          c.first_col() + c.row_lo_size() > plan.grid->cols()) {
-        return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
-      }
-      BoustrophedonCellInfo info;
-      info.cell.first_col = c.first_col();
-      for (int k = 0; k < c.row_lo_size(); ++k) {
-        if (c.row_lo(k) < 0 || c.row_lo(k) > c.row_hi(k) || c.row_hi(k) >= plan.grid->rows()) {
-          return absl::InvalidArgumentError("plan boustrophedon cell lies outside the grid");
-        }
-        info.cell.columns.push_back({c.row_lo(k), c.row_hi(k)});
-      }
-      info.axis =
-          c.axis() == v1::SWEEP_AXIS_HORIZONTAL ? SweepAxis::kHorizontal : SweepAxis::kVertical;
-      info.num_lines = c.num_lines();
-      detail->cells.push_back(std::move(info));
-    }
-    for (int32_t index : b.cell_order()) {
-      if (index < 0 || index >= static_cast<int>(detail->cells.size())) {
-        return absl::InvalidArgumentError("plan cell_order refers to a missing cell");
-      }
-      detail->cell_order.push_back(index);
-    }
-    detail->cell_reversed.assign(b.cell_reversed().begin(), b.cell_reversed().end());
-    detail->cell_mirrored.assign(b.cell_mirrored().begin(), b.cell_mirrored().end());
-    plan.detail = std::move(detail);
+    ASSIGN_OR_RETURN(plan.detail,
+                     BoustrophedonDetailFromProto(response.boustrophedon(), *plan.grid));
   }
   if (response.has_stc()) {
     ASSIGN_OR_RETURN(plan.detail, StcDetailFromProto(response.stc()));
   }
-  for (const v1::Waypoint& p : response.path()) {
-    Waypoint w;
-    w.x = p.x();
-    w.y = p.y();
-    w.theta = p.theta();
-    absl::StatusOr<SegmentKind> kind = KindFromProto(p.kind());
-    if (!kind.ok()) return kind.status();
-    w.kind = *kind;
-    w.rank = p.rank();
-    plan.path.push_back(w);
-  }
-  for (const v1::CoverageSweep& s : response.sweeps()) {
-    if (s.waypoint() < 0 || s.waypoint() >= static_cast<int>(plan.path.size())) {
-      return absl::InvalidArgumentError("plan sweep refers to a missing waypoint");
-    }
-    CoverageSweep sweep;
-    sweep.waypoint = s.waypoint();
-    for (int32_t cell : s.cells()) {
-      if (cell < 0 || cell >= plan.grid->size()) {
-        return absl::InvalidArgumentError("plan sweep cell lies outside the grid");
-      }
-      sweep.cells.push_back(plan.grid->FromIndex(cell));
-    }
-    plan.sweeps.push_back(std::move(sweep));
-  }
-  const v1::Termination& t = response.termination();
-  plan.termination.reason = t.reason() == v1::FEASIBLE_LIMIT_REACHED
-                                ? TerminationReason::kFeasibleLimitReached
-                                : TerminationReason::kConverged;
-  switch (t.limit()) {
-    case v1::LIMIT_TIME:
-      plan.termination.limit = TerminationLimit::kTime;
-      break;
-    case v1::LIMIT_DEADLINE:
-      plan.termination.limit = TerminationLimit::kDeadline;
-      break;
-    case v1::LIMIT_CANCELLED:
-      plan.termination.limit = TerminationLimit::kCancelled;
-      break;
-    default:
-      plan.termination.limit = TerminationLimit::kNone;
-      break;
-  }
-  plan.termination.detail = t.detail();
-  const v1::PlanStats& s = response.stats();
-  PlanStats& o = plan.stats;
-  o.num_ranks = s.num_ranks();
-  o.num_turns = s.num_turns();
-  o.coverage_length_m = s.coverage_length_m();
-  o.transition_length_m = s.transition_length_m();
-  o.covered_free_area_ratio = s.covered_free_area_ratio();
-  o.estimated_duration_s = s.estimated_duration_s();
-  o.turning_time_s = s.turning_time_s();
-  o.planning_ms = s.planning_ms();
-  o.grid_ms = s.grid_ms();
-  o.partition_ms = s.partition_ms();
-  o.transitions_ms = s.transitions_ms();
-  o.tour_ms = s.tour_ms();
-  o.free_cells = s.free_cells();
-  o.grid_rows = s.grid_rows();
-  o.grid_cols = s.grid_cols();
-  o.map_free_area_m2 = s.map_free_area_m2();
-  o.tour_cut_short = s.tour_cut_short();
-  o.decomposition_cached = s.decomposition_cached();
-  o.plan_source = PlanOriginFromProto(s.plan_source());
-  o.partition_solver = s.partition_solver();
-  o.tour_solver = s.tour_solver();
-  o.unreachable_free_cells = s.unreachable_free_cells();
-  o.covered_cells = s.covered_cells();
-  o.no_go_cells = s.no_go_cells();
-  o.mission_covered_cells = s.mission_covered_cells();
-  o.mission_cut_off_cells = s.mission_cut_off_cells();
-  o.mission_obstructed_cells = s.mission_obstructed_cells();
-  o.charge_cycles = s.charge_cycles();
-  o.energy_total = s.energy_total();
-  o.energy_unconstrained = s.energy_unconstrained();
-  o.energy_lower_bound = s.energy_lower_bound();
-  for (const v1::ChargeCycle& c : response.cycles()) {
-    const int n = static_cast<int>(plan.path.size());
-    for (int w : {c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(), c.leave_waypoint()}) {
-      if (w < 0 || w >= n)
-        return absl::InvalidArgumentError("plan charge cycle refers to a missing waypoint");
-    }
-    plan.cycles.push_back({c.first_waypoint(), c.last_waypoint(), c.resume_waypoint(),
-                           c.leave_waypoint(), c.energy(), c.energy_at_leave(), c.resume_unit(),
-                           c.resumes_mid_unit()});
-  }
+  RETURN_IF_ERROR(PathFromProto(response, &plan));
+  plan.termination = TerminationFromProto(response.termination());
+  plan.stats = PlanStatsFromProto(response.stats());
+  ASSIGN_OR_RETURN(plan.cycles, CyclesFromProto(response, static_cast<int>(plan.path.size())));
   return plan;
 }
 

@@ -46,6 +46,60 @@ absl::StatusOr<RobotProgress> ProgressFromProto(const v1::RobotProgress& p) {
   return out;
 }
 
+v1::ReplanMethod ReplanMethodToProto(ReplanMethod m) {
+  switch (m) {
+    case ReplanMethod::kAuto:
+      return v1::AUTO;
+    case ReplanMethod::kIlp1:
+      return v1::ILP1;
+    case ReplanMethod::kIlp2:
+      return v1::ILP2;
+    case ReplanMethod::kGreedyDetour:
+      return v1::GREEDY_DETOUR;
+    case ReplanMethod::kFull:
+      return v1::FULL;
+  }
+  return v1::AUTO;
+}
+
+void ProgressToProto(const RobotProgress& at, v1::RobotProgress* out) {
+  if (at.waypoint >= 1) out->set_waypoint(at.waypoint);
+  if (at.distance_m) out->set_distance_m(*at.distance_m);
+  if (at.position) {
+    out->mutable_position()->set_x(at.position->x);
+    out->mutable_position()->set_y(at.position->y);
+  }
+  if (at.tolerance_m) out->set_tolerance_m(*at.tolerance_m);
+}
+
+ReplanStats ReplanStatsFromProto(const v1::ReplanStats& s) {
+  ReplanStats out;
+  out.method = s.method();
+  out.num_encounters = s.num_encounters();
+  out.greedy_detours.assign(s.greedy_detours().begin(), s.greedy_detours().end());
+  out.replanned_encounter = s.replanned_encounter();
+  out.time_to_encounter_s = s.time_to_encounter_s();
+  out.rank_budget = s.rank_budget();
+  out.new_ranks = s.new_ranks();
+  out.kept_ranks = s.kept_ranks();
+  out.kept_path_pieces = s.kept_path_pieces();
+  out.kept_path_m = s.kept_path_m();
+  out.newly_blocked_cells = s.newly_blocked_cells();
+  out.covered_cells_before = s.covered_cells_before();
+  out.remaining_cells = s.remaining_cells();
+  out.newly_unreachable_cells = s.newly_unreachable_cells();
+  out.newly_obstructed_cells = s.newly_obstructed_cells();
+  out.remaining_free_area_m2 = s.remaining_free_area_m2();
+  out.rank_replan_ms = s.rank_replan_ms();
+  out.transitions_ms = s.transitions_ms();
+  out.tour_ms = s.tour_ms();
+  out.total_ms = s.total_ms();
+  out.end_moved = s.end_moved();
+  out.robot_cell_blocked = s.robot_cell_blocked();
+  out.robot_cell_kept_free = s.robot_cell_kept_free();
+  return out;
+}
+
 Observations ObstaclesFromProto(const v1::Obstacles& o) {
   Observations out;
   for (const v1::CellRef& c : o.cells()) out.cells.push_back({c.row(), c.col()});

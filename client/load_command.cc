@@ -102,66 +102,79 @@ double Percentile(std::vector<double> sorted, double q) {
   return sorted[std::min(sorted.size() - 1, rank == 0 ? 0 : rank - 1)];
 }
 
-absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(
-      ParsedArgs a,
-      ParseArgs(args,
-                WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
-                                     "deadline-ms", "resolution", "tool-width", "time-limit",
-                                     "tour", "backoff-ms", "zipf", "seed", "requests"}),
-                {"inline", "random-start", "full-replies"}));
+// The flags of one load run, checked.
+struct LoadFlags {
+  std::string server;
+  std::optional<double> zipf;
+  std::optional<int64_t> seed;
+  std::optional<int64_t> max_requests;
+  std::optional<int64_t> backoff_ms;
+  std::optional<double> tool;
+  std::optional<double> limit;
+  std::optional<std::string> tour;
+  MapFileOverrides overrides;
+  int threads = 4;
+  double seconds = 10.0;
+  int64_t deadline = 1000;
+  bool send_inline = false;
+  bool random_start = false;
+  bool full_replies = false;
+};
+
+absl::StatusOr<LoadFlags> ParseLoadFlags(const ParsedArgs& a) {
   if (!a.Get("server")) return absl::InvalidArgumentError("--server HOST:PORT is required");
   if (!a.Get("map") == !a.Get("maps")) {
     return absl::InvalidArgumentError("exactly one of --map FILE or --maps DIR|LIST is required");
   }
-  ASSIGN_OR_RETURN(std::optional<double> zipf, a.GetDouble("zipf"));
-  ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
-  ASSIGN_OR_RETURN(std::optional<int64_t> max_requests, a.GetInt("requests"));
-  if (zipf && !(*zipf >= 0 && *zipf <= 10))
+  LoadFlags f;
+  ASSIGN_OR_RETURN(f.zipf, a.GetDouble("zipf"));
+  ASSIGN_OR_RETURN(f.seed, a.GetInt("seed"));
+  ASSIGN_OR_RETURN(f.max_requests, a.GetInt("requests"));
+  if (f.zipf && !(*f.zipf >= 0 && *f.zipf <= 10))
     return absl::InvalidArgumentError("--zipf must be in [0, 10]");
-  if (max_requests && *max_requests <= 0)
+  if (f.max_requests && *f.max_requests <= 0)
     return absl::InvalidArgumentError("--requests must be positive");
   ASSIGN_OR_RETURN(std::optional<int64_t> concurrency, a.GetInt("concurrency"));
   ASSIGN_OR_RETURN(std::optional<double> duration, a.GetDouble("duration"));
   ASSIGN_OR_RETURN(std::optional<int64_t> deadline_ms, a.GetInt("deadline-ms"));
-  ASSIGN_OR_RETURN(std::optional<int64_t> backoff_ms, a.GetInt("backoff-ms"));
-  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
-  ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
-  MapFileOverrides overrides;
-  ASSIGN_OR_RETURN(overrides.resolution, a.GetDouble("resolution"));
-  const int threads = static_cast<int>(concurrency.value_or(4));
-  if (threads < 1 || threads > 1024)
+  ASSIGN_OR_RETURN(f.backoff_ms, a.GetInt("backoff-ms"));
+  ASSIGN_OR_RETURN(f.tool, a.GetDouble("tool-width"));
+  ASSIGN_OR_RETURN(f.limit, a.GetDouble("time-limit"));
+  ASSIGN_OR_RETURN(f.overrides.resolution, a.GetDouble("resolution"));
+  f.threads = static_cast<int>(concurrency.value_or(4));
+  if (f.threads < 1 || f.threads > 1024)
     return absl::InvalidArgumentError("--concurrency must be in [1, 1024]");
-  const double seconds = duration.value_or(10.0);
-  if (!(seconds > 0 && seconds <= 24 * 3600))
+  f.seconds = duration.value_or(10.0);
+  if (!(f.seconds > 0 && f.seconds <= 24 * 3600))
     return absl::InvalidArgumentError("--duration must be in (0, 86400]");
-  const int64_t deadline = deadline_ms.value_or(1000);
-  if (deadline <= 0) return absl::InvalidArgumentError("--deadline-ms must be positive");
+  f.deadline = deadline_ms.value_or(1000);
+  if (f.deadline <= 0) return absl::InvalidArgumentError("--deadline-ms must be positive");
+  f.server = *a.Get("server");
+  f.tour = a.Get("tour");
+  f.send_inline = a.Has("inline");
+  f.random_start = a.Has("random-start");
+  f.full_replies = a.Has("full-replies");
+  return f;
+}
 
-  const std::string server = *a.Get("server");
-  std::vector<std::string> files;
-  if (a.Get("map")) {
-    files.push_back(*a.Get("map"));
-  } else {
-    ASSIGN_OR_RETURN(files, MapFiles(*a.Get("maps")));
-  }
-  const bool send_inline = a.Has("inline");
-  const bool random_start = a.Has("random-start");
-  const bool full_replies = a.Has("full-replies");
-  std::vector<std::vector<Point2>> start_cells;  // per map, with --random-start
-  ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, server));
-  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(connection);
-  // One prepared request per map.
+// One prepared request per map, in the order of the map files.
+struct PreparedMaps {
   std::vector<v1::PlanRequest> requests;
-  std::vector<std::string> acknowledged;
+  std::vector<std::string> acknowledged;         // map ids PutMap returned (not with --inline)
+  std::vector<std::vector<Point2>> start_cells;  // per map, with --random-start
+};
+
+absl::StatusOr<PreparedMaps> PrepareMaps(const LoadFlags& f, const std::vector<std::string>& files,
+                                         RemotePlanner* remote) {
+  PreparedMaps out;
   for (const std::string& file : files) {
-    ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, overrides, EngineLimits()));
-    if (random_start) {
-      ASSIGN_OR_RETURN(std::vector<Point2> cells, ReachableCellCentres(map, tool.value_or(0.8)));
-      start_cells.push_back(std::move(cells));
+    ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(file, f.overrides, EngineLimits()));
+    if (f.random_start) {
+      ASSIGN_OR_RETURN(std::vector<Point2> cells, ReachableCellCentres(map, f.tool.value_or(0.8)));
+      out.start_cells.push_back(std::move(cells));
     }
     v1::PlanRequest request;
-    if (send_inline) {
+    if (f.send_inline) {
       *request.mutable_map() = std::move(map);
     } else {
       v1::PutMapRequest put;
@@ -170,87 +183,139 @@ absl::Status Run(const std::vector<std::string>& args) {
       absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
       if (!stored.ok()) {
         return absl::Status(stored.status().code(),
-                            absl::StrCat("PutMap of ", file, " to ", server, " failed: ",
+                            absl::StrCat("PutMap of ", file, " to ", f.server, " failed: ",
                                          absl::StatusCodeToString(stored.status().code()), ": ",
                                          stored.status().message()));
       }
       request.set_map_id(stored->map_id());
-      acknowledged.push_back(stored->map_id());
+      out.acknowledged.push_back(stored->map_id());
     }
-    request.mutable_robot()->set_tool_width_m(tool.value_or(0.8));
-    if (limit) request.set_time_limit_s(*limit);
-    if (auto t = a.Get("tour")) request.set_tour_solver(*t == "greedy" ? v1::GREEDY : v1::GTSP);
-    requests.push_back(std::move(request));
+    request.mutable_robot()->set_tool_width_m(f.tool.value_or(0.8));
+    if (f.limit) request.set_time_limit_s(*f.limit);
+    if (f.tour) request.set_tour_solver(*f.tour == "greedy" ? v1::GREEDY : v1::GTSP);
+    out.requests.push_back(std::move(request));
   }
-  std::vector<double> weights;
-  for (size_t k = 0; k < requests.size(); ++k) {
-    weights.push_back(1.0 / std::pow(static_cast<double>(k + 1), zipf.value_or(0.0)));
+  return out;
+}
+
+// Sends the prepared requests from `flags.threads` workers until the
+// duration or the request count runs out, and tallies the replies.
+// Thread-compatible: one Run() per instance; the workers share `remote`.
+class LoadRun {
+ public:
+  LoadRun(const LoadFlags& flags, const PreparedMaps& maps, RemotePlanner* remote)
+      : flags_(flags), maps_(maps), remote_(remote) {
+    for (size_t k = 0; k < maps_.requests.size(); ++k) {
+      weights_.push_back(1.0 / std::pow(static_cast<double>(k + 1), flags_.zipf.value_or(0.0)));
+    }
   }
 
-  LoadReport report;
-  report.concurrency = threads;
-  report.deadline_ms = deadline;
-  report.maps = static_cast<int>(requests.size());
-  report.map_ids = acknowledged;
-  report.random_start = random_start;
-  absl::Mutex mu;
-  int64_t issued = 0;  // guarded by mu
-  const absl::Time start = absl::Now();
-  const absl::Time end = start + absl::Seconds(seconds);
-  std::vector<std::thread> workers;
-  for (int t = 0; t < threads; ++t) {
-    workers.emplace_back([&, t] {
-      std::mt19937_64 rng(static_cast<uint64_t>(seed.value_or(1)) * 1000003u + t);
-      std::discrete_distribution<size_t> pick(weights.begin(), weights.end());
-      while (absl::Now() < end) {
-        if (max_requests) {
-          absl::MutexLock lock(&mu);
-          if (issued >= *max_requests) break;
-          ++issued;
-        }
-        const size_t k = pick(rng);
-        v1::PlanRequest request = requests[k];
-        if (random_start) {
-          const std::vector<Point2>& cells = start_cells[k];
-          const Point2 p = cells[std::uniform_int_distribution<size_t>(0, cells.size() - 1)(rng)];
-          v1::Pose* start = request.mutable_robot()->mutable_start();
-          start->set_x(p.x);
-          start->set_y(p.y);
-          start->set_theta(std::uniform_real_distribution<double>(0.0, 2 * M_PI)(rng));
-        }
-        const absl::Time sent = absl::Now();
-        absl::StatusOr<v1::PlanStats> reply;
-        if (full_replies) {
-          absl::StatusOr<v1::PlanResponse> whole =
-              remote->Plan(request, absl::Milliseconds(deadline));
-          reply = whole.ok() ? absl::StatusOr<v1::PlanStats>(whole->stats()) : whole.status();
-        } else {
-          reply = remote->PlanStatsOnly(request, absl::Milliseconds(deadline));
-        }
-        const double ms = absl::ToDoubleMilliseconds(absl::Now() - sent);
-        {
-          absl::MutexLock lock(&mu);
-          ++report.requests;
-          ++report.codes[absl::StatusCodeToString(reply.status().code())];
-          report.latencies_ms.push_back(ms);
-          if (reply.ok()) {
-            ++report.ok;
-            report.cut_short += reply->tour_cut_short();
-            ++report.plan_sources[SourceName(reply->plan_source())];
-            report.estimated_duration_sum_s += reply->estimated_duration_s();
-          }
-          if (ms > static_cast<double>(deadline)) ++report.late;
-        }
-        // Back off briefly after a refusal so an overloaded server is probed,
-        // not hammered.
-        if (absl::IsResourceExhausted(reply.status())) {
-          absl::SleepFor(absl::Milliseconds(backoff_ms.value_or(10)));
-        }
-      }
-    });
+  LoadReport Run() {
+    report_.concurrency = flags_.threads;
+    report_.deadline_ms = flags_.deadline;
+    report_.maps = static_cast<int>(maps_.requests.size());
+    report_.map_ids = maps_.acknowledged;
+    report_.random_start = flags_.random_start;
+    const absl::Time start = absl::Now();
+    end_ = start + absl::Seconds(flags_.seconds);
+    std::vector<std::thread> workers;
+    for (int t = 0; t < flags_.threads; ++t) workers.emplace_back([this, t] { Work(t); });
+    for (std::thread& w : workers) w.join();
+    report_.duration_s = absl::ToDoubleSeconds(absl::Now() - start);
+    return report_;
   }
-  for (std::thread& w : workers) w.join();
-  report.duration_s = absl::ToDoubleSeconds(absl::Now() - start);
+
+ private:
+  // False once --requests requests have been issued.
+  bool TakeTicket() {
+    if (!flags_.max_requests) return true;
+    absl::MutexLock lock(&mu_);
+    if (issued_ >= *flags_.max_requests) return false;
+    ++issued_;
+    return true;
+  }
+
+  // Map k's request, from a random reachable start with --random-start.
+  v1::PlanRequest RequestFor(size_t k, std::mt19937_64& rng) const {
+    v1::PlanRequest request = maps_.requests[k];
+    if (flags_.random_start) {
+      const std::vector<Point2>& cells = maps_.start_cells[k];
+      const Point2 p = cells[std::uniform_int_distribution<size_t>(0, cells.size() - 1)(rng)];
+      v1::Pose* start = request.mutable_robot()->mutable_start();
+      start->set_x(p.x);
+      start->set_y(p.y);
+      start->set_theta(std::uniform_real_distribution<double>(0.0, 2 * M_PI)(rng));
+    }
+    return request;
+  }
+
+  absl::StatusOr<v1::PlanStats> Send(const v1::PlanRequest& request) const {
+    const absl::Duration deadline = absl::Milliseconds(flags_.deadline);
+    if (!flags_.full_replies) return remote_->PlanStatsOnly(request, deadline);
+    absl::StatusOr<v1::PlanResponse> whole = remote_->Plan(request, deadline);
+    return whole.ok() ? absl::StatusOr<v1::PlanStats>(whole->stats()) : whole.status();
+  }
+
+  void Tally(const absl::StatusOr<v1::PlanStats>& reply, double ms) {
+    absl::MutexLock lock(&mu_);
+    ++report_.requests;
+    ++report_.codes[absl::StatusCodeToString(reply.status().code())];
+    report_.latencies_ms.push_back(ms);
+    if (reply.ok()) {
+      ++report_.ok;
+      report_.cut_short += reply->tour_cut_short();
+      ++report_.plan_sources[SourceName(reply->plan_source())];
+      report_.estimated_duration_sum_s += reply->estimated_duration_s();
+    }
+    if (ms > static_cast<double>(flags_.deadline)) ++report_.late;
+  }
+
+  void Work(int t) {
+    std::mt19937_64 rng(static_cast<uint64_t>(flags_.seed.value_or(1)) * 1000003u + t);
+    std::discrete_distribution<size_t> pick(weights_.begin(), weights_.end());
+    while (absl::Now() < end_) {
+      if (!TakeTicket()) break;
+      const v1::PlanRequest request = RequestFor(pick(rng), rng);
+      const absl::Time sent = absl::Now();
+      const absl::StatusOr<v1::PlanStats> reply = Send(request);
+      Tally(reply, absl::ToDoubleMilliseconds(absl::Now() - sent));
+      // Back off briefly after a refusal so an overloaded server is probed,
+      // not hammered.
+      if (absl::IsResourceExhausted(reply.status())) {
+        absl::SleepFor(absl::Milliseconds(flags_.backoff_ms.value_or(10)));
+      }
+    }
+  }
+
+  const LoadFlags& flags_;
+  const PreparedMaps& maps_;
+  RemotePlanner* const remote_;
+  std::vector<double> weights_;  // map k's share of the requests
+  absl::Time end_;               // set before the workers start
+  absl::Mutex mu_;
+  int64_t issued_ = 0;  // guarded by mu_
+  LoadReport report_;   // guarded by mu_ while the workers run
+};
+
+absl::Status Run(const std::vector<std::string>& args) {
+  ASSIGN_OR_RETURN(
+      ParsedArgs a,
+      ParseArgs(args,
+                WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
+                                     "deadline-ms", "resolution", "tool-width", "time-limit",
+                                     "tour", "backoff-ms", "zipf", "seed", "requests"}),
+                {"inline", "random-start", "full-replies"}));
+  ASSIGN_OR_RETURN(const LoadFlags flags, ParseLoadFlags(a));
+  std::vector<std::string> files;
+  if (a.Get("map")) {
+    files.push_back(*a.Get("map"));
+  } else {
+    ASSIGN_OR_RETURN(files, MapFiles(*a.Get("maps")));
+  }
+  ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, flags.server));
+  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(connection);
+  ASSIGN_OR_RETURN(const PreparedMaps maps, PrepareMaps(flags, files, remote.get()));
+  const LoadReport report = LoadRun(flags, maps, remote.get()).Run();
   std::printf("%s\n", report.ToJson().c_str());
   return absl::OkStatus();
 }

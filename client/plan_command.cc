@@ -8,7 +8,9 @@
 #include <fstream>
 #include <optional>
 #include <random>
+#include <set>
 #include <sstream>
+#include <utility>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -162,44 +164,203 @@ struct PlanCommand {
   std::optional<GtspEffort> tour_effort;  // --local only
 };
 
+// The value flags `covplan plan` accepts, besides the connection flags.
+std::set<std::string> PlanValueFlags() {
+  return {"map",
+          "resolution",
+          "tool-width",
+          "server",
+          "out",
+          "svg",
+          "time-limit",
+          "seed",
+          "partition",
+          "tour",
+          "max-speed",
+          "acceleration",
+          "turn-rate",
+          "free-thresh",
+          "occupied-thresh",
+          "min-free-fraction",
+          "deadline-ms",
+          "start",
+          "end",
+          "planner",
+          "battery-capacity",
+          "station",
+          "reserve",
+          "energy-per-metre",
+          "energy-per-turn",
+          "energy-per-second",
+          "atomic-units",
+          "sweep-axis",
+          "algorithm",
+          "stc-tree",
+          "sweep-direction",
+          "stc-partial",
+          "threads",
+          "tour-effort"};
+}
+
+// `text`, the value of --`flag`, as one of `choices` (named in the order
+// the error lists them); else InvalidArgument "--flag must be a, b or c,
+// got 'text'".
+template <typename T>
+absl::StatusOr<T> ParseChoice(const char* flag, const std::string& text,
+                              const std::vector<std::pair<std::string, T>>& choices) {
+  std::string names;
+  for (size_t i = 0; i < choices.size(); ++i) {
+    if (choices[i].first == text) return choices[i].second;
+    absl::StrAppend(&names,
+                    i == 0                    ? ""
+                    : i + 1 == choices.size() ? " or "
+                                              : ", ",
+                    choices[i].first);
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--", flag, " must be ", names, ", got '", text, "'"));
+}
+
+// --threads and --tour-effort: knobs of the in-process engine, so --local only.
+absl::Status ParseLocalEngineFlags(const ParsedArgs& a, PlanCommand* c) {
+  ASSIGN_OR_RETURN(std::optional<int64_t> threads, a.GetInt("threads"));
+  if (threads) {
+    if (!c->local)
+      return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
+    if (*threads < 1 || *threads > 256)
+      return absl::InvalidArgumentError("--threads must be in [1, 256]");
+    c->threads = static_cast<int>(*threads);
+  }
+  if (auto effort = a.Get("tour-effort")) {
+    if (!c->local) return absl::InvalidArgumentError("--tour-effort needs --local");
+    ASSIGN_OR_RETURN(c->tour_effort,
+                     ParseChoice<GtspEffort>("tour-effort", *effort,
+                                             {{"fast", GtspEffort::kFast},
+                                              {"default", GtspEffort::kDefault},
+                                              {"thorough", GtspEffort::kThorough}}));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ParseRobotFlags(const ParsedArgs& a, v1::RobotModel* robot) {
+  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
+  robot->set_tool_width_m(tool.value_or(0.8));
+  ASSIGN_OR_RETURN(std::optional<double> speed, a.GetDouble("max-speed"));
+  if (speed) robot->set_max_speed_mps(*speed);
+  ASSIGN_OR_RETURN(std::optional<double> accel, a.GetDouble("acceleration"));
+  if (accel) robot->set_acceleration_mps2(*accel);
+  ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
+  if (turn) robot->set_turn_rate_deg_s(*turn);
+  if (auto start = a.Get("start"))
+    RETURN_IF_ERROR(ParsePose("start", *start, robot->mutable_start()));
+  if (auto end = a.Get("end")) RETURN_IF_ERROR(ParsePose("end", *end, robot->mutable_end()));
+  return absl::OkStatus();
+}
+
+// --stc-tree, --sweep-direction and --stc-partial; `r`'s planner is already set.
+absl::Status ParseStcFlags(const ParsedArgs& a, v1::PlanRequest* r) {
+  if (!a.Get("stc-tree") && !a.Get("sweep-direction") && !a.Get("stc-partial"))
+    return absl::OkStatus();
+  if (r->planner() != "stc") {
+    return absl::InvalidArgumentError(
+        "--stc-tree, --sweep-direction and --stc-partial need --planner stc");
+  }
+  v1::StcOptions* stc = r->mutable_stc();
+  if (auto t = a.Get("stc-tree")) {
+    ASSIGN_OR_RETURN(v1::StcTree tree,
+                     ParseChoice<v1::StcTree>(
+                         "stc-tree", *t, {{"dfs", v1::STC_TREE_DFS}, {"prim", v1::STC_TREE_PRIM}}));
+    stc->set_tree(tree);
+  }
+  if (auto d = a.Get("sweep-direction")) {
+    ASSIGN_OR_RETURN(v1::StcSweepDirection direction,
+                     ParseChoice<v1::StcSweepDirection>("sweep-direction", *d,
+                                                        {{"horizontal", v1::STC_SWEEP_HORIZONTAL},
+                                                         {"vertical", v1::STC_SWEEP_VERTICAL}}));
+    stc->set_sweep_direction(direction);
+  }
+  if (auto m = a.Get("stc-partial")) {
+    ASSIGN_OR_RETURN(v1::StcPartialCells partial,
+                     ParseChoice<v1::StcPartialCells>(
+                         "stc-partial", *m,
+                         {{"cover", v1::STC_PARTIAL_COVER}, {"discard", v1::STC_PARTIAL_DISCARD}}));
+    stc->set_partial_cells(partial);
+  }
+  return absl::OkStatus();
+}
+
+// The battery flags: none of them, or at least --battery-capacity and --station.
+absl::Status ParseBatteryFlags(const ParsedArgs& a, v1::PlanRequest* r) {
+  ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
+  const bool battery = capacity || a.Get("station") || a.Get("reserve") ||
+                       a.Get("energy-per-metre") || a.Get("energy-per-turn") ||
+                       a.Get("energy-per-second") || a.Has("interruptible") ||
+                       a.Get("atomic-units");
+  if (!battery) return absl::OkStatus();
+  if (!capacity || !a.Get("station")) {
+    return absl::InvalidArgumentError(
+        "a battery needs --battery-capacity E and --station X,Y[,THETA]");
+  }
+  v1::Battery* b = r->mutable_battery();
+  b->set_capacity(*capacity);
+  RETURN_IF_ERROR(ParsePose("station", *a.Get("station"), b->mutable_station()));
+  ASSIGN_OR_RETURN(std::optional<double> reserve, a.GetDouble("reserve"));
+  if (reserve) b->set_reserve(*reserve);
+  ASSIGN_OR_RETURN(std::optional<double> per_metre, a.GetDouble("energy-per-metre"));
+  if (per_metre) b->mutable_energy()->set_per_metre(*per_metre);
+  ASSIGN_OR_RETURN(std::optional<double> per_turn, a.GetDouble("energy-per-turn"));
+  if (per_turn) b->mutable_energy()->set_per_turn(*per_turn);
+  ASSIGN_OR_RETURN(std::optional<double> per_second, a.GetDouble("energy-per-second"));
+  if (per_second) b->mutable_energy()->set_per_second(*per_second);
+  b->set_interruptible_units(a.Has("interruptible"));
+  if (auto ids = a.Get("atomic-units")) {
+    for (absl::string_view id : absl::StrSplit(*ids, ',')) {
+      int value = 0;
+      if (!absl::SimpleAtoi(id, &value)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
+      }
+      b->add_atomic_units(value);
+    }
+  }
+  return absl::OkStatus();
+}
+
+// --sweep-axis (boustrophedon only), --partition and --tour.
+absl::Status ParseSolverFlags(const ParsedArgs& a, v1::PlanRequest* r) {
+  if (auto axis = a.Get("sweep-axis")) {
+    if (r->planner() != "boustrophedon")
+      return absl::InvalidArgumentError("--sweep-axis needs --planner boustrophedon");
+    v1::BoustrophedonOptions* o = r->mutable_boustrophedon();
+    ASSIGN_OR_RETURN(v1::SweepAxis sweep_axis,
+                     ParseChoice<v1::SweepAxis>("sweep-axis", *axis,
+                                                {{"auto", v1::SWEEP_AXIS_AUTO},
+                                                 {"vertical", v1::SWEEP_AXIS_VERTICAL},
+                                                 {"horizontal", v1::SWEEP_AXIS_HORIZONTAL}}));
+    o->set_sweep_axis(sweep_axis);
+  }
+  if (auto p = a.Get("partition")) {
+    ASSIGN_OR_RETURN(v1::PartitionSolver solver,
+                     ParseChoice<v1::PartitionSolver>("partition", *p,
+                                                      {{"pushrelabel", v1::PUSH_RELABEL},
+                                                       {"matching", v1::MATCHING},
+                                                       {"mincut", v1::MINCUT},
+                                                       {"lp", v1::LP}}));
+    r->set_partition_solver(solver);
+  }
+  if (auto t = a.Get("tour")) {
+    ASSIGN_OR_RETURN(
+        v1::TourSolver solver,
+        ParseChoice<v1::TourSolver>("tour", *t, {{"gtsp", v1::GTSP}, {"greedy", v1::GREEDY}}));
+    r->set_tour_solver(solver);
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(
       ParsedArgs a,
-      ParseArgs(args,
-                WithConnectionFlags({"map",
-                                     "resolution",
-                                     "tool-width",
-                                     "server",
-                                     "out",
-                                     "svg",
-                                     "time-limit",
-                                     "seed",
-                                     "partition",
-                                     "tour",
-                                     "max-speed",
-                                     "acceleration",
-                                     "turn-rate",
-                                     "free-thresh",
-                                     "occupied-thresh",
-                                     "min-free-fraction",
-                                     "deadline-ms",
-                                     "start",
-                                     "end",
-                                     "planner",
-                                     "battery-capacity",
-                                     "station",
-                                     "reserve",
-                                     "energy-per-metre",
-                                     "energy-per-turn",
-                                     "energy-per-second",
-                                     "atomic-units",
-                                     "sweep-axis",
-                                     "algorithm",
-                                     "stc-tree",
-                                     "sweep-direction",
-                                     "stc-partial",
-                                     "threads",
-                                     "tour-effort"}),
+      ParseArgs(args, WithConnectionFlags(PlanValueFlags()),
                 {"local", "negate", "interruptible", "improve-remembered"}, {"region", "no-go"}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
@@ -216,40 +377,10 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   if (c.deadline_ms && *c.deadline_ms <= 0) {
     return absl::InvalidArgumentError("--deadline-ms must be positive");
   }
-  ASSIGN_OR_RETURN(std::optional<int64_t> threads, a.GetInt("threads"));
-  if (threads) {
-    if (!c.local)
-      return absl::InvalidArgumentError("--threads needs --local (the server sets its own)");
-    if (*threads < 1 || *threads > 256)
-      return absl::InvalidArgumentError("--threads must be in [1, 256]");
-    c.threads = static_cast<int>(*threads);
-  }
-  if (auto effort = a.Get("tour-effort")) {
-    if (!c.local) return absl::InvalidArgumentError("--tour-effort needs --local");
-    if (*effort == "fast")
-      c.tour_effort = GtspEffort::kFast;
-    else if (*effort == "default")
-      c.tour_effort = GtspEffort::kDefault;
-    else if (*effort == "thorough")
-      c.tour_effort = GtspEffort::kThorough;
-    else
-      return absl::InvalidArgumentError(
-          absl::StrCat("--tour-effort must be fast, default or thorough, got '", *effort, "'"));
-  }
+  RETURN_IF_ERROR(ParseLocalEngineFlags(a, &c));
 
   v1::PlanRequest& r = c.request;
-  v1::RobotModel* robot = r.mutable_robot();
-  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
-  robot->set_tool_width_m(tool.value_or(0.8));
-  ASSIGN_OR_RETURN(std::optional<double> speed, a.GetDouble("max-speed"));
-  if (speed) robot->set_max_speed_mps(*speed);
-  ASSIGN_OR_RETURN(std::optional<double> accel, a.GetDouble("acceleration"));
-  if (accel) robot->set_acceleration_mps2(*accel);
-  ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
-  if (turn) robot->set_turn_rate_deg_s(*turn);
-  if (auto start = a.Get("start"))
-    RETURN_IF_ERROR(ParsePose("start", *start, robot->mutable_start()));
-  if (auto end = a.Get("end")) RETURN_IF_ERROR(ParsePose("end", *end, robot->mutable_end()));
+  RETURN_IF_ERROR(ParseRobotFlags(a, r.mutable_robot()));
   ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
   if (limit) r.set_time_limit_s(*limit);
   r.set_improve_remembered(a.Has("improve-remembered"));
@@ -267,40 +398,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   }
   if (auto p = a.Get("planner")) r.set_planner(*p);
   if (auto p = a.Get("algorithm")) r.set_planner(*p);
-  if (a.Get("stc-tree") || a.Get("sweep-direction") || a.Get("stc-partial")) {
-    if (r.planner() != "stc") {
-      return absl::InvalidArgumentError(
-          "--stc-tree, --sweep-direction and --stc-partial need --planner stc");
-    }
-    v1::StcOptions* stc = r.mutable_stc();
-    if (auto t = a.Get("stc-tree")) {
-      if (*t == "dfs")
-        stc->set_tree(v1::STC_TREE_DFS);
-      else if (*t == "prim")
-        stc->set_tree(v1::STC_TREE_PRIM);
-      else
-        return absl::InvalidArgumentError(
-            absl::StrCat("--stc-tree must be dfs or prim, got '", *t, "'"));
-    }
-    if (auto d = a.Get("sweep-direction")) {
-      if (*d == "horizontal")
-        stc->set_sweep_direction(v1::STC_SWEEP_HORIZONTAL);
-      else if (*d == "vertical")
-        stc->set_sweep_direction(v1::STC_SWEEP_VERTICAL);
-      else
-        return absl::InvalidArgumentError(
-            absl::StrCat("--sweep-direction must be horizontal or vertical, got '", *d, "'"));
-    }
-    if (auto m = a.Get("stc-partial")) {
-      if (*m == "cover")
-        stc->set_partial_cells(v1::STC_PARTIAL_COVER);
-      else if (*m == "discard")
-        stc->set_partial_cells(v1::STC_PARTIAL_DISCARD);
-      else
-        return absl::InvalidArgumentError(
-            absl::StrCat("--stc-partial must be cover or discard, got '", *m, "'"));
-    }
-  }
+  RETURN_IF_ERROR(ParseStcFlags(a, &r));
   if (auto it = a.repeated.find("region"); it != a.repeated.end()) {
     for (const std::string& text : it->second)
       RETURN_IF_ERROR(ParseArea("region", text, r.mutable_regions()));
@@ -309,75 +407,8 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     for (const std::string& text : it->second)
       RETURN_IF_ERROR(ParseArea("no-go", text, r.mutable_no_go()));
   }
-  ASSIGN_OR_RETURN(std::optional<double> capacity, a.GetDouble("battery-capacity"));
-  const bool battery = capacity || a.Get("station") || a.Get("reserve") ||
-                       a.Get("energy-per-metre") || a.Get("energy-per-turn") ||
-                       a.Get("energy-per-second") || a.Has("interruptible") ||
-                       a.Get("atomic-units");
-  if (battery) {
-    if (!capacity || !a.Get("station")) {
-      return absl::InvalidArgumentError(
-          "a battery needs --battery-capacity E and --station X,Y[,THETA]");
-    }
-    v1::Battery* b = r.mutable_battery();
-    b->set_capacity(*capacity);
-    RETURN_IF_ERROR(ParsePose("station", *a.Get("station"), b->mutable_station()));
-    ASSIGN_OR_RETURN(std::optional<double> reserve, a.GetDouble("reserve"));
-    if (reserve) b->set_reserve(*reserve);
-    ASSIGN_OR_RETURN(std::optional<double> per_metre, a.GetDouble("energy-per-metre"));
-    if (per_metre) b->mutable_energy()->set_per_metre(*per_metre);
-    ASSIGN_OR_RETURN(std::optional<double> per_turn, a.GetDouble("energy-per-turn"));
-    if (per_turn) b->mutable_energy()->set_per_turn(*per_turn);
-    ASSIGN_OR_RETURN(std::optional<double> per_second, a.GetDouble("energy-per-second"));
-    if (per_second) b->mutable_energy()->set_per_second(*per_second);
-    b->set_interruptible_units(a.Has("interruptible"));
-    if (auto ids = a.Get("atomic-units")) {
-      for (absl::string_view id : absl::StrSplit(*ids, ',')) {
-        int value = 0;
-        if (!absl::SimpleAtoi(id, &value)) {
-          return absl::InvalidArgumentError(absl::StrCat(
-              "--atomic-units must be unit ids separated by commas, got '", *ids, "'"));
-        }
-        b->add_atomic_units(value);
-      }
-    }
-  }
-  if (auto axis = a.Get("sweep-axis")) {
-    if (r.planner() != "boustrophedon")
-      return absl::InvalidArgumentError("--sweep-axis needs --planner boustrophedon");
-    v1::BoustrophedonOptions* o = r.mutable_boustrophedon();
-    if (*axis == "auto")
-      o->set_sweep_axis(v1::SWEEP_AXIS_AUTO);
-    else if (*axis == "vertical")
-      o->set_sweep_axis(v1::SWEEP_AXIS_VERTICAL);
-    else if (*axis == "horizontal")
-      o->set_sweep_axis(v1::SWEEP_AXIS_HORIZONTAL);
-    else
-      return absl::InvalidArgumentError(
-          absl::StrCat("--sweep-axis must be auto, vertical or horizontal, got '", *axis, "'"));
-  }
-  if (auto p = a.Get("partition")) {
-    if (*p == "mincut")
-      r.set_partition_solver(v1::MINCUT);
-    else if (*p == "lp")
-      r.set_partition_solver(v1::LP);
-    else if (*p == "matching")
-      r.set_partition_solver(v1::MATCHING);
-    else if (*p == "pushrelabel")
-      r.set_partition_solver(v1::PUSH_RELABEL);
-    else
-      return absl::InvalidArgumentError(
-          absl::StrCat("--partition must be pushrelabel, matching, mincut or lp, got '", *p, "'"));
-  }
-  if (auto t = a.Get("tour")) {
-    if (*t == "gtsp")
-      r.set_tour_solver(v1::GTSP);
-    else if (*t == "greedy")
-      r.set_tour_solver(v1::GREEDY);
-    else
-      return absl::InvalidArgumentError(
-          absl::StrCat("--tour must be gtsp or greedy, got '", *t, "'"));
-  }
+  RETURN_IF_ERROR(ParseBatteryFlags(a, &r));
+  RETURN_IF_ERROR(ParseSolverFlags(a, &r));
   return c;
 }
 

@@ -65,6 +65,28 @@ struct RemotePlanner::Impl {
 
 namespace {
 
+// Credentials, deadline and routing key of one call, in that order.
+void PrepareCall(const Connection& connection, std::optional<absl::Duration> timeout,
+                 const std::string& map_id, grpc::ClientContext* context) {
+  AddCallCredentials(connection, context);
+  if (timeout) context->set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
+  SetMapId(context, map_id);
+}
+
+// One blocking unary call of the generated stub, e.g. &Stub::Plan.
+template <typename Request, typename Response>
+absl::StatusOr<Response> CallUnary(const Connection& connection, v1::CoveragePlanner::Stub* stub,
+                                   grpc::Status (v1::CoveragePlanner::Stub::*method)(
+                                       grpc::ClientContext*, const Request&, Response*),
+                                   const Request& request, std::optional<absl::Duration> timeout,
+                                   const std::string& map_id) {
+  grpc::ClientContext context;
+  PrepareCall(connection, timeout, map_id, &context);
+  Response response;
+  if (absl::Status s = FromGrpc((stub->*method)(&context, request, &response)); !s.ok()) return s;
+  return response;
+}
+
 // The stats of a serialised PlanResponse; every other field is skipped. A
 // field that occurs more than once is merged, as protobuf parsing does.
 absl::StatusOr<v1::PlanStats> StatsOfPlanReply(grpc::ByteBuffer* reply) {
@@ -116,36 +138,20 @@ std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const Connection& connecti
 
 absl::StatusOr<v1::PutMapResponse> RemotePlanner::PutMap(const v1::PutMapRequest& request,
                                                          absl::Duration timeout) {
-  grpc::ClientContext context;
-  AddCallCredentials(impl_->connection, &context);
-  context.set_deadline(absl::ToChronoTime(absl::Now() + timeout));
-  SetMapId(&context, ComputeMapId(request.map()));
-  v1::PutMapResponse response;
-  if (absl::Status s = FromGrpc(impl_->stub->PutMap(&context, request, &response)); !s.ok()) {
-    return s;
-  }
-  return response;
+  return CallUnary(impl_->connection, impl_->stub.get(), &v1::CoveragePlanner::Stub::PutMap,
+                   request, timeout, ComputeMapId(request.map()));
 }
 
 absl::StatusOr<v1::PlanResponse> RemotePlanner::Plan(const v1::PlanRequest& request,
                                                      std::optional<absl::Duration> timeout) {
-  grpc::ClientContext context;
-  AddCallCredentials(impl_->connection, &context);
-  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
-  SetMapId(&context, RoutingMapId(request));
-  v1::PlanResponse response;
-  if (absl::Status s = FromGrpc(impl_->stub->Plan(&context, request, &response)); !s.ok()) {
-    return s;
-  }
-  return response;
+  return CallUnary(impl_->connection, impl_->stub.get(), &v1::CoveragePlanner::Stub::Plan, request,
+                   timeout, RoutingMapId(request));
 }
 
 absl::StatusOr<v1::PlanStats> RemotePlanner::PlanStatsOnly(const v1::PlanRequest& request,
                                                            std::optional<absl::Duration> timeout) {
   grpc::ClientContext context;
-  AddCallCredentials(impl_->connection, &context);
-  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
-  SetMapId(&context, RoutingMapId(request));
+  PrepareCall(impl_->connection, timeout, RoutingMapId(request), &context);
   grpc::ByteBuffer sent, reply;
   bool own = false;
   if (!grpc::SerializationTraits<v1::PlanRequest>::Serialize(request, &sent, &own).ok()) {
@@ -173,34 +179,18 @@ absl::StatusOr<v1::PlanStats> RemotePlanner::PlanStatsOnly(const v1::PlanRequest
 absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest& request,
                                                          std::optional<absl::Duration> timeout,
                                                          const std::string& map_id) {
-  grpc::ClientContext context;
-  AddCallCredentials(impl_->connection, &context);
-  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
   // A replan by plan_id names no map; the caller passes the map id when it
   // has it (the plan's map_id), otherwise the router picks any replica and
   // the plan is found through the shared store.
-  if (request.has_plan()) {
-    SetMapId(&context, RoutingMapId(request.plan().request()));
-  } else {
-    SetMapId(&context, map_id);
-  }
-  v1::ReplanResponse response;
-  if (absl::Status s = FromGrpc(impl_->stub->Replan(&context, request, &response)); !s.ok()) {
-    return s;
-  }
-  return response;
+  return CallUnary(impl_->connection, impl_->stub.get(), &v1::CoveragePlanner::Stub::Replan,
+                   request, timeout,
+                   request.has_plan() ? RoutingMapId(request.plan().request()) : map_id);
 }
 
 absl::StatusOr<v1::ReplanResponse> RemotePlanner::Resume(const v1::ResumeRequest& request,
                                                          std::optional<absl::Duration> timeout) {
-  grpc::ClientContext context;
-  AddCallCredentials(impl_->connection, &context);
-  if (timeout) context.set_deadline(absl::ToChronoTime(absl::Now() + *timeout));
-  v1::ReplanResponse response;
-  if (absl::Status s = FromGrpc(impl_->stub->Resume(&context, request, &response)); !s.ok()) {
-    return s;
-  }
-  return response;
+  return CallUnary(impl_->connection, impl_->stub.get(), &v1::CoveragePlanner::Stub::Resume,
+                   request, timeout, /*map_id=*/"");
 }
 
 struct RemotePlanner::DriveSession::Stream {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -198,38 +199,213 @@ absl::Status WithFlagNames(const absl::Status& status) {
   return absl::InvalidArgumentError(m);
 }
 
+// The value flags `covplan simulate` accepts, besides the connection flags.
+std::set<std::string> SimulateValueFlags() {
+  return {"map",
+          "resolution",
+          "tool-width",
+          "true-map",
+          "clutter",
+          "seed",
+          "method",
+          "sensor-range",
+          "svg",
+          "time-limit",
+          "step",
+          "max-speed",
+          "acceleration",
+          "turn-rate",
+          "free-thresh",
+          "occupied-thresh",
+          "server",
+          "replan-tour-limit",
+          "planner",
+          "battery-capacity",
+          "station",
+          "reserve",
+          "energy-per-metre",
+          "energy-per-turn",
+          "energy-per-second",
+          "atomic-units",
+          "recharge-s"};
+}
+
+// Everything but the maps: seed, method, planner, battery, sensor, robot, time limit.
+absl::Status ParseSimulationOptions(const ParsedArgs& a, SimulationOptions* o) {
+  ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
+  if (seed && (*seed < 0 || *seed > UINT32_MAX))
+    return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
+  o->seed = seed.value_or(1);
+  if (auto m = a.Get("method")) {
+    ASSIGN_OR_RETURN(o->method, ParseMethod(*m));
+  }
+  if (auto planner = a.Get("planner")) o->plan.planner = *planner;
+  ASSIGN_OR_RETURN(o->plan.battery, ParseBattery(a));
+  if (o->plan.battery) {
+    if (a.Get("server"))
+      return absl::InvalidArgumentError(
+          "--battery-capacity: battery runs are local only, not with --server");
+    if (a.Get("method") && o->method != ReplanMethod::kGreedyDetour) {
+      return absl::InvalidArgumentError(
+          "--method: battery plans are replanned with greedy_detour only (the other methods drop "
+          "the station legs)");
+    }
+    o->method = ReplanMethod::kGreedyDetour;
+    ASSIGN_OR_RETURN(std::optional<double> recharge, a.GetDouble("recharge-s"));
+    o->recharge_s = recharge.value_or(0.0);
+    if (!(o->recharge_s >= 0.0)) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("--recharge-s must be >= 0 s, got %g", o->recharge_s));
+    }
+    RETURN_IF_ERROR(WithFlagNames(o->plan.battery->Validate()));
+  }
+  ASSIGN_OR_RETURN(std::optional<double> range, a.GetDouble("sensor-range"));
+  if (range) o->sensor_range_m = *range;
+  ASSIGN_OR_RETURN(std::optional<double> step, a.GetDouble("step"));
+  if (step) o->step_s = *step;
+  ASSIGN_OR_RETURN(std::optional<double> tour_limit, a.GetDouble("replan-tour-limit"));
+  if (tour_limit) o->replan_tour_time_limit_s = *tour_limit;
+  RobotModel& robot = o->plan.robot;
+  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
+  if (tool) robot.tool_width_m = *tool;
+  ASSIGN_OR_RETURN(std::optional<double> speed, a.GetDouble("max-speed"));
+  if (speed) robot.max_speed_mps = *speed;
+  ASSIGN_OR_RETURN(std::optional<double> accel, a.GetDouble("acceleration"));
+  if (accel) robot.acceleration_mps2 = *accel;
+  ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
+  if (turn) robot.turn_rate_deg_s = *turn;
+  ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
+  o->plan.time_limit_s = limit.value_or(1.0);
+  o->plan.seed = o->seed;
+  if (!(o->plan.time_limit_s > 0.0 && o->plan.time_limit_s <= 3600.0)) {
+    return absl::InvalidArgumentError("--time-limit must be in (0, 3600] s");
+  }
+  return absl::OkStatus();
+}
+
+// The map the simulated robot drives through.
+struct TrueMap {
+  OccupancyMap map;
+  std::string name;  // as the JSON's true_map reports it
+};
+
+// --true-map TRUE as loaded, or `known` with --clutter PCT % of random rectangles.
+absl::StatusOr<TrueMap> LoadTrueMap(const ParsedArgs& a, const OccupancyMap& known,
+                                    const MapLoadOptions& load, const SimulationOptions& o) {
+  const RobotModel& robot = o.plan.robot;
+  TrueMap truth;
+  if (auto path = a.Get("true-map")) {
+    ASSIGN_OR_RETURN(truth.map, LoadMapFile(*path, load));
+    truth.name = *path;
+  } else {
+    ASSIGN_OR_RETURN(std::optional<double> percent, a.GetDouble("clutter"));
+    ClutterOptions clutter;
+    if (!a.Has("clutter-may-disconnect")) clutter.keep_connected_cell_m = robot.tool_width_m;
+    ASSIGN_OR_RETURN(truth.map, AddClutter(known, *percent, o.seed, clutter));
+    if (o.plan.battery) {
+      const Pose2& st = o.plan.battery->station;  // clutter kept off the station
+      ClearAround(known, {st.x, st.y}, robot.tool_width_m, &truth.map);
+    }
+    truth.name = absl::StrFormat("clutter %g %% seed %d", *percent, o.seed);
+  }
+  return truth;
+}
+
+absl::Status WriteRunSvg(const std::string& svg_path, const OccupancyMap& truth,
+                         const SimulationResult& r, const SimulationOptions& o) {
+  const RobotModel& robot = o.plan.robot;
+  GridOptions go;
+  go.cell_size = robot.tool_width_m;
+  go.min_free_fraction = o.plan.min_free_fraction;
+  ASSIGN_OR_RETURN(Grid grid, BuildGrid(truth, go));
+  std::ofstream out(svg_path, std::ios::binary | std::ios::trunc);
+  out << RenderRunSvg(truth, grid, r, robot);
+  out.close();
+  if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot write ", svg_path));
+  return absl::OkStatus();
+}
+
+// One JSON object's fields, written in the order they are added.
+class JsonObject {
+ public:
+  void Field(const char* name, const std::string& value) {
+    absl::StrAppend(&text_, text_.size() > 1 ? ", " : "", "\"", name, "\": ", value);
+  }
+  std::string Close() const { return text_ + "}"; }
+
+ private:
+  std::string text_ = "{";
+};
+
+void AddBatteryFields(const BatteryRun& b, const SimulationOptions& o, JsonObject* json) {
+  std::string energies = "[";
+  for (size_t i = 0; i < b.cycle_energy.size(); ++i)
+    absl::StrAppend(&energies, i ? "," : "", JsonNumber(b.cycle_energy[i]));
+  energies += "]";
+  json->Field("battery_capacity", JsonNumber(o.plan.battery->capacity));
+  json->Field("battery_reserve", JsonNumber(o.plan.battery->reserve));
+  json->Field("recharge_s", JsonNumber(o.recharge_s));
+  json->Field("planned_charge_cycles", absl::StrCat(b.charge_cycles_planned));
+  json->Field("planned_energy", JsonNumber(b.energy_planned));
+  json->Field("charge_cycles_driven", absl::StrCat(b.charge_cycles_driven));
+  json->Field("recharge_time_s", JsonNumber(b.recharge_time_s));
+  json->Field("energy_used", JsonNumber(b.energy_used));
+  json->Field("extra_energy", JsonNumber(b.energy_used - b.energy_planned));
+  json->Field("min_battery_left", JsonNumber(b.min_battery_left));
+  json->Field("below_reserve", b.below_reserve ? "true" : "false");
+  json->Field("cycles_over_budget", absl::StrCat(b.cycles_over_budget));
+  json->Field("ended_at_station", b.ended_at_station ? "true" : "false");
+  json->Field("cycle_energy", energies);
+}
+
+std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::string& truth_name,
+                    const SimulationResult& r, const OfflineBound& bound,
+                    const OfflineBound& cell_bound) {
+  const double total_ms = std::accumulate(r.replan_ms.begin(), r.replan_ms.end(), 0.0);
+  double max_ms = 0.0;
+  for (double ms : r.replan_ms) max_ms = std::max(max_ms, ms);
+  std::string problems = "[";
+  for (size_t i = 0; i < r.problems.size(); ++i)
+    absl::StrAppend(&problems, i ? "," : "", JsonString(r.problems[i]));
+  problems += "]";
+  JsonObject json;
+  json.Field("method", JsonString(ReplanMethodName(o.method)));
+  json.Field("planner_at",
+             JsonString(a.Get("server") ? absl::StrCat("server ", *a.Get("server")) : "local"));
+  json.Field("true_map", JsonString(truth_name));
+  json.Field("total_time_s", JsonNumber(r.total_time_s));
+  json.Field("drive_time_s", JsonNumber(r.drive_time_s));
+  json.Field("stoppage_s", JsonNumber(r.stoppage_s));
+  json.Field("num_replans", absl::StrCat(r.num_replans));
+  json.Field("num_encounters", absl::StrCat(r.num_encounters));
+  json.Field("num_greedy_detours", absl::StrCat(r.num_greedy_detours));
+  json.Field("num_turns", absl::StrCat(r.num_turns));
+  json.Field("path_length_m", JsonNumber(r.path_length_m));
+  json.Field("covered_free_area_ratio", JsonNumber(r.covered_free_area_ratio));
+  json.Field("mean_replan_ms",
+             JsonNumber(r.replan_ms.empty() ? 0.0 : total_ms / r.replan_ms.size()));
+  json.Field("max_replan_ms", JsonNumber(max_ms));
+  json.Field("obstacle_cells_found", absl::StrCat(r.obstacles_found.size()));
+  json.Field("touch_detections", absl::StrCat(r.num_touch_detections));
+  json.Field("truth_cleared_px", absl::StrCat(r.truth_cleared_px));
+  json.Field("planned_duration_s", JsonNumber(r.planned_duration_s));
+  json.Field("offline_lower_bound_s", JsonNumber(bound.duration_s));
+  json.Field("offline_covered_free_area_ratio", JsonNumber(bound.covered_free_area_ratio));
+  json.Field("offline_cell_bound_s", JsonNumber(cell_bound.duration_s));
+  json.Field("length_in_obstacles_m", JsonNumber(r.length_in_obstacles_m));
+  json.Field("completed", r.completed ? "true" : "false");
+  json.Field("termination", JsonString(r.termination));
+  json.Field("problems", problems);
+  json.Field("planner", JsonString(o.plan.planner));
+  if (r.battery) AddBatteryFields(*r.battery, o, &json);
+  return json.Close();
+}
+
 }  // namespace
 
 absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
                                                 const RemotePlanSourceFactory& make_remote) {
-  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args,
-                                           WithConnectionFlags({"map",
-                                                                "resolution",
-                                                                "tool-width",
-                                                                "true-map",
-                                                                "clutter",
-                                                                "seed",
-                                                                "method",
-                                                                "sensor-range",
-                                                                "svg",
-                                                                "time-limit",
-                                                                "step",
-                                                                "max-speed",
-                                                                "acceleration",
-                                                                "turn-rate",
-                                                                "free-thresh",
-                                                                "occupied-thresh",
-                                                                "server",
-                                                                "replan-tour-limit",
-                                                                "planner",
-                                                                "battery-capacity",
-                                                                "station",
-                                                                "reserve",
-                                                                "energy-per-metre",
-                                                                "energy-per-turn",
-                                                                "energy-per-second",
-                                                                "atomic-units",
-                                                                "recharge-s"}),
+  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, WithConnectionFlags(SimulateValueFlags()),
                                            {"local", "negate", "clutter-may-disconnect",
                                             "no-offline-bound", "interruptible"}));
   if (a.Get("server") && a.Has("local"))
@@ -250,72 +426,11 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   load.negate = a.Has("negate");
 
   SimulationOptions o;
-  ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
-  if (seed && (*seed < 0 || *seed > UINT32_MAX))
-    return absl::InvalidArgumentError("--seed must be in [0, 2^32)");
-  o.seed = seed.value_or(1);
-  if (auto m = a.Get("method")) {
-    ASSIGN_OR_RETURN(o.method, ParseMethod(*m));
-  }
-  if (auto planner = a.Get("planner")) o.plan.planner = *planner;
-  ASSIGN_OR_RETURN(o.plan.battery, ParseBattery(a));
-  if (o.plan.battery) {
-    if (a.Get("server"))
-      return absl::InvalidArgumentError(
-          "--battery-capacity: battery runs are local only, not with --server");
-    if (a.Get("method") && o.method != ReplanMethod::kGreedyDetour) {
-      return absl::InvalidArgumentError(
-          "--method: battery plans are replanned with greedy_detour only (the other methods drop "
-          "the station legs)");
-    }
-    o.method = ReplanMethod::kGreedyDetour;
-    ASSIGN_OR_RETURN(std::optional<double> recharge, a.GetDouble("recharge-s"));
-    o.recharge_s = recharge.value_or(0.0);
-    if (!(o.recharge_s >= 0.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("--recharge-s must be >= 0 s, got %g", o.recharge_s));
-    }
-    RETURN_IF_ERROR(WithFlagNames(o.plan.battery->Validate()));
-  }
-  ASSIGN_OR_RETURN(std::optional<double> range, a.GetDouble("sensor-range"));
-  if (range) o.sensor_range_m = *range;
-  ASSIGN_OR_RETURN(std::optional<double> step, a.GetDouble("step"));
-  if (step) o.step_s = *step;
-  ASSIGN_OR_RETURN(std::optional<double> tour_limit, a.GetDouble("replan-tour-limit"));
-  if (tour_limit) o.replan_tour_time_limit_s = *tour_limit;
-  RobotModel& robot = o.plan.robot;
-  ASSIGN_OR_RETURN(std::optional<double> tool, a.GetDouble("tool-width"));
-  if (tool) robot.tool_width_m = *tool;
-  ASSIGN_OR_RETURN(std::optional<double> speed, a.GetDouble("max-speed"));
-  if (speed) robot.max_speed_mps = *speed;
-  ASSIGN_OR_RETURN(std::optional<double> accel, a.GetDouble("acceleration"));
-  if (accel) robot.acceleration_mps2 = *accel;
-  ASSIGN_OR_RETURN(std::optional<double> turn, a.GetDouble("turn-rate"));
-  if (turn) robot.turn_rate_deg_s = *turn;
-  ASSIGN_OR_RETURN(std::optional<double> limit, a.GetDouble("time-limit"));
-  o.plan.time_limit_s = limit.value_or(1.0);
-  o.plan.seed = o.seed;
-  if (!(o.plan.time_limit_s > 0.0 && o.plan.time_limit_s <= 3600.0)) {
-    return absl::InvalidArgumentError("--time-limit must be in (0, 3600] s");
-  }
+  RETURN_IF_ERROR(ParseSimulationOptions(a, &o));
 
   ASSIGN_OR_RETURN(OccupancyMap known, LoadMapFile(*a.Get("map"), load));
-  OccupancyMap truth;
-  std::string truth_name;
-  if (auto path = a.Get("true-map")) {
-    ASSIGN_OR_RETURN(truth, LoadMapFile(*path, load));
-    truth_name = *path;
-  } else {
-    ASSIGN_OR_RETURN(std::optional<double> percent, a.GetDouble("clutter"));
-    ClutterOptions clutter;
-    if (!a.Has("clutter-may-disconnect")) clutter.keep_connected_cell_m = robot.tool_width_m;
-    ASSIGN_OR_RETURN(truth, AddClutter(known, *percent, o.seed, clutter));
-    if (o.plan.battery) {
-      const Pose2& st = o.plan.battery->station;
-      ClearAround(known, {st.x, st.y}, robot.tool_width_m, &truth);  // clutter kept off the station
-    }
-    truth_name = absl::StrFormat("clutter %g %% seed %d", *percent, o.seed);
-  }
+  ASSIGN_OR_RETURN(TrueMap true_map, LoadTrueMap(a, known, load, o));
+  OccupancyMap& truth = true_map.map;
   std::unique_ptr<PlanSource> remote;
   if (auto server = a.Get("server")) {
     if (!make_remote) return absl::InvalidArgumentError("--server is not available in this build");
@@ -344,77 +459,9 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
     cell_bound.duration_s += o.recharge_s * cell_bound.charge_cycles;
   }
 
-  if (auto svg_path = a.Get("svg")) {
-    GridOptions go;
-    go.cell_size = robot.tool_width_m;
-    go.min_free_fraction = o.plan.min_free_fraction;
-    ASSIGN_OR_RETURN(Grid grid, BuildGrid(truth, go));
-    std::ofstream out(*svg_path, std::ios::binary | std::ios::trunc);
-    out << RenderRunSvg(truth, grid, r, robot);
-    out.close();
-    if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot write ", *svg_path));
-  }
+  if (auto svg_path = a.Get("svg")) RETURN_IF_ERROR(WriteRunSvg(*svg_path, truth, r, o));
 
-  const double total_ms = std::accumulate(r.replan_ms.begin(), r.replan_ms.end(), 0.0);
-  double max_ms = 0.0;
-  for (double ms : r.replan_ms) max_ms = std::max(max_ms, ms);
-  std::string problems = "[";
-  for (size_t i = 0; i < r.problems.size(); ++i)
-    absl::StrAppend(&problems, i ? "," : "", JsonString(r.problems[i]));
-  problems += "]";
-  std::string json = "{";
-  auto field = [&](const char* name, const std::string& value) {
-    absl::StrAppend(&json, json.size() > 1 ? ", " : "", "\"", name, "\": ", value);
-  };
-  field("method", JsonString(ReplanMethodName(o.method)));
-  field("planner_at",
-        JsonString(a.Get("server") ? absl::StrCat("server ", *a.Get("server")) : "local"));
-  field("true_map", JsonString(truth_name));
-  field("total_time_s", JsonNumber(r.total_time_s));
-  field("drive_time_s", JsonNumber(r.drive_time_s));
-  field("stoppage_s", JsonNumber(r.stoppage_s));
-  field("num_replans", absl::StrCat(r.num_replans));
-  field("num_encounters", absl::StrCat(r.num_encounters));
-  field("num_greedy_detours", absl::StrCat(r.num_greedy_detours));
-  field("num_turns", absl::StrCat(r.num_turns));
-  field("path_length_m", JsonNumber(r.path_length_m));
-  field("covered_free_area_ratio", JsonNumber(r.covered_free_area_ratio));
-  field("mean_replan_ms", JsonNumber(r.replan_ms.empty() ? 0.0 : total_ms / r.replan_ms.size()));
-  field("max_replan_ms", JsonNumber(max_ms));
-  field("obstacle_cells_found", absl::StrCat(r.obstacles_found.size()));
-  field("touch_detections", absl::StrCat(r.num_touch_detections));
-  field("truth_cleared_px", absl::StrCat(r.truth_cleared_px));
-  field("planned_duration_s", JsonNumber(r.planned_duration_s));
-  field("offline_lower_bound_s", JsonNumber(bound.duration_s));
-  field("offline_covered_free_area_ratio", JsonNumber(bound.covered_free_area_ratio));
-  field("offline_cell_bound_s", JsonNumber(cell_bound.duration_s));
-  field("length_in_obstacles_m", JsonNumber(r.length_in_obstacles_m));
-  field("completed", r.completed ? "true" : "false");
-  field("termination", JsonString(r.termination));
-  field("problems", problems);
-  field("planner", JsonString(o.plan.planner));
-  if (r.battery) {
-    const BatteryRun& b = *r.battery;
-    std::string energies = "[";
-    for (size_t i = 0; i < b.cycle_energy.size(); ++i)
-      absl::StrAppend(&energies, i ? "," : "", JsonNumber(b.cycle_energy[i]));
-    energies += "]";
-    field("battery_capacity", JsonNumber(o.plan.battery->capacity));
-    field("battery_reserve", JsonNumber(o.plan.battery->reserve));
-    field("recharge_s", JsonNumber(o.recharge_s));
-    field("planned_charge_cycles", absl::StrCat(b.charge_cycles_planned));
-    field("planned_energy", JsonNumber(b.energy_planned));
-    field("charge_cycles_driven", absl::StrCat(b.charge_cycles_driven));
-    field("recharge_time_s", JsonNumber(b.recharge_time_s));
-    field("energy_used", JsonNumber(b.energy_used));
-    field("extra_energy", JsonNumber(b.energy_used - b.energy_planned));
-    field("min_battery_left", JsonNumber(b.min_battery_left));
-    field("below_reserve", b.below_reserve ? "true" : "false");
-    field("cycles_over_budget", absl::StrCat(b.cycles_over_budget));
-    field("ended_at_station", b.ended_at_station ? "true" : "false");
-    field("cycle_energy", energies);
-  }
-  return json + "}";
+  return RunJson(a, o, true_map.name, r, bound, cell_bound);
 }
 
 namespace {

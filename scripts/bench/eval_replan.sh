@@ -65,6 +65,16 @@ add() { printf '%s\t%s\n' "$1" "$2" >>"$jobs_file"; }
 methods_for_seed() {  # clutter seed -> methods
   if [ "$1" -le "$FULL_SEEDS" ]; then echo "greedy_detour auto ilp1 ilp2 full"; else echo "greedy_detour auto"; fi
 }
+add_clutter() {  # SET MAP PERCENT SEEDS: MAP with PERCENT % clutter, seeds 1..SEEDS
+  local label=$1 map=$2 percent=$3 seed method bound
+  for seed in $(seq 1 "$4"); do
+    bound=""
+    for method in $(methods_for_seed "$seed"); do
+      add "$label $map $percent $seed $method" "--map $IPA/$map.png --clutter $percent --seed $seed --method $method $bound"
+      bound="--no-offline-bound"
+    done
+  done
+}
 for set in $SETS; do
   case "$set" in
     furnished)
@@ -76,25 +86,9 @@ for set in $SETS; do
         done
       done ;;
     clutter10)
-      for m in $CLUTTER_MAPS; do
-        for seed in $(seq 1 "$SEEDS"); do
-          bound=""
-          for method in $(methods_for_seed "$seed"); do
-            add "clutter10 $m 10 $seed $method" "--map $IPA/$m.png --clutter 10 --seed $seed --method $method $bound"
-            bound="--no-offline-bound"
-          done
-        done
-      done ;;
+      for m in $CLUTTER_MAPS; do add_clutter clutter10 "$m" 10 "$SEEDS"; done ;;
     levels)
-      for p in $LEVELS; do
-        for seed in $(seq 1 "$LEVEL_SEEDS"); do
-          bound=""
-          for method in $(methods_for_seed "$seed"); do
-            add "levels $LEVEL_MAP $p $seed $method" "--map $IPA/$LEVEL_MAP.png --clutter $p --seed $seed --method $method $bound"
-            bound="--no-offline-bound"
-          done
-        done
-      done ;;
+      for p in $LEVELS; do add_clutter levels "$LEVEL_MAP" "$p" "$LEVEL_SEEDS"; done ;;
     *) echo "eval_replan: unknown set '$set'" >&2; exit 2 ;;
   esac
 done

@@ -54,15 +54,173 @@ SearchTour ToSearchTour(const Problem& p, const std::vector<int>& tour) {
   return t;
 }
 
-GtspResult Finish(const GtspInstance& instance, const Problem& problem, const SearchTour& best,
-                  absl::Time t_start, double time_to_best, GtspResult result) {
-  result.tour.reserve(best.seq.size());
-  for (int v : best.seq) result.tour.push_back(problem.to_external[v]);
-  result.cost = TourCost(instance, result.tour);
-  result.elapsed_s = absl::ToDoubleSeconds(absl::Now() - t_start);
-  result.time_to_best_s = time_to_best;
-  return result;
+// Runs run(0..count-1), in parallel threads unless count is 1.
+void RunParallel(int count, const std::function<void(int)>& run) {
+  if (count == 1) {
+    run(0);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(count);
+  for (int j = 0; j < count; ++j) pool.emplace_back(run, j);
+  for (std::thread& th : pool) th.join();
 }
+
+// One SolveGtsp call: the problem, the best tour so far and the tallies of
+// the searches run on it. The searches of one round run in parallel and
+// call ReportBest concurrently (it locks); everything else is called from
+// the solving thread only.
+class GtspSolve {
+ public:
+  GtspSolve(const GtspInstance& instance, const GtspOptions& options)
+      : instance_(instance),
+        options_(options),
+        t_start_(absl::Now()),
+        problem_(Problem::Build(instance)),
+        cfg_(ConfigFor(options.effort)) {
+    params_.max_iterations =
+        std::max<int64_t>(cfg_.min_iterations, cfg_.iterations_per_set * problem_.m);
+    params_.stall_iterations =
+        std::max<int64_t>(cfg_.min_iterations / 2, cfg_.stall_per_set * problem_.m);
+    on_best_ = [this](const SearchTour& t) { ReportBest(t); };
+  }
+
+  GtspResult Solve() {
+    GreedyStart();
+    // kThorough with a deadline (and no trial limit) uses all the time given:
+    // one memetic search per thread, each evolving its own population (seeded
+    // with the tour so far) until the deadline. On GTSPLIB two threads for
+    // 1 s this way beat one thread of LNS trials for 5 s (docs/benchmarks.md,
+    // section 4, "A memetic search for deadlines").
+    const bool until_deadline = options_.max_trials == 0 && options_.stop.has_deadline() &&
+                                options_.effort == GtspEffort::kThorough;
+    if (until_deadline) {
+      RunMemetic();
+    } else {
+      RunTrials();
+    }
+    return Finish();
+  }
+
+ private:
+  // Shared best, only for progress reporting; the returned tour is chosen
+  // deterministically from the per-trial results (Take).
+  void ReportBest(const SearchTour& t) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (t.cost >= reported_cost_) return;
+    reported_cost_ = t.cost;
+    time_to_best_ = absl::ToDoubleSeconds(absl::Now() - t_start_);
+    if (options_.on_improvement) options_.on_improvement(t.cost, time_to_best_);
+  }
+
+  // A greedy tour first, so that there is always an answer.
+  void GreedyStart() {
+    LnsTrial greedy(problem_, params_, SeedFor(options_.seed, 0xFFFFFFFFull));
+    greedy.Construct(best_, /*mode=cheapest*/ 0);
+    if (!options_.initial_tour.empty()) {
+      SearchTour init = ToSearchTour(problem_, options_.initial_tour);
+      if (init.cost <= best_.cost) best_ = init;
+    }
+    if (!options_.stop.ShouldStop()) greedy.LocalOptimize(best_, options_.stop);
+    ReportBest(best_);
+  }
+
+  void Take(std::vector<TrialOutcome>& outcomes) {
+    for (TrialOutcome& o : outcomes) {
+      result_.iterations += o.iterations;
+      if (o.stopped) {
+        result_.stopped_early = true;
+      } else {
+        ++result_.trials_completed;
+      }
+      if (gtsp_internal::Cheaper(o.best.cost, best_.cost)) best_ = std::move(o.best);
+    }
+  }
+
+  void RunMemetic() {
+    const StopToken& stop = options_.stop;
+    if (problem_.m <= 1) return;
+    if (stop.ShouldStop()) {
+      result_.stopped_early = true;  // stopped before the search began
+      return;
+    }
+    SearchParams memetic_params = params_;
+    memetic_params.time_budget_end = stop.deadline();
+    const int threads = options_.num_threads;
+    std::vector<TrialOutcome> outcomes(threads);
+    const SearchTour warm = best_;
+    RunParallel(threads, [&](int j) {
+      MemeticSearch search(problem_, memetic_params, SeedFor(options_.seed, j));
+      outcomes[j] = search.Run(&warm, stop, on_best_);
+    });
+    Take(outcomes);
+  }
+
+  // The effort's trials, in whole rounds of `num_threads` parallel trials: a
+  // last round with fewer trials than threads would cost a full trial of
+  // wall time with cores idle, so it is dropped (at least one round runs).
+  int TotalTrials() const {
+    const int threads = options_.num_threads;
+    int total_trials = std::max(1, cfg_.trials / threads) * threads;
+    if (options_.max_trials == GtspOptions::kLocalStepOnly) {
+      total_trials = 0;
+    } else if (options_.max_trials > 0) {
+      total_trials = options_.max_trials;
+    }
+    if (problem_.m <= 1) total_trials = 0;  // the greedy step is exact for one set
+    return total_trials;
+  }
+
+  void RunTrials() {
+    const StopToken& stop = options_.stop;
+    const int threads = options_.num_threads;
+    const int total_trials = TotalTrials();
+    int started = 0;
+    while (started < total_trials && !stop.ShouldStop()) {
+      const int round = std::min(threads, total_trials - started);
+      SearchParams round_params = params_;
+      if (stop.has_deadline()) {
+        // Spread the remaining time over the remaining rounds so that every
+        // trial completes its annealing schedule before the deadline.
+        const int rounds_left = (total_trials - started + threads - 1) / threads;
+        round_params.time_budget_end = absl::Now() + stop.remaining() / rounds_left;
+      }
+      std::vector<TrialOutcome> outcomes(round);
+      const SearchTour warm = best_;
+      RunParallel(round, [&](int j) {
+        const int trial = started + j;
+        LnsTrial lns(problem_, round_params, SeedFor(options_.seed, trial));
+        const bool cold = trial < cfg_.cold_trials && options_.initial_tour.empty();
+        outcomes[j] = lns.Run(cold ? nullptr : &warm, stop, on_best_);
+      });
+      Take(outcomes);
+      started += round;
+    }
+    if (started < total_trials) result_.stopped_early = true;
+  }
+
+  GtspResult Finish() {
+    result_.tour.reserve(best_.seq.size());
+    for (int v : best_.seq) result_.tour.push_back(problem_.to_external[v]);
+    result_.cost = TourCost(instance_, result_.tour);
+    result_.elapsed_s = absl::ToDoubleSeconds(absl::Now() - t_start_);
+    result_.time_to_best_s = time_to_best_;
+    return std::move(result_);
+  }
+
+  const GtspInstance& instance_;
+  const GtspOptions& options_;
+  const absl::Time t_start_;
+  const Problem problem_;
+  const EffortConfig cfg_;
+  SearchParams params_;
+  std::function<void(const SearchTour&)> on_best_;  // ReportBest
+  SearchTour best_;
+  GtspResult result_;
+  std::mutex mu_;
+  double reported_cost_ = std::numeric_limits<double>::infinity();  // guarded by mu_
+  double time_to_best_ = 0.0;                                       // guarded by mu_
+};
 
 }  // namespace
 
@@ -163,124 +321,7 @@ absl::StatusOr<GtspResult> SolveGtsp(const GtspInstance& instance, const GtspOpt
     absl::Status st = ValidateTour(instance, options.initial_tour);
     if (!st.ok()) return absl::InvalidArgumentError(absl::StrCat("initial_tour: ", st.message()));
   }
-  const absl::Time t_start = absl::Now();
-  const StopToken& stop = options.stop;
-  const Problem problem = Problem::Build(instance);
-  const EffortConfig cfg = ConfigFor(options.effort);
-
-  SearchParams params;
-  params.max_iterations = std::max<int64_t>(cfg.min_iterations, cfg.iterations_per_set * problem.m);
-  params.stall_iterations =
-      std::max<int64_t>(cfg.min_iterations / 2, cfg.stall_per_set * problem.m);
-
-  // Shared best, only for progress reporting; the returned tour is chosen
-  // deterministically from the per-trial results below.
-  std::mutex mu;
-  double reported_cost = std::numeric_limits<double>::infinity();
-  double time_to_best = 0.0;
-  auto on_best = [&](const SearchTour& t) {
-    std::lock_guard<std::mutex> lock(mu);
-    if (t.cost >= reported_cost) return;
-    reported_cost = t.cost;
-    time_to_best = absl::ToDoubleSeconds(absl::Now() - t_start);
-    if (options.on_improvement) options.on_improvement(t.cost, time_to_best);
-  };
-
-  // A greedy tour first, so that there is always an answer.
-  SearchTour best;
-  {
-    LnsTrial greedy(problem, params, SeedFor(options.seed, 0xFFFFFFFFull));
-    greedy.Construct(best, /*mode=cheapest*/ 0);
-    if (!options.initial_tour.empty()) {
-      SearchTour init = ToSearchTour(problem, options.initial_tour);
-      if (init.cost <= best.cost) best = init;
-    }
-    if (!stop.ShouldStop()) greedy.LocalOptimize(best, stop);
-    on_best(best);
-  }
-
-  GtspResult result;
-  const int threads = options.num_threads;
-  auto run_parallel = [](int count, const std::function<void(int)>& run) {
-    if (count == 1) {
-      run(0);
-      return;
-    }
-    std::vector<std::thread> pool;
-    pool.reserve(count);
-    for (int j = 0; j < count; ++j) pool.emplace_back(run, j);
-    for (std::thread& th : pool) th.join();
-  };
-  auto take = [&](std::vector<TrialOutcome>& outcomes) {
-    for (TrialOutcome& o : outcomes) {
-      result.iterations += o.iterations;
-      if (o.stopped) {
-        result.stopped_early = true;
-      } else {
-        ++result.trials_completed;
-      }
-      if (gtsp_internal::Cheaper(o.best.cost, best.cost)) best = std::move(o.best);
-    }
-  };
-
-  // kThorough with a deadline (and no trial limit) uses all the time given:
-  // one memetic search per thread, each evolving its own population (seeded
-  // with the tour so far) until the deadline. On GTSPLIB two threads for
-  // 1 s this way beat one thread of LNS trials for 5 s (docs/benchmarks.md,
-  // section 4, "A memetic search for deadlines").
-  const bool until_deadline =
-      options.max_trials == 0 && stop.has_deadline() && options.effort == GtspEffort::kThorough;
-  if (until_deadline) {
-    if (problem.m > 1 && !stop.ShouldStop()) {
-      SearchParams memetic_params = params;
-      memetic_params.time_budget_end = stop.deadline();
-      std::vector<TrialOutcome> outcomes(threads);
-      const SearchTour warm = best;
-      run_parallel(threads, [&](int j) {
-        MemeticSearch search(problem, memetic_params, SeedFor(options.seed, j));
-        outcomes[j] = search.Run(&warm, stop, on_best);
-      });
-      take(outcomes);
-    } else if (problem.m > 1) {
-      result.stopped_early = true;  // stopped before the search began
-    }
-    return Finish(instance, problem, best, t_start, time_to_best, std::move(result));
-  }
-
-  // The effort's trials, in whole rounds of `num_threads` parallel trials: a
-  // last round with fewer trials than threads would cost a full trial of
-  // wall time with cores idle, so it is dropped (at least one round runs).
-  int total_trials = std::max(1, cfg.trials / threads) * threads;
-  if (options.max_trials == GtspOptions::kLocalStepOnly) {
-    total_trials = 0;
-  } else if (options.max_trials > 0) {
-    total_trials = options.max_trials;
-  }
-  if (problem.m <= 1) total_trials = 0;  // the greedy step is exact for one set
-
-  int started = 0;
-  while (started < total_trials && !stop.ShouldStop()) {
-    const int round = std::min(threads, total_trials - started);
-    SearchParams round_params = params;
-    if (stop.has_deadline()) {
-      // Spread the remaining time over the remaining rounds so that every
-      // trial completes its annealing schedule before the deadline.
-      const int rounds_left = (total_trials - started + threads - 1) / threads;
-      round_params.time_budget_end = absl::Now() + stop.remaining() / rounds_left;
-    }
-    std::vector<TrialOutcome> outcomes(round);
-    const SearchTour warm = best;
-    run_parallel(round, [&](int j) {
-      const int trial = started + j;
-      LnsTrial lns(problem, round_params, SeedFor(options.seed, trial));
-      const bool cold = trial < cfg.cold_trials && options.initial_tour.empty();
-      outcomes[j] = lns.Run(cold ? nullptr : &warm, stop, on_best);
-    });
-    take(outcomes);
-    started += round;
-  }
-  if (started < total_trials) result.stopped_early = true;
-  return Finish(instance, problem, best, t_start, time_to_best, std::move(result));
+  return GtspSolve(instance, options).Solve();
 }
 
 }  // namespace covplan

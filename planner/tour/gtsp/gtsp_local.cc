@@ -9,24 +9,6 @@ namespace {
 
 double Eps(double cost) { return 1e-9 + 1e-12 * std::abs(cost); }
 
-// Best vertex of `set` between a and b: returns c(a,v)+c(v,b), sets `v`.
-double BestBetween(const Problem& p, int a, int b, int set, int& v) {
-  const double* in = p.to_set(set, a);
-  const double* out = p.from_set(set, b);
-  const int size = p.set_size(set);
-  double best = in[0] + out[0];
-  int arg = 0;
-  for (int k = 1; k < size; ++k) {
-    const double d = in[k] + out[k];
-    if (d < best) {
-      best = d;
-      arg = k;
-    }
-  }
-  v = p.set_begin[set] + arg;
-  return best;
-}
-
 }  // namespace
 
 LocalSearch::LocalSearch(const Problem& p) : p_(p) { active_.assign(p.m, 0); }
@@ -65,7 +47,7 @@ bool LocalSearch::TryRelocate(SearchTour& t, int s) {
   int best_v = -1, best_after = -1;
   auto consider = [&](int x, int y) {
     int w;
-    const double d = BestBetween(p_, x, y, s, w) - p_.c(x, y);
+    const double d = p_.BestBetween(x, y, s, &w) - p_.c(x, y);
     if (d < best) {
       best = d;
       best_v = w;

@@ -52,6 +52,24 @@ struct Problem {
                            static_cast<size_t>(b) * set_size(s)];
   }
   int set_size(int s) const { return set_begin[s + 1] - set_begin[s]; }
+  // The cheapest way through set s from a to b: sets `v` to the vertex of s
+  // (the first in id order on ties) and returns c(a, v) + c(v, b).
+  double BestBetween(int a, int b, int s, int* v) const {
+    const double* in = to_set(s, a);
+    const double* out = from_set(s, b);
+    const int size = set_size(s);
+    double best = in[0] + out[0];
+    int arg = 0;
+    for (int k = 1; k < size; ++k) {
+      const double d = in[k] + out[k];
+      if (d < best) {
+        best = d;
+        arg = k;
+      }
+    }
+    *v = set_begin[s] + arg;
+    return best;
+  }
 };
 
 // True if `cost` beats `than` by more than rounding (relative 1e-9): how

@@ -45,19 +45,8 @@ int LnsTrial::Roulette(const double* weights, int count) {
 }
 
 void LnsTrial::EvaluateEdge(int a, int b, int set, double noise, Insertion& io) {
-  const double* in = p_.to_set(set, a);
-  const double* out = p_.from_set(set, b);
-  const int size = p_.set_size(set);
-  double best = in[0] + out[0];
-  int arg = 0;
-  for (int k = 1; k < size; ++k) {
-    const double d = in[k] + out[k];
-    if (d < best) {
-      best = d;
-      arg = k;
-    }
-  }
-  arg += p_.set_begin[set];
+  int arg = -1;
+  const double best = p_.BestBetween(a, b, set, &arg);
   double delta = best - p_.c(a, b);
   if (noise > 0.0) delta += noise * rng_.Uniform();
   if (delta < io.cost) {
