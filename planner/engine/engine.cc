@@ -409,6 +409,50 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
   return EngineResult{std::move(plan), ctx.area, nullptr};
 }
 
+absl::StatusOr<EngineResult> PlanningEngine::PlanPart(
+    const MapSource& source, const PlanRequest& original,
+    const std::vector<uint8_t>& cover_mask) const {
+  ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
+  const PlanRequest request = WithStationPoses(original);
+  PlanContext ctx;
+  bool all_cached = true;
+  RETURN_IF_ERROR(
+      Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
+  if (request.battery.has_value())
+    RETURN_IF_ERROR(CheckStation(*ctx.area->drive, *request.battery));
+  const CoverageArea& whole = *ctx.area;
+  if (static_cast<int64_t>(cover_mask.size()) != whole.cover->size()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "cover mask has %d entries, the grid %d cells", cover_mask.size(), whole.cover->size()));
+  }
+  std::vector<uint8_t> flags = whole.cover->free_flags();
+  int64_t cells = 0;
+  uint64_t digest = 1469598103934665603ull;  // FNV-1a over the selected cell indices
+  for (size_t i = 0; i < flags.size(); ++i) {
+    flags[i] = flags[i] != 0 && cover_mask[i] != 0;
+    if (flags[i] == 0) continue;
+    ++cells;
+    for (uint64_t v = i + 1; v != 0; v >>= 8) digest = (digest ^ (v & 0xff)) * 1099511628211ull;
+  }
+  if (cells == 0) return absl::InvalidArgumentError("cover mask selects no cell to cover");
+  auto part = std::make_shared<CoverageArea>(whole);
+  part->cover = std::make_shared<const Grid>(whole.cover->WithFreeFlags(std::move(flags)));
+  part->cover_cells = cells;
+  ctx.area_key =
+      ctx.area_key.Derive<CoverageArea>("part", absl::StrFormat("%d:%016x", cells, digest));
+  ctx.area = part;
+  ASSIGN_OR_RETURN(CoveragePlan plan, resolved.planner->Plan(ctx));
+  plan.planner = std::string(resolved.planner->name());
+  if (request.battery.has_value()) {
+    const absl::Time t = absl::Now();
+    ASSIGN_OR_RETURN(plan, SplitIntoChargeCycles(plan, *part->drive, *request.battery,
+                                                 request.common.robot, request.common.stop));
+    plan.stats.tour_ms += absl::ToDoubleMilliseconds(absl::Now() - t);
+  }
+  RETURN_IF_ERROR(Finish(request, resolved, *part, all_cached, &plan));
+  return EngineResult{std::move(plan), std::move(part), nullptr};
+}
+
 PlanStats ComputePathStats(const std::vector<Waypoint>& path, const RobotModel& robot) {
   PlanStats s;
   if (path.empty()) return s;

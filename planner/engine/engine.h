@@ -128,6 +128,15 @@ class PlanningEngine {
   // network thread.
   absl::StatusOr<std::optional<Recalled>> Recall(const MapSource& source,
                                                  const PlanRequest& request) const;
+  // Plans `request` on a part of its coverage area: only the cells whose
+  // `cover_mask` entry is non-zero (indexed like the area's grids, Grid::Index)
+  // are swept; the robot may still drive anywhere on the drive grid. The
+  // part's per-planner artifacts are keyed by the mask's content. Plan memory
+  // is neither read nor written. InvalidArgument when the mask has the wrong
+  // size or selects no cell to cover. For fleets (planner/fleet): one robot's
+  // share of the site.
+  absl::StatusOr<EngineResult> PlanPart(const MapSource& source, const PlanRequest& request,
+                                        const std::vector<uint8_t>& cover_mask) const;
   // Builds every per-map artifact `request` needs, without planning.
   absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
   // The coverage area `request` plans on (validated like Plan), e.g. to
