@@ -1,0 +1,37 @@
+// A lower bound on the makespan of a fleet plan (docs/fleet.md gives the
+// proof). It holds for every fleet plan that sweeps the reference tour's
+// units (units.h) as that tour drives each of them, forwards or backwards,
+// with the robots' own models (trapezoidal straight moves, turns in place):
+//
+//   work:  makespan >= (sum over units of [the fastest robot's time to drive
+//          the unit + the cheapest way into it from another unit's exit or a
+//          start]) / k, where "the cheapest way in" is the straight-line
+//          distance at the fleet's top speed plus the net heading change at
+//          its top turn rate; at most k units are entered from a start, so
+//          the k largest savings of a start over a unit are taken off;
+//   reach: makespan >= max over units of min over robots of (straight-line
+//          trip from the robot's start to the unit + the unit + straight-line
+//          trip to its end pose), for the unit's better direction.
+//
+// Thread-safety: reentrant.
+#ifndef COVPLAN_PLANNER_FLEET_BOUNDS_H_
+#define COVPLAN_PLANNER_FLEET_BOUNDS_H_
+
+#include <vector>
+
+#include "planner/fleet/fleet_request.h"
+#include "planner/fleet/units.h"
+
+namespace covplan {
+
+struct MakespanBound {
+  double work_s = 0.0;
+  double reach_s = 0.0;
+  double value() const { return work_s > reach_s ? work_s : reach_s; }
+};
+
+MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_PLANNER_FLEET_BOUNDS_H_
