@@ -93,7 +93,7 @@ void AppendRobot(std::string* out, const CoveragePlan& plan, const char* colour,
 std::vector<std::pair<std::string, size_t>> LegendRows(const std::vector<FleetSvgRobot>& robots,
                                                        const std::string& title) {
   std::vector<std::pair<std::string, size_t>> rows;  // markup, visible characters
-  const std::string key = "solid: coverage · dashed: transitions · disc: start · ring: end";
+  const std::string key = "dashed: transitions · disc: start · ring: end";
   const std::string lead = title.empty() ? "" : XmlEscaped(title) + " · ";
   rows.push_back({lead + key, title.size() + 3 + key.size()});
   for (size_t i = 0; i < robots.size(); ++i) {
@@ -115,7 +115,14 @@ std::string RenderFleetSvg(const std::vector<FleetSvgRobot>& robots, const Grid&
                            const OccupancyMap* map, const SvgZones& zones,
                            const std::string& title) {
   const std::vector<std::pair<std::string, size_t>> rows = LegendRows(robots, title);
-  const SvgFrame f = SvgFrameOf(grid, map, static_cast<int>(rows.size()));
+  size_t chars = 1;
+  for (const auto& row : rows) chars = std::max(chars, row.second);
+  // The text fits the map's width; rows are as tall as the text needs, but
+  // no taller than the single plan's legend row.
+  const SvgFrame one_row = SvgFrameOf(grid, map, 1);
+  const double fs = LegendFontSize(one_row, static_cast<double>(chars));
+  const SvgFrame f =
+      SvgFrameOf(grid, map, static_cast<int>(rows.size()), std::min(one_row.row_h, 1.8 * fs));
   std::string out;
   AppendSvgOpen(&out, f);
   AppendSite(&out, grid, map, zones);
@@ -123,9 +130,6 @@ std::string RenderFleetSvg(const std::vector<FleetSvgRobot>& robots, const Grid&
   for (size_t i = 0; i < robots.size(); ++i) {
     if (robots[i].plan != nullptr) AppendRobot(&out, *robots[i].plan, FleetSvgColour(i), f.cell);
   }
-  size_t chars = 1;
-  for (const auto& row : rows) chars = std::max(chars, row.second);
-  const double fs = LegendFontSize(f, static_cast<double>(chars));
   std::string legend;
   for (size_t r = 0; r < rows.size(); ++r) {
     absl::StrAppendFormat(&legend,

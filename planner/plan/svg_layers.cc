@@ -9,7 +9,7 @@
 
 namespace covplan::svg_internal {
 
-SvgFrame SvgFrameOf(const Grid& grid, const OccupancyMap* map, int legend_rows) {
+SvgFrame SvgFrameOf(const Grid& grid, const OccupancyMap* map, int legend_rows, double row_h) {
   SvgFrame f;
   f.cell = grid.cell_size();
   f.origin = grid.origin();
@@ -19,7 +19,7 @@ SvgFrame SvgFrameOf(const Grid& grid, const OccupancyMap* map, int legend_rows) 
     f.width = std::max(f.width, map->width() * map->resolution());
     f.height = std::max(f.height, map->height() * map->resolution());
   }
-  f.row_h = 0.06 * std::max(f.width, f.height) + 1.0;
+  f.row_h = row_h > 0.0 ? row_h : 0.06 * std::max(f.width, f.height) + 1.0;
   f.legend_h = std::max(1, legend_rows) * f.row_h;
   return f;
 }

@@ -29,13 +29,15 @@ namespace covplan::svg_internal {
 
 // Where the drawing lies, in metres: the map's frame below a legend band of
 // `legend_rows` rows of height `row_h` (the band spans y in [-legend_h, 0)).
+// The default row height is 6 % of the map's larger side plus 1 m; a
+// positive `row_h` overrides it (rows of small text).
 struct SvgFrame {
   Point2 origin;
   double width = 0.0, height = 0.0;  // the map (or grid) extent
   double cell = 0.0;                 // the grid's cell size
   double row_h = 0.0, legend_h = 0.0;
 };
-SvgFrame SvgFrameOf(const Grid& grid, const OccupancyMap* map, int legend_rows);
+SvgFrame SvgFrameOf(const Grid& grid, const OccupancyMap* map, int legend_rows, double row_h = 0.0);
 
 // The XML header, the <svg> element, a white background and the opening of
 // the group in map coordinates (y up); AppendSvgClose closes that group,
