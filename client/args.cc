@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include <cmath>
+#include <fstream>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -102,6 +103,15 @@ int RunSubcommand(const char* name, const char* usage, const std::vector<std::st
   if (status.ok()) return 0;
   std::fprintf(stderr, "covplan %s: %s\n", name, std::string(status.message()).c_str());
   return 1;
+}
+
+absl::Status WriteTextFile(const std::string& path, const std::string& contents) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot open ", path, " for writing"));
+  out << contents;
+  out.close();
+  if (!out) return absl::InternalError(absl::StrCat("cannot write ", path));
+  return absl::OkStatus();
 }
 
 std::string JsonString(const std::string& s) {

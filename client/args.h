@@ -14,9 +14,11 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/str_cat.h"
 
 namespace covplan {
 
@@ -38,6 +40,29 @@ absl::StatusOr<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
                                      const std::set<std::string>& value_flags,
                                      const std::set<std::string>& bool_flags,
                                      const std::set<std::string>& repeatable_flags = {});
+
+// `text`, the value of --`flag`, as one of `choices` (named in the order
+// the error lists them); else InvalidArgument "--flag must be a, b or c,
+// got 'text'".
+template <typename T>
+absl::StatusOr<T> ParseChoice(const char* flag, const std::string& text,
+                              const std::vector<std::pair<std::string, T>>& choices) {
+  std::string names;
+  for (size_t i = 0; i < choices.size(); ++i) {
+    if (choices[i].first == text) return choices[i].second;
+    absl::StrAppend(&names,
+                    i == 0                    ? ""
+                    : i + 1 == choices.size() ? " or "
+                                              : ", ",
+                    choices[i].first);
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--", flag, " must be ", names, ", got '", text, "'"));
+}
+
+// Writes `contents` to `path` (replacing it); InvalidArgument when it cannot
+// be opened, Internal when the write fails.
+absl::Status WriteTextFile(const std::string& path, const std::string& contents);
 
 // `s` as a JSON string literal (quotes, backslashes and control characters escaped).
 std::string JsonString(const std::string& s);

@@ -18,6 +18,7 @@
 #include "absl/strings/str_split.h"
 #include "api/geojson.h"
 #include "client/args.h"
+#include "client/fleet_plan.h"
 #include "client/local_engine.h"
 #include "client/map_flags.h"
 #include "client/remote.h"
@@ -61,6 +62,8 @@ constexpr char kUsage[] =
     "                    [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
     "                     [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
     "                     [--interruptible [--atomic-units ID,ID...]]]\n"
+    "                    [--robot [ID=]X,Y[,THETA]]... | [--robots K]   (a fleet; --local)\n"
+    "                    [--division makespan|equal_area] [--clearance M]\n"
     "--algorithm is another name for --planner. The --stc-* flags and --sweep-direction\n"
     "set the stc planner's options (--sweep-direction: the prim tree only).\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
@@ -73,16 +76,15 @@ constexpr char kUsage[] =
     "map may still be driven through); --no-go is never entered. Both repeat.\n"
     "Poses are in metres in the map frame, THETA in radians (default 0). Without\n"
     "--start the robot starts at the first rank; without --end it returns to the start.\n"
-    "A pose in a blocked cell next to a free one (a dock at a wall) joins the grid there.\n";
-
-absl::Status WriteFile(const std::string& path, const std::string& contents) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot open ", path, " for writing"));
-  out << contents;
-  out.close();
-  if (!out) return absl::InternalError(absl::StrCat("cannot write ", path));
-  return absl::OkStatus();
-}
+    "A pose in a blocked cell next to a free one (a dock at a wall) joins the grid there.\n"
+    "Fleets: each --robot is one robot starting at X,Y (ids r1, r2, ... unless ID= names\n"
+    "it); --robots K plans K robots the planner spreads over the site. All share the\n"
+    "robot flags (tool width, speeds, --end, battery); without --end each returns to its\n"
+    "own start. --division makespan (default) divides the work so the last robot finishes\n"
+    "early; equal_area gives each robot as many cells. --clearance M (default the tool\n"
+    "width) is the distance the safety report counts robots coming closer than. Prints\n"
+    "one line per robot and the fleet's makespan, lower bound and gap; --out writes the\n"
+    "fleet JSON (each robot's plan as plan.json), --svg one picture of every robot.\n";
 
 // "X,Y" or "X,Y,THETA" (finite numbers) into `pose`.
 absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pose* pose) {
@@ -162,6 +164,7 @@ struct PlanCommand {
   std::optional<int64_t> deadline_ms;
   int threads = 1;                        // --local only
   std::optional<GtspEffort> tour_effort;  // --local only
+  std::optional<FleetFlags> fleet;        // --robot / --robots: a fleet plan (--local only)
 };
 
 // The value flags `covplan plan` accepts, besides the connection flags.
@@ -200,25 +203,6 @@ std::set<std::string> PlanValueFlags() {
           "stc-partial",
           "threads",
           "tour-effort"};
-}
-
-// `text`, the value of --`flag`, as one of `choices` (named in the order
-// the error lists them); else InvalidArgument "--flag must be a, b or c,
-// got 'text'".
-template <typename T>
-absl::StatusOr<T> ParseChoice(const char* flag, const std::string& text,
-                              const std::vector<std::pair<std::string, T>>& choices) {
-  std::string names;
-  for (size_t i = 0; i < choices.size(); ++i) {
-    if (choices[i].first == text) return choices[i].second;
-    absl::StrAppend(&names,
-                    i == 0                    ? ""
-                    : i + 1 == choices.size() ? " or "
-                                              : ", ",
-                    choices[i].first);
-  }
-  return absl::InvalidArgumentError(
-      absl::StrCat("--", flag, " must be ", names, ", got '", text, "'"));
 }
 
 // --threads and --tour-effort: knobs of the in-process engine, so --local only.
@@ -357,11 +341,30 @@ absl::Status ParseSolverFlags(const ParsedArgs& a, v1::PlanRequest* r) {
   return absl::OkStatus();
 }
 
+// --robot / --robots and the fleet flags (fleet_plan.h): --local only, and
+// each robot's start comes from its --robot, not --start.
+absl::Status ParseFleetPlanFlags(const ParsedArgs& a, PlanCommand* c) {
+  ASSIGN_OR_RETURN(c->fleet, ParseFleetFlags(a));
+  if (!c->fleet) return absl::OkStatus();
+  if (!c->local) {
+    return absl::InvalidArgumentError(
+        "--robot and --robots plan a fleet in this process: they need --local");
+  }
+  if (a.Get("start")) {
+    return absl::InvalidArgumentError(
+        "--start is the single robot's start: give each robot's start with --robot "
+        "[ID=]X,Y[,THETA]");
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
+  std::set<std::string> value_flags = WithConnectionFlags(PlanValueFlags());
+  value_flags.merge(FleetValueFlags());
   ASSIGN_OR_RETURN(
       ParsedArgs a,
-      ParseArgs(args, WithConnectionFlags(PlanValueFlags()),
-                {"local", "negate", "interruptible", "improve-remembered"}, {"region", "no-go"}));
+      ParseArgs(args, value_flags, {"local", "negate", "interruptible", "improve-remembered"},
+                {"region", "no-go", kRobotFlag}));
   PlanCommand c;
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   c.map_path = *a.Get("map");
@@ -378,6 +381,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
     return absl::InvalidArgumentError("--deadline-ms must be positive");
   }
   RETURN_IF_ERROR(ParseLocalEngineFlags(a, &c));
+  RETURN_IF_ERROR(ParseFleetPlanFlags(a, &c));
 
   v1::PlanRequest& r = c.request;
   RETURN_IF_ERROR(ParseRobotFlags(a, r.mutable_robot()));
@@ -445,11 +449,17 @@ absl::Status Run(const std::vector<std::string>& args) {
   const PlanCommand& c = *parsed;
   EngineLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(c.map_path, c.overrides, limits));
+  if (c.fleet) {
+    v1::PlanRequest request = c.request;
+    *request.mutable_map() = map;
+    return RunLocalFleet(request, *c.fleet, limits,
+                         {c.map_path, c.out, c.svg, c.threads, c.tour_effort});
+  }
   ASSIGN_OR_RETURN(v1::PlanResponse response, Execute(c, map, limits));
   std::fputs(FormatPlanSummary(response).c_str(), stdout);
   if (c.out) {
     ASSIGN_OR_RETURN(std::string json, PlanToJson(response));
-    RETURN_IF_ERROR(WriteFile(*c.out, json));
+    RETURN_IF_ERROR(WriteTextFile(*c.out, json));
   }
   if (c.svg) {
     // In server mode the map is decoded here too, for the SVG background.
@@ -458,7 +468,7 @@ absl::Status Run(const std::vector<std::string>& args) {
     SvgZones zones;
     zones.regions = PolygonsFromProto(response.regions());
     zones.no_go = PolygonsFromProto(response.no_go());
-    RETURN_IF_ERROR(WriteFile(*c.svg, RenderPlanSvg(plan, site.raster.get(), zones)));
+    RETURN_IF_ERROR(WriteTextFile(*c.svg, RenderPlanSvg(plan, site.raster.get(), zones)));
   }
   return absl::OkStatus();
 }
