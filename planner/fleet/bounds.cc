@@ -22,6 +22,18 @@ double UnitTime(const TourUnits& units, const TourUnit& u, const RobotModel& rob
 
 double Reversed(double heading) { return heading + M_PI; }
 
+// The least total turning (radians) of any path of straight segments and
+// turns in place from `a` heading `ha` to `b` heading `hb`
+// (docs/fleet.md): at least the net change, and, when the robot moves, the
+// way through the displacement's direction d, capped at half a turn (the
+// headings a path takes span an arc; under half a turn that arc holds d).
+double TurnBound(double ha, double hb, Point2 a, Point2 b) {
+  const double net = HeadingChange(ha, hb);
+  if (std::hypot(b.x - a.x, b.y - a.y) <= 1e-9) return net;
+  const double d = std::atan2(b.y - a.y, b.x - a.x);
+  return std::max(net, std::min(M_PI, HeadingChange(ha, d) + HeadingChange(d, hb)));
+}
+
 }  // namespace
 
 MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots) {
@@ -34,10 +46,13 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
   for (const FleetRobot& r : robots) {
     fastest.max_speed_mps = std::max(fastest.max_speed_mps, r.robot.max_speed_mps);
     fastest.turn_rate_deg_s = std::max(fastest.turn_rate_deg_s, r.robot.turn_rate_deg_s);
+    fastest.acceleration_mps2 = std::max(fastest.acceleration_mps2, r.robot.acceleration_mps2);
   }
   auto move = [&](Point2 a, double ha, Point2 b, double hb) {
-    return std::hypot(b.x - a.x, b.y - a.y) / fastest.max_speed_mps +
-           fastest.TurnTime(HeadingChange(ha, hb));
+    const double dist = std::hypot(b.x - a.x, b.y - a.y);
+    // Straight moves from rest to rest: their times add up to at least one
+    // move of their summed length (StraightTime is concave, zero at zero).
+    return fastest.StraightTime(dist) + fastest.TurnTime(TurnBound(ha, hb, a, b));
   };
   // Variant 0: forwards (enter at entry heading entry_heading, leave at exit);
   // variant 1: backwards (enter at exit reversed, leave at entry reversed).
@@ -125,8 +140,8 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
       for (int v = 0; v < 2; ++v) {
         const End& e = ends[2 * u + v];
         double t = time[r][u];
-        if (m.start) t += std::hypot(e.in.x - m.start->x, e.in.y - m.start->y) / m.max_speed_mps;
-        if (m.end) t += std::hypot(e.out.x - m.end->x, e.out.y - m.end->y) / m.max_speed_mps;
+        if (m.start) t += m.StraightTime(std::hypot(e.in.x - m.start->x, e.in.y - m.start->y));
+        if (m.end) t += m.StraightTime(std::hypot(e.out.x - m.end->x, e.out.y - m.end->y));
         best = std::min(best, t);
       }
     }

@@ -5,13 +5,18 @@
 //
 //   work:  makespan >= (sum over units of [the fastest robot's time to drive
 //          the unit + the cheapest way into it from another unit's exit or a
-//          start]) / k, where "the cheapest way in" is the straight-line
-//          distance at the fleet's top speed plus the net heading change at
-//          its top turn rate; at most k units are entered from a start, so
-//          the k largest savings of a start over a unit are taken off;
-//   reach: makespan >= max over units of min over robots of (straight-line
-//          trip from the robot's start to the unit + the unit + straight-line
-//          trip to its end pose), for the unit's better direction.
+//          start]) / k. "The cheapest way in" from pose a to pose b is
+//          StraightTime(|ab|) at the fleet's top speed and acceleration (a
+//          path's straight moves from rest to rest take at least one move of
+//          their summed length, StraightTime being concave) plus TurnBound
+//          at its top turn rate: the least turning of any path from a's
+//          heading to b's, at least the net change and, when the robot moves,
+//          the way through the direction of b - a, capped at half a turn. At
+//          most k units are entered from a start, so the k largest savings of
+//          a start over a unit are taken off;
+//   reach: makespan >= max over units of min over robots of (the straight
+//          move from the robot's start to the unit + the unit + the straight
+//          move to its end pose), for the unit's better direction.
 //
 // Thread-safety: reentrant.
 #ifndef COVPLAN_PLANNER_FLEET_BOUNDS_H_

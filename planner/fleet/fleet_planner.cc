@@ -224,6 +224,27 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
     if (candidate.makespan_s < best.makespan_s) best = std::move(candidate);
   }
   best.rebalance_rounds = rounds;
+  if (request.division == FleetDivision::kMakespan && Seconds(t0) < 0.9 * budget &&
+      !request.base.common.stop.ShouldStop()) {
+    // The equal-area regions are one more candidate division: the makespan
+    // division is never worse than the baseline where the tour's pieces are.
+    std::vector<std::optional<Pose2>> starts;
+    for (const FleetRobot& r : request.robots) starts.push_back(r.robot.start);
+    std::vector<std::vector<int64_t>> regions =
+        EqualAreaRegions(*area->drive, *area->cover, starts);
+    if (connected) MakeRegionsConnected(*area->drive, &regions);
+    FleetPlan candidate;
+    candidate.division = request.division;
+    candidate.lower_bound_s = lower_bound;
+    RETURN_IF_ERROR(
+        PlanShares(engine, source, request, *area, regions, round_limit(0.5), &candidate));
+    FillFleetFigures(request, area->cover_cells, &candidate);
+    if (candidate.makespan_s < best.makespan_s) {
+      candidate.rebalance_rounds = rounds;
+      candidate.from_regions = true;
+      best = std::move(candidate);
+    }
+  }
   best.termination = Termination::Converged(absl::StrFormat("%d rebalancing rounds", rounds));
   for (const FleetRobotPlan& rp : best.robots) {
     if (rp.result.plan.termination.limit_reached()) best.termination = rp.result.plan.termination;

@@ -105,6 +105,8 @@ struct FleetPlan {
   int64_t cover_cells = 0;
   int64_t covered_cells = 0;  // distinct cells swept by some robot
   int rebalance_rounds = 0;
+  // The makespan division kept the equal-area regions (they finished first).
+  bool from_regions = false;
   double planning_ms = 0.0;
   Termination termination;
   FleetSafety safety;
