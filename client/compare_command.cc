@@ -18,6 +18,7 @@
 #include "client/map_flags.h"
 #include "planner/assembly/builtin_planners.h"
 #include "planner/common/status_macros.h"
+#include "planner/fleet/fleet_planner.h"
 
 namespace covplan {
 namespace {
@@ -26,25 +27,43 @@ constexpr char kUsage[] =
     "usage: covplan compare --map FILE [--algorithms oarp,stc,...] [--tool-width M]\n"
     "                       [--json out.json] [--markdown] [--no-header] [--name NAME]\n"
     "                       [--resolution M] [--free-thresh P] [--occupied-thresh P] [--negate]\n"
-    "                       [--time-limit S] [--seed N]\n"
+    "                       [--time-limit S] [--seed N] [--robots K]\n"
     "Plans FILE (as covplan plan reads it) with each planner, in this process, with\n"
     "its default options, and prints one table: turns, path length, estimated\n"
     "duration, covered free-area ratio, redundant cells (cells to cover the path\n"
     "enters more than once) and planning time. Default: every registered planner.\n"
     "--markdown prints a markdown table (with a map column named NAME, default the\n"
-    "file name; --no-header leaves out the header rows). --json writes the rows.\n";
+    "file name; --no-header leaves out the header rows). --json writes the rows.\n"
+    "--robots K plans each planner as a K-robot fleet (robots spread by the planner,\n"
+    "--time-limit per fleet) with the makespan division and with equal areas, and\n"
+    "prints the makespan, its lower bound, the gap and the equal-area makespan.\n";
 
 std::string TerminationText(const Termination& t) {
   if (!t.limit_reached()) return "converged";
   return absl::StrCat("limit: ", TerminationLimitName(t.limit));
 }
 
+// Prints `table`, or with --markdown the markdown of `markdown(name,
+// header)`, and writes `json` to --json when given.
+template <typename Markdown>
+absl::Status Print(const ParsedArgs& a, const std::string& map_path, const std::string& table,
+                   Markdown markdown, const std::string& json) {
+  if (a.Has("markdown")) {
+    std::string name = a.Get("name").value_or(map_path.substr(map_path.find_last_of('/') + 1));
+    std::fputs(markdown(name, !a.Has("no-header")).c_str(), stdout);
+  } else {
+    std::fputs(table.c_str(), stdout);
+  }
+  if (auto path = a.Get("json")) RETURN_IF_ERROR(WriteTextFile(*path, json));
+  return absl::OkStatus();
+}
+
 absl::Status Run(const std::vector<std::string>& args) {
-  ASSIGN_OR_RETURN(ParsedArgs a,
-                   ParseArgs(args,
-                             {"map", "algorithms", "tool-width", "json", "resolution",
-                              "free-thresh", "occupied-thresh", "time-limit", "seed", "name"},
-                             {"markdown", "no-header", "negate"}));
+  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args,
+                                           {"map", "algorithms", "tool-width", "json", "resolution",
+                                            "free-thresh", "occupied-thresh", "time-limit", "seed",
+                                            "name", "robots"},
+                                           {"markdown", "no-header", "negate"}));
   if (!a.Get("map")) return absl::InvalidArgumentError("--map FILE is required");
   const std::string map_path = *a.Get("map");
   ASSIGN_OR_RETURN(const MapFileOverrides overrides, MapFileOverridesFromFlags(a));
@@ -64,21 +83,28 @@ absl::Status Run(const std::vector<std::string>& args) {
   if (limit) request.common.time_limit_s = *limit;
   ASSIGN_OR_RETURN(std::optional<int64_t> seed, a.GetInt("seed"));
   if (seed) request.common.seed = static_cast<uint64_t>(*seed);
+  ASSIGN_OR_RETURN(std::optional<int64_t> robots, a.GetInt("robots"));
+  if (robots) {
+    if (*robots < 1 || *robots > FleetRequest::kMaxRobots) {
+      return absl::InvalidArgumentError(absl::StrFormat("--robots must be in [1, %d], got %d",
+                                                        FleetRequest::kMaxRobots, *robots));
+    }
+    ASSIGN_OR_RETURN(std::vector<FleetComparisonRow> rows,
+                     CompareFleets(registry, MapSourceFor(map, limits), planners, request,
+                                   static_cast<int>(*robots), limits));
+    return Print(
+        a, map_path, FleetComparisonTable(rows),
+        [&](const std::string& name, bool header) {
+          return FleetComparisonMarkdown(rows, name, header);
+        },
+        FleetComparisonJson(rows, map_path, request.common.robot.tool_width_m));
+  }
   ASSIGN_OR_RETURN(std::vector<ComparisonRow> rows,
                    ComparePlanners(registry, MapSourceFor(map, limits), planners, request, limits));
-  if (a.Has("markdown")) {
-    std::string name = a.Get("name").value_or(map_path.substr(map_path.find_last_of('/') + 1));
-    std::fputs(ComparisonMarkdown(rows, name, !a.Has("no-header")).c_str(), stdout);
-  } else {
-    std::fputs(ComparisonTable(rows).c_str(), stdout);
-  }
-  if (auto json = a.Get("json")) {
-    std::ofstream out(*json, std::ios::binary | std::ios::trunc);
-    out << ComparisonJson(rows, map_path, request.common.robot.tool_width_m);
-    out.close();
-    if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot write ", *json));
-  }
-  return absl::OkStatus();
+  return Print(
+      a, map_path, ComparisonTable(rows),
+      [&](const std::string& name, bool header) { return ComparisonMarkdown(rows, name, header); },
+      ComparisonJson(rows, map_path, request.common.robot.tool_width_m));
 }
 
 }  // namespace
@@ -220,6 +246,109 @@ std::string ComparisonJson(const std::vector<ComparisonRow>& rows, const std::st
   return absl::StrFormat(
       "{\n  \"map\": %s,\n  \"tool_width_m\": %.6g,\n  \"planners\": [\n%s\n  ]\n}\n",
       quote(map_path), tool_width_m, absl::StrJoin(items, ",\n"));
+}
+
+absl::StatusOr<std::vector<FleetComparisonRow>> CompareFleets(
+    const PlannerRegistry& registry, const MapSource& source,
+    const std::vector<std::string>& planners, const PlanRequest& request, int robots,
+    const EngineLimits& limits) {
+  for (const std::string& name : planners) {
+    if (registry.Find(name) == nullptr) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "unknown algorithm '%s'; registered: %s", name, absl::StrJoin(registry.Names(), ", ")));
+    }
+  }
+  FleetRequest fleet;
+  for (int i = 0; i < robots; ++i) {
+    FleetRobot robot;
+    robot.id = absl::StrCat("r", i + 1);
+    robot.robot = request.common.robot;
+    fleet.robots.push_back(std::move(robot));
+  }
+  std::vector<FleetComparisonRow> rows;
+  for (const std::string& name : planners) {
+    const LocalEngine local(limits, registry);
+    fleet.base = request;
+    fleet.base.planner = name;
+    fleet.base.options = nullptr;
+    FleetPlan plans[2];
+    for (FleetDivision d : {FleetDivision::kMakespan, FleetDivision::kEqualArea}) {
+      fleet.division = d;
+      absl::StatusOr<FleetPlan> plan = PlanFleet(local.engine(), source, fleet);
+      if (!plan.ok()) {
+        return absl::Status(plan.status().code(), absl::StrCat(name, " (", FleetDivisionName(d),
+                                                               "): ", plan.status().message()));
+      }
+      plans[static_cast<int>(d)] = *std::move(plan);
+    }
+    const FleetPlan& m = plans[0];
+    const FleetPlan& e = plans[1];
+    FleetComparisonRow row;
+    row.planner = name;
+    row.robots = robots;
+    row.makespan_s = m.makespan_s;
+    row.lower_bound_s = m.lower_bound_s;
+    row.gap = m.gap;
+    row.equal_area_makespan_s = e.makespan_s;
+    row.equal_area_gap = e.gap;
+    row.cells_to_cover = m.cover_cells;
+    row.covered_cells = m.covered_cells;
+    row.planning_ms = m.planning_ms + e.planning_ms;
+    row.termination = TerminationText(m.termination);
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+std::string FleetComparisonTable(const std::vector<FleetComparisonRow>& rows) {
+  std::string out = absl::StrFormat("%-14s %6s %11s %14s %8s %13s %9s %12s  %s\n", "planner",
+                                    "robots", "makespan_s", "lower_bound_s", "gap", "equal_area_s",
+                                    "covered", "planning_ms", "search");
+  for (const FleetComparisonRow& r : rows) {
+    out += absl::StrFormat("%-14s %6d %11.1f %14.1f %7.1f%% %13.1f %8.1f%% %12.1f  %s\n", r.planner,
+                           r.robots, r.makespan_s, r.lower_bound_s, 100.0 * r.gap,
+                           r.equal_area_makespan_s,
+                           r.cells_to_cover > 0 ? 100.0 * r.covered_cells / r.cells_to_cover : 0.0,
+                           r.planning_ms, r.termination);
+  }
+  return out;
+}
+
+std::string FleetComparisonMarkdown(const std::vector<FleetComparisonRow>& rows,
+                                    const std::string& map_name, bool header) {
+  std::string out;
+  const std::string lead = map_name.empty() ? "" : "| map ";
+  if (header) {
+    out += lead +
+           "| planner | robots | makespan (s) | lower bound (s) | gap | equal-area makespan (s) | "
+           "planning (ms) |\n";
+    out += std::string(map_name.empty() ? "" : "|---") + "|---|---:|---:|---:|---:|---:|---:|\n";
+  }
+  for (const FleetComparisonRow& r : rows) {
+    if (!map_name.empty()) out += absl::StrCat("| ", map_name, " ");
+    out += absl::StrFormat("| %s | %d | %.1f | %.1f | %.1f %% | %.1f | %.1f |\n", r.planner,
+                           r.robots, r.makespan_s, r.lower_bound_s, 100.0 * r.gap,
+                           r.equal_area_makespan_s, r.planning_ms);
+  }
+  return out;
+}
+
+std::string FleetComparisonJson(const std::vector<FleetComparisonRow>& rows,
+                                const std::string& map_path, double tool_width_m) {
+  std::vector<std::string> items;
+  for (const FleetComparisonRow& r : rows) {
+    items.push_back(absl::StrFormat(
+        "    {\"planner\": %s, \"robots\": %d, \"makespan_s\": %.6g, \"lower_bound_s\": %.6g, "
+        "\"gap\": %.6g, \"equal_area_makespan_s\": %.6g, \"equal_area_gap\": %.6g, "
+        "\"cells_to_cover\": %d, \"covered_cells\": %d, \"planning_ms\": %.6g, "
+        "\"termination\": %s}",
+        JsonString(r.planner), r.robots, r.makespan_s, r.lower_bound_s, r.gap,
+        r.equal_area_makespan_s, r.equal_area_gap, r.cells_to_cover, r.covered_cells, r.planning_ms,
+        JsonString(r.termination)));
+  }
+  return absl::StrFormat(
+      "{\n  \"map\": %s,\n  \"tool_width_m\": %.6g,\n  \"fleets\": [\n%s\n  ]\n}\n",
+      JsonString(map_path), tool_width_m, absl::StrJoin(items, ",\n"));
 }
 
 int RunCompareCommand(const std::vector<std::string>& args) {

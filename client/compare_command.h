@@ -10,6 +10,8 @@
 // cover that the path's centre line enters more than once, transitions
 // included) and planning time (wall clock of the engine call, each planner
 // with a fresh artifact cache, so every planner pays for the grid).
+// With --robots K each planner plans a K-robot fleet instead (both
+// divisions): makespan, its lower bound, the gap and the equal-area makespan.
 // Thread-safety: not applicable (command entry points).
 #ifndef COVPLAN_CLIENT_COMPARE_COMMAND_H_
 #define COVPLAN_CLIENT_COMPARE_COMMAND_H_
@@ -56,6 +58,36 @@ std::string ComparisonMarkdown(const std::vector<ComparisonRow>& rows, const std
                                bool header);
 std::string ComparisonJson(const std::vector<ComparisonRow>& rows, const std::string& map_path,
                            double tool_width_m);
+
+// `covplan compare --robots K`: each planner plans the map as a K-robot
+// fleet (robots without start poses, spread by the planner), once with the
+// makespan division and once with the equal-area baseline.
+struct FleetComparisonRow {
+  std::string planner;
+  int robots = 0;
+  double makespan_s = 0.0;     // makespan division
+  double lower_bound_s = 0.0;  // the fleet's makespan lower bound
+  double gap = 0.0;            // makespan / lower bound - 1
+  double equal_area_makespan_s = 0.0;
+  double equal_area_gap = 0.0;
+  int64_t cells_to_cover = 0;
+  int64_t covered_cells = 0;  // by the makespan fleet
+  double planning_ms = 0.0;   // both fleets
+  std::string termination;    // the makespan fleet's
+};
+
+// `request`'s robot model is every robot's; each planner gets its own
+// artifact cache, shared by its two fleets.
+absl::StatusOr<std::vector<FleetComparisonRow>> CompareFleets(
+    const PlannerRegistry& registry, const MapSource& source,
+    const std::vector<std::string>& planners, const PlanRequest& request, int robots,
+    const EngineLimits& limits);
+
+std::string FleetComparisonTable(const std::vector<FleetComparisonRow>& rows);
+std::string FleetComparisonMarkdown(const std::vector<FleetComparisonRow>& rows,
+                                    const std::string& map_name, bool header);
+std::string FleetComparisonJson(const std::vector<FleetComparisonRow>& rows,
+                                const std::string& map_path, double tool_width_m);
 
 // Returns the process exit code.
 int RunCompareCommand(const std::vector<std::string>& args);

@@ -116,5 +116,41 @@ TEST(CompareCommand, UnknownAlgorithmsListTheRegisteredOnes) {
   EXPECT_NE(RunCompareCommand({"--algorithms", "stc"}), 0);
 }
 
+// --robots K: each planner as a K-robot fleet, both divisions, each row's
+// makespan at least its lower bound and every cell swept.
+TEST(CompareCommand, RobotsCompareEachPlannerAsAFleet) {
+  const PlannerRegistry registry = BuiltinPlanners();
+  PlanRequest request;
+  request.common.robot.tool_width_m = 0.8;
+  request.common.time_limit_s = 0.5;
+  absl::StatusOr<std::vector<FleetComparisonRow>> rows = CompareFleets(
+      registry, ShippedSource("small_rooms.yaml"), {"stc", "oarp"}, request, 2, EngineLimits{});
+  ASSERT_TRUE(rows.ok()) << rows.status();
+  ASSERT_EQ(rows->size(), 2u);
+  EXPECT_EQ((*rows)[0].planner, "stc");
+  EXPECT_EQ((*rows)[1].planner, "oarp");
+  for (const FleetComparisonRow& row : *rows) {
+    SCOPED_TRACE(row.planner);
+    EXPECT_EQ(row.robots, 2);
+    EXPECT_GT(row.lower_bound_s, 0.0);
+    EXPECT_GE(row.makespan_s, row.lower_bound_s);
+    EXPECT_NEAR(row.gap, row.makespan_s / row.lower_bound_s - 1.0, 1e-9);
+    EXPECT_GE(row.equal_area_makespan_s, row.lower_bound_s);
+    EXPECT_EQ(row.covered_cells, row.cells_to_cover);
+    EXPECT_GT(row.planning_ms, 0.0);
+  }
+  EXPECT_THAT(FleetComparisonTable(*rows), HasSubstr("equal_area_s"));
+  EXPECT_THAT(FleetComparisonMarkdown(*rows, "rooms", true), HasSubstr("| rooms | stc | 2 | "));
+  EXPECT_THAT(FleetComparisonJson(*rows, "maps/small_rooms.yaml", 0.8),
+              HasSubstr("\"equal_area_makespan_s\": "));
+
+  const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml");
+  EXPECT_EQ(RunCompareCommand(
+                {"--map", map, "--algorithms", "stc", "--robots", "2", "--time-limit", "0.3"}),
+            0);
+  EXPECT_NE(RunCompareCommand({"--map", map, "--robots", "0"}), 0);
+  EXPECT_NE(RunCompareCommand({"--map", map, "--robots", "2", "--algorithms", "nope"}), 0);
+}
+
 }  // namespace
 }  // namespace covplan
