@@ -24,7 +24,9 @@ using svg_internal::SvgFrameOf;
 // Distinguishable on the light site background (no yellow or cyan).
 constexpr const char* kColours[kFleetSvgColours] = {"#e6194b", "#3cb44b", "#4363d8", "#f58231",
                                                     "#911eb4", "#008080", "#f032e6", "#9a6324"};
-constexpr size_t kRobotsPerLegendRow = 4;
+// Robots per legend row: at least this many, more while a row of them is no
+// wider than the key row.
+constexpr size_t kMinRobotsPerLegendRow = 4;
 
 std::string XmlEscaped(const std::string& s) {
   std::string out;
@@ -89,20 +91,27 @@ void AppendRobot(std::string* out, const CoveragePlan& plan, const char* colour,
   AppendEnds(out, plan.path, s, colour, "#000000", colour);
 }
 
-// The legend rows: the title and the key, then the robots, four per row.
+// The legend rows: the title and the key, then the robots, as many per row
+// as fit the key row's width (at least four).
 std::vector<std::pair<std::string, size_t>> LegendRows(const std::vector<FleetSvgRobot>& robots,
                                                        const std::string& title) {
   std::vector<std::pair<std::string, size_t>> rows;  // markup, visible characters
   const std::string key = "dashed: transitions · disc: start · ring: end";
   const std::string lead = title.empty() ? "" : XmlEscaped(title) + " · ";
   rows.push_back({lead + key, title.size() + 3 + key.size()});
+  std::vector<std::string> figures;
+  size_t widest = 1;
+  for (const FleetSvgRobot& r : robots) {
+    figures.push_back(absl::StrFormat(" %.0f s", r.duration_s));
+    widest = std::max(widest, 3 + r.id.size() + figures.back().size());
+  }
+  const size_t per_row = std::max(kMinRobotsPerLegendRow, rows[0].second / widest);
   for (size_t i = 0; i < robots.size(); ++i) {
-    if (i % kRobotsPerLegendRow == 0) rows.push_back({"", 0});
-    const std::string figures = absl::StrFormat(" %.0f s", robots[i].duration_s);
-    absl::StrAppend(&rows.back().first, i % kRobotsPerLegendRow == 0 ? "" : " · ", "<tspan fill=\"",
+    if (i % per_row == 0) rows.push_back({"", 0});
+    absl::StrAppend(&rows.back().first, i % per_row == 0 ? "" : " · ", "<tspan fill=\"",
                     FleetSvgColour(i), "\" font-weight=\"bold\">", XmlEscaped(robots[i].id),
-                    "</tspan>", figures);
-    rows.back().second += 3 + robots[i].id.size() + figures.size();
+                    "</tspan>", figures[i]);
+    rows.back().second += 3 + robots[i].id.size() + figures[i].size();
   }
   return rows;
 }

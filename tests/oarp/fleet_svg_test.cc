@@ -91,9 +91,10 @@ TEST(FleetSvg, ColoursCycleAfterEightAndIdsAreEscaped) {
   const std::string svg = RenderFleetSvg(robots, *grid, nullptr);
   EXPECT_THAT(svg, HasSubstr("&lt;b&amp;&quot;x&quot;&gt;"));
   EXPECT_THAT(svg, Not(HasSubstr("<b&")));
-  // Ten robots: the key row and three rows of robots.
-  EXPECT_EQ(Count(svg, "<text "), 4u);
-  EXPECT_THAT(svg, HasSubstr(">r9</tspan>"));
+  // Ten robots: the key row, then several robots per row.
+  EXPECT_GE(Count(svg, "<text "), 2u);
+  EXPECT_LE(Count(svg, "<text "), 4u);
+  for (int i = 3; i < 10; ++i) EXPECT_THAT(svg, HasSubstr(absl::StrCat(">r", i, "</tspan>")));
   EXPECT_EQ(Count(svg, "<g "), Count(svg, "</g>"));
 }
 
