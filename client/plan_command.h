@@ -5,6 +5,10 @@
 //   covplan plan --map maps/sample_office.yaml --tool-width 0.8 --server 127.0.0.1:50051
 //       --out plan.json --svg plan.svg
 //
+// With --robot X,Y (repeated) or --robots K, and --local, it plans a fleet
+// instead (client/fleet_plan.h): PlanFleet, the fleet's figures, a fleet JSON
+// and one SVG of every robot.
+//
 // Thread-safety: not applicable (command entry points).
 #ifndef COVPLAN_CLIENT_PLAN_COMMAND_H_
 #define COVPLAN_CLIENT_PLAN_COMMAND_H_
