@@ -80,6 +80,10 @@ void RetainedPlanToProto(const RetainedPlan& plan, v1::PlanResponse* out);
 // an inconsistent response.
 absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response);
 
+// A plan's termination and back (also a fleet plan's, convert_fleet.h).
+void TerminationToProto(const Termination& termination, v1::Termination* out);
+Termination TerminationFromProto(const v1::Termination& termination);
+
 // Replanning (convert_replan.cc). Range checks of progress and obstacles
 // happen in the replanner, with the same field names.
 absl::StatusOr<ReplanMethod> ReplanMethodFromProto(v1::ReplanMethod method);

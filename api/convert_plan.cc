@@ -226,28 +226,6 @@ absl::Status PathFromProto(const v1::PlanResponse& response, CoveragePlan* plan)
   return absl::OkStatus();
 }
 
-Termination TerminationFromProto(const v1::Termination& t) {
-  Termination out;
-  out.reason = t.reason() == v1::FEASIBLE_LIMIT_REACHED ? TerminationReason::kFeasibleLimitReached
-                                                        : TerminationReason::kConverged;
-  switch (t.limit()) {
-    case v1::LIMIT_TIME:
-      out.limit = TerminationLimit::kTime;
-      break;
-    case v1::LIMIT_DEADLINE:
-      out.limit = TerminationLimit::kDeadline;
-      break;
-    case v1::LIMIT_CANCELLED:
-      out.limit = TerminationLimit::kCancelled;
-      break;
-    default:
-      out.limit = TerminationLimit::kNone;
-      break;
-  }
-  out.detail = t.detail();
-  return out;
-}
-
 PlanStats PlanStatsFromProto(const v1::PlanStats& s) {
   PlanStats o;
   o.num_ranks = s.num_ranks();
@@ -301,6 +279,35 @@ absl::StatusOr<std::vector<ChargeCycle>> CyclesFromProto(const v1::PlanResponse&
 }
 
 }  // namespace
+
+void TerminationToProto(const Termination& termination, v1::Termination* out) {
+  out->set_reason(termination.reason == TerminationReason::kConverged ? v1::CONVERGED
+                                                                      : v1::FEASIBLE_LIMIT_REACHED);
+  out->set_limit(LimitToProto(termination.limit));
+  out->set_detail(termination.detail);
+}
+
+Termination TerminationFromProto(const v1::Termination& t) {
+  Termination out;
+  out.reason = t.reason() == v1::FEASIBLE_LIMIT_REACHED ? TerminationReason::kFeasibleLimitReached
+                                                        : TerminationReason::kConverged;
+  switch (t.limit()) {
+    case v1::LIMIT_TIME:
+      out.limit = TerminationLimit::kTime;
+      break;
+    case v1::LIMIT_DEADLINE:
+      out.limit = TerminationLimit::kDeadline;
+      break;
+    case v1::LIMIT_CANCELLED:
+      out.limit = TerminationLimit::kCancelled;
+      break;
+    default:
+      out.limit = TerminationLimit::kNone;
+      break;
+  }
+  out.detail = t.detail();
+  return out;
+}
 
 void PolygonsToProto(const std::vector<PolygonInput>& polygons,
                      google::protobuf::RepeatedPtrField<v1::Polygon>* out) {
@@ -409,12 +416,7 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
     s->set_waypoint(sweep.waypoint);
     for (const CellIndex& c : sweep.cells) s->add_cells(c.row * cols + c.col);
   }
-  v1::Termination* t = out->mutable_termination();
-  t->set_reason(plan.termination.reason == TerminationReason::kConverged
-                    ? v1::CONVERGED
-                    : v1::FEASIBLE_LIMIT_REACHED);
-  t->set_limit(LimitToProto(plan.termination.limit));
-  t->set_detail(plan.termination.detail);
+  TerminationToProto(plan.termination, out->mutable_termination());
   const PlanStats& s = plan.stats;
   v1::PlanStats* o = out->mutable_stats();
   o->set_num_ranks(static_cast<int32_t>(s.num_ranks));
