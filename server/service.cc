@@ -18,6 +18,8 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       maps_(options_, store, &cache_, metrics, &gate_, &admission_, &io_pool_, &read_pool_),
       plans_(options_, store, metrics, &engine_, &gate_, &admission_, &served_, &archive_,
              &warm_pool_, background_stop_),
+      missions_(4 * options.max_retained_plans + 16),
+      fleets_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &missions_),
       replans_(&gate_, &admission_, &replan_work_),
       drive_(options_, metrics, &gate_, &admission_, &replan_work_, &progress_),
       io_pool_(/*threads=*/2, /*max_queue=*/64),

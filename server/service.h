@@ -9,6 +9,8 @@
 //   ProgressLog     the robot's progress per plan, for Resume
 //   MapHandlers     PutMap, GetMap, ListMaps, DeleteMap
 //   PlanHandlers    Plan, GetPlan
+//   FleetHandlers   PlanFleet (each robot's plan retained like a Plan's;
+//                   FleetMissions keeps mission_id -> robots, plan ids)
 //   ReplanHandlers  Replan, Resume (their work: ReplanWork)
 //   DriveHandler    Drive, and the DriveHost of its sessions
 //
@@ -46,6 +48,8 @@
 #include "server/call_gate.h"
 #include "server/drive_handler.h"
 #include "server/drive_session.h"
+#include "server/fleet_handlers.h"
+#include "server/fleet_missions.h"
 #include "server/map_handlers.h"
 #include "server/map_repository.h"
 #include "server/metrics.h"
@@ -101,6 +105,11 @@ class CoveragePlannerService final
                                     v1::PlanResponse* response) override {
     return plans_.GetPlan(context, request, response);
   }
+  grpc::ServerUnaryReactor* PlanFleet(grpc::CallbackServerContext* context,
+                                      const v1::PlanFleetRequest* request,
+                                      v1::PlanFleetResponse* response) override {
+    return fleets_.PlanFleet(context, request, response);
+  }
   grpc::ServerUnaryReactor* Replan(grpc::CallbackServerContext* context,
                                    const v1::ReplanRequest* request,
                                    v1::ReplanResponse* response) override {
@@ -134,6 +143,7 @@ class CoveragePlannerService final
   const ArtifactLru& cache() const { return cache_; }
   const ReplanEstimator& estimator() const { return archive_.estimator(); }
   const SessionRegistry& sessions() const { return drive_.sessions(); }
+  const FleetMissions& missions() const { return missions_; }
 
  private:
   const ServiceOptions options_;
@@ -149,6 +159,8 @@ class CoveragePlannerService final
   ReplanWork replan_work_;
   MapHandlers maps_;
   PlanHandlers plans_;
+  FleetMissions missions_;
+  FleetHandlers fleets_;
   ReplanHandlers replans_;
   DriveHandler drive_;
   // Last: their threads stop before the rest is destroyed.
