@@ -1,8 +1,9 @@
 // The PlanFleet RPC in process: two robots on the shipped office map get
 // two retained plans (GetPlan returns them, Replan continues one, and after
 // a restart the stored ones are found again) that together sweep every cell
-// the single-robot Plan sweeps; bad fleets are INVALID_ARGUMENT naming the
-// field.
+// the single-robot Plan sweeps; more robots than work on an inline map
+// leaves some idle, whose plans are retained but not replanned; bad fleets
+// are INVALID_ARGUMENT naming the field.
 #include <grpcpp/grpcpp.h>
 
 #include <chrono>
@@ -16,6 +17,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "tests/testing/test_maps.h"
 
 namespace covplan {
 namespace {
@@ -199,6 +201,50 @@ TEST_F(FleetServiceTest, StoredRobotPlansAreReplannedAfterARestart) {
     EXPECT_EQ(static_cast<int>(SweptCells(replanned.plan()).size()),
               replanned.replan().remaining_cells());
   }
+}
+
+TEST_F(FleetServiceTest, IdleRobotsGetPlansThatAreNotReplanned) {
+  v1::PlanFleetRequest request;
+  *request.mutable_plan()->mutable_map() =
+      testing::RasterMap(testing::AsciiToPgm(testing::TwoRooms(), 4), 0.1);
+  request.mutable_plan()->mutable_robot()->set_tool_width_m(0.4);
+  request.mutable_plan()->set_time_limit_s(1.0);
+  for (int i = 0; i < 24; ++i) {
+    v1::FleetRobot* robot = request.add_robots();
+    robot->set_id(absl::StrCat("r", i));
+    robot->mutable_robot()->set_tool_width_m(0.4);
+  }
+  v1::PlanFleetResponse fleet;
+  grpc::Status status = PlanFleet(request, &fleet);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(fleet.robots_size(), 24);
+  EXPECT_EQ(fleet.covered_cells(), fleet.cover_cells());
+  std::set<std::string> ids;
+  int idle = 0;
+  for (const v1::FleetRobotPlan& robot : fleet.robots()) {
+    ids.insert(robot.plan().plan_id());
+    v1::PlanResponse retained;
+    ASSERT_TRUE(GetPlan(robot.plan().plan_id(), &retained).ok()) << robot.id();
+    if (!robot.idle()) continue;
+    ++idle;
+    EXPECT_EQ(robot.assigned_cells(), 0);
+    EXPECT_EQ(robot.plan().sweeps_size(), 0);
+    v1::ReplanRequest replan;
+    replan.set_plan_id(robot.plan().plan_id());
+    replan.mutable_progress()->set_distance_m(0);
+    replan.mutable_obstacles()->add_cells()->set_row(1);
+    v1::ReplanResponse out;
+    EXPECT_EQ(Replan(replan, &out).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    grpc::ClientContext context;
+    v1::ResumeRequest resume;
+    resume.set_plan_id(robot.plan().plan_id());
+    resume.mutable_pose()->set_x(1.0);
+    resume.mutable_pose()->set_y(1.0);
+    EXPECT_EQ(stub_->Resume(&context, resume, &out).error_code(),
+              grpc::StatusCode::FAILED_PRECONDITION);
+  }
+  EXPECT_EQ(ids.size(), 24u);
+  EXPECT_GT(idle, 0);
 }
 
 TEST_F(FleetServiceTest, BadFleetsAreInvalidArgumentNamingTheField) {
