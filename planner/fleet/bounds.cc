@@ -1,8 +1,12 @@
 #include "planner/fleet/bounds.h"
 
+#include <optional>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
+
+#include "planner/fleet/assignment.h"
 
 namespace covplan {
 namespace {
@@ -36,51 +40,100 @@ double TurnBound(double ha, double hb, Point2 a, Point2 b) {
 
 }  // namespace
 
-MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots) {
-  MakespanBound bound;
-  const int n = static_cast<int>(units.units.size());
-  const int k = static_cast<int>(robots.size());
-  if (n == 0 || k == 0) return bound;
-  // The fleet's fastest straight speed and turn rate: a move's lower bound.
-  RobotModel fastest = robots[0].robot;
-  for (const FleetRobot& r : robots) {
-    fastest.max_speed_mps = std::max(fastest.max_speed_mps, r.robot.max_speed_mps);
-    fastest.turn_rate_deg_s = std::max(fastest.turn_rate_deg_s, r.robot.turn_rate_deg_s);
-    fastest.acceleration_mps2 = std::max(fastest.acceleration_mps2, r.robot.acceleration_mps2);
-  }
-  auto move = [&](Point2 a, double ha, Point2 b, double hb) {
-    const double dist = std::hypot(b.x - a.x, b.y - a.y);
-    // Straight moves from rest to rest: their times add up to at least one
-    // move of their summed length (StraightTime is concave, zero at zero).
-    return fastest.StraightTime(dist) + fastest.TurnTime(TurnBound(ha, hb, a, b));
-  };
-  // Variant 0: forwards (enter at entry heading entry_heading, leave at exit);
-  // variant 1: backwards (enter at exit reversed, leave at entry reversed).
-  struct End {
-    Point2 in, out;
-    double h_in, h_out;
-  };
-  std::vector<End> ends(2 * n);
-  std::vector<std::vector<double>> time(k, std::vector<double>(n));
-  double work = 0.0;
-  for (int u = 0; u < n; ++u) {
-    const TourUnit& t = units.units[u];
-    ends[2 * u] = {t.entry, t.exit, t.entry_heading, t.exit_heading};
-    ends[2 * u + 1] = {t.exit, t.entry, Reversed(t.exit_heading), Reversed(t.entry_heading)};
-    double best = INFINITY;
-    for (int r = 0; r < k; ++r) {
-      time[r][u] = UnitTime(units, t, robots[r].robot);
-      best = std::min(best, time[r][u]);
+namespace {
+
+// Variant 0 of a unit: forwards (entered at its entry along entry_heading,
+// left at its exit); variant 1: backwards.
+struct End {
+  Point2 in, out;
+  double h_in, h_out;
+};
+
+class BoundInput {
+ public:
+  BoundInput(const TourUnits& units, const std::vector<FleetRobot>& robots) : robots_(robots) {
+    n_ = static_cast<int>(units.units.size());
+    k_ = static_cast<int>(robots.size());
+    fastest_ = robots[0].robot;
+    for (const FleetRobot& r : robots) {
+      fastest_.max_speed_mps = std::max(fastest_.max_speed_mps, r.robot.max_speed_mps);
+      fastest_.turn_rate_deg_s = std::max(fastest_.turn_rate_deg_s, r.robot.turn_rate_deg_s);
+      fastest_.acceleration_mps2 = std::max(fastest_.acceleration_mps2, r.robot.acceleration_mps2);
     }
-    work += best;
+    ends_.resize(2 * n_);
+    time_.assign(k_, std::vector<double>(n_));
+    for (int u = 0; u < n_; ++u) {
+      const TourUnit& t = units.units[u];
+      ends_[2 * u] = {t.entry, t.exit, t.entry_heading, t.exit_heading};
+      ends_[2 * u + 1] = {t.exit, t.entry, Reversed(t.exit_heading), Reversed(t.entry_heading)};
+      for (int r = 0; r < k_; ++r) time_[r][u] = UnitTime(units, t, robots[r].robot);
+    }
   }
-  // The cheapest way into each unit: from another unit (exits bucketed on a
-  // square grid, searched ring by ring until no nearer bucket can beat the
-  // best move found), and from a start.
+  int n() const { return n_; }
+  int k() const { return k_; }
+  const End& end(int variant) const { return ends_[variant]; }
+  double time(int r, int u) const { return time_[r][u]; }
+  double fastest_time(int u) const {
+    double best = INFINITY;
+    for (int r = 0; r < k_; ++r) best = std::min(best, time_[r][u]);
+    return best;
+  }
+  const RobotModel& robot(int r) const { return robots_[r].robot; }
+  // The least time of any move from pose (a, ha) to pose (b, hb): straight
+  // moves from rest to rest take at least one move of their summed length
+  // (StraightTime is concave), plus the least turning (TurnBound).
+  double Move(Point2 a, double ha, Point2 b, double hb) const {
+    return fastest_.StraightTime(std::hypot(b.x - a.x, b.y - a.y)) +
+           fastest_.TurnTime(TurnBound(ha, hb, a, b));
+  }
+  // The cheapest move into unit u (either direction) from robot r's start
+  // (0 when it has none), and out of u to r's end (0 when it has none).
+  double FromStart(int r, int u) const {
+    const std::optional<Pose2>& s = robot(r).start;
+    if (!s) return 0.0;
+    return std::min(Move({s->x, s->y}, s->theta, ends_[2 * u].in, ends_[2 * u].h_in),
+                    Move({s->x, s->y}, s->theta, ends_[2 * u + 1].in, ends_[2 * u + 1].h_in));
+  }
+  double ToEnd(int r, int u) const {
+    const std::optional<Pose2>& e = robot(r).end;
+    if (!e) return 0.0;
+    double best = INFINITY;
+    for (int v = 0; v < 2; ++v) {
+      const Point2 out = ends_[2 * u + v].out;
+      best = std::min(best, fastest_.StraightTime(std::hypot(e->x - out.x, e->y - out.y)));
+    }
+    return best;
+  }
+  double Between(int w, int u) const {
+    double best = INFINITY;
+    for (int a = 0; a < 2; ++a) {
+      for (int b = 0; b < 2; ++b) {
+        const End& x = ends_[2 * w + a];
+        const End& y = ends_[2 * u + b];
+        best = std::min(best, Move(x.out, x.h_out, y.in, y.h_in));
+      }
+    }
+    return best;
+  }
+
+ private:
+  const std::vector<FleetRobot>& robots_;
+  int n_ = 0, k_ = 0;
+  RobotModel fastest_;
+  std::vector<End> ends_;
+  std::vector<std::vector<double>> time_;
+};
+
+// Sum of the cheapest way into each unit from another unit's exit or a start,
+// with the k largest savings of a start taken off. Exits are bucketed on a
+// square grid and searched ring by ring until no nearer bucket can beat the
+// best move found.
+double CheapestEntries(const BoundInput& in) {
+  const int n = in.n(), k = in.k();
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (const End& e : ends) {
-    x0 = std::min(x0, e.out.x), y0 = std::min(y0, e.out.y);
-    x1 = std::max(x1, e.out.x), y1 = std::max(y1, e.out.y);
+  for (int w = 0; w < 2 * n; ++w) {
+    const Point2 p = in.end(w).out;
+    x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
   }
   const double span = std::max({x1 - x0, y1 - y0, 1e-6});
   const int side = std::max(1, static_cast<int>(std::sqrt(2.0 * n)));
@@ -89,57 +142,85 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
   auto bx = [&](double x) { return std::clamp(static_cast<int>((x - x0) / bucket), 0, side - 1); };
   auto by = [&](double y) { return std::clamp(static_cast<int>((y - y0) / bucket), 0, side - 1); };
   for (int w = 0; w < 2 * n; ++w)
-    buckets[by(ends[w].out.y) * side + bx(ends[w].out.x)].push_back(w);
+    buckets[by(in.end(w).out.y) * side + bx(in.end(w).out.x)].push_back(w);
   auto cheapest_in = [&](int u, const End& e) {
     double best = INFINITY;
     const int cx = bx(e.in.x), cy = by(e.in.y);
     for (int ring = 0; ring <= side; ++ring) {
       // Every exit in this ring or beyond is at least this far away.
-      const double near = std::max(0, ring - 1) * bucket;
-      if (near / fastest.max_speed_mps >= best) break;
+      if (in.Move({0, 0}, 0, {std::max(0, ring - 1) * bucket, 0}, 0) >= best) break;
       for (int gy = cy - ring; gy <= cy + ring; ++gy) {
         for (int gx = cx - ring; gx <= cx + ring; ++gx) {
           if (std::max(std::abs(gx - cx), std::abs(gy - cy)) != ring) continue;
           if (gx < 0 || gy < 0 || gx >= side || gy >= side) continue;
           for (int w : buckets[gy * side + gx]) {
             if (w / 2 == u) continue;
-            best = std::min(best, move(ends[w].out, ends[w].h_out, e.in, e.h_in));
+            best = std::min(best, in.Move(in.end(w).out, in.end(w).h_out, e.in, e.h_in));
           }
         }
       }
     }
     return best;
   };
+  double sum = 0.0;
   std::vector<double> saving;
   for (int u = 0; u < n; ++u) {
-    double from_unit = INFINITY, from_start = INFINITY;
-    for (int v = 0; v < 2; ++v) {
-      const End& e = ends[2 * u + v];
-      from_unit = std::min(from_unit, cheapest_in(u, e));
-      for (const FleetRobot& r : robots) {
-        if (!r.robot.start.has_value()) {
-          from_start = 0.0;
-          continue;
-        }
-        const Pose2& s = *r.robot.start;
-        from_start = std::min(from_start, move({s.x, s.y}, s.theta, e.in, e.h_in));
-      }
-    }
+    double from_unit = std::min(cheapest_in(u, in.end(2 * u)), cheapest_in(u, in.end(2 * u + 1)));
+    double from_start = INFINITY;
+    for (int r = 0; r < k; ++r) from_start = std::min(from_start, in.FromStart(r, u));
     if (!std::isfinite(from_unit)) from_unit = from_start;  // a single unit
-    work += from_unit;
+    sum += from_unit;
     saving.push_back(std::max(0.0, from_unit - from_start));
   }
   std::sort(saving.begin(), saving.end(), std::greater<>());
-  for (int i = 0; i < std::min(k, n); ++i) work -= saving[i];
+  for (int i = 0; i < std::min(k, n); ++i) sum -= saving[i];
+  return sum;
+}
+
+// The least total cost of the moves of any k paths, start_r -> units ->
+// end_r, that enter every unit once: the assignment relaxation over the
+// predecessors (unit exits, starts) and successors (unit entries, ends).
+std::optional<double> AssignedMoves(const BoundInput& in) {
+  const int n = in.n(), k = in.k(), size = n + k;
+  std::vector<double> c(static_cast<size_t>(size) * size, INFINITY);
+  auto at = [&](int row, int col) -> double& { return c[static_cast<size_t>(row) * size + col]; };
+  for (int w = 0; w < n; ++w) {
+    for (int u = 0; u < n; ++u) {
+      if (u != w) at(w, u) = in.Between(w, u);
+    }
+    for (int r = 0; r < k; ++r) at(w, n + r) = in.ToEnd(r, w);
+  }
+  for (int r = 0; r < k; ++r) {
+    for (int u = 0; u < n; ++u) at(n + r, u) = in.FromStart(r, u);
+    at(n + r, n + r) = 0.0;  // a robot given nothing
+  }
+  return MinAssignmentCost(c, size);
+}
+
+// Units and robots up to which the assignment bound is computed (O(n^3)).
+constexpr int kMaxAssignment = 400;
+
+}  // namespace
+
+MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots) {
+  MakespanBound bound;
+  if (units.units.empty() || robots.empty()) return bound;
+  const BoundInput in(units, robots);
+  const int n = in.n(), k = in.k();
+  double work = 0.0;
+  for (int u = 0; u < n; ++u) work += in.fastest_time(u);
+  std::optional<double> moves;
+  if (n + k <= kMaxAssignment) moves = AssignedMoves(in);
+  work += moves.has_value() ? *moves : CheapestEntries(in);
   bound.work_s = std::max(0.0, work) / k;
   // Some robot must drive each unit, from its start and back to its end.
   for (int u = 0; u < n; ++u) {
     double best = INFINITY;
     for (int r = 0; r < k; ++r) {
-      const RobotModel& m = robots[r].robot;
+      const RobotModel& m = in.robot(r);
       for (int v = 0; v < 2; ++v) {
-        const End& e = ends[2 * u + v];
-        double t = time[r][u];
+        const End& e = in.end(2 * u + v);
+        double t = in.time(r, u);
         if (m.start) t += m.StraightTime(std::hypot(e.in.x - m.start->x, e.in.y - m.start->y));
         if (m.end) t += m.StraightTime(std::hypot(e.out.x - m.end->x, e.out.y - m.end->y));
         best = std::min(best, t);

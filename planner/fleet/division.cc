@@ -182,6 +182,30 @@ std::vector<int64_t> SpreadSeeds(const Grid& cover, int count) {
   return seeds;
 }
 
+// True when cell i can leave its region without cutting it locally: the
+// region's cells among its 8 neighbours (in ring order) form at most one run
+// that holds a 4-neighbour, so every path through i can go around it.
+bool KeepsRegionConnected(const Grid& drive, const std::vector<int>& owner, int64_t i) {
+  static constexpr int kRingDr[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+  static constexpr int kRingDc[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+  const CellIndex c = drive.FromIndex(i);
+  bool in[8];
+  for (int j = 0; j < 8; ++j) {
+    const int r = c.row + kRingDr[j], col = c.col + kRingDc[j];
+    in[j] = drive.InBounds(r, col) && owner[drive.Index(r, col)] == owner[i];
+  }
+  int runs = 0;
+  bool all = true;
+  for (int j = 0; j < 8; ++j) {
+    all &= in[j];
+    if (!in[j] || in[(j + 7) % 8]) continue;  // not the start of a run
+    bool orthogonal = false;
+    for (int m = j; m < j + 8 && in[m % 8]; ++m) orthogonal |= (m % 8) % 2 == 0;
+    runs += orthogonal;
+  }
+  return all || runs <= 1;
+}
+
 // Evens out the cell counts of regions grown unevenly (a robot boxed in by
 // the others): the largest region hands the cells along its border with its
 // smallest neighbour over to it, half the difference at a time, while that
@@ -207,9 +231,8 @@ void BalanceRegions(const Grid& drive, int k, std::vector<int>* owner_ptr) {
       for (int m = 0; m < 4; ++m) {
         if (!drive.Passable(c.row, c.col, kDr[m], kDc[m])) continue;
         const int o = owner[drive.Index(c.row + kDr[m], c.col + kDc[m])];
-        if (o >= 0 && o != big) {
+        if (o >= 0 && o != big && (border[o].empty() || border[o].back() != i)) {
           border[o].push_back(i);
-          break;
         }
       }
     }
@@ -222,10 +245,21 @@ void BalanceRegions(const Grid& drive, int k, std::vector<int>* owner_ptr) {
       stuck[big] = 1;
       continue;
     }
-    const int64_t give = std::min<int64_t>((count[big] - count[small]) / 2, border[small].size());
-    for (int64_t j = 0; j < give; ++j) owner[border[small][j]] = small;
-    count[big] -= give;
-    count[small] += give;
+    // Hand over border cells whose loss leaves `big` connected around them.
+    const int64_t want = (count[big] - count[small]) / 2;
+    int64_t given = 0;
+    for (int64_t i : border[small]) {
+      if (given >= want) break;
+      if (!KeepsRegionConnected(drive, owner, i)) continue;
+      owner[i] = small;
+      ++given;
+    }
+    count[big] -= given;
+    count[small] += given;
+    if (given == 0) {
+      stuck[big] = 1;
+      continue;
+    }
     std::fill(stuck.begin(), stuck.end(), 0);
   }
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <thread>
 #include <utility>
 
@@ -19,7 +21,7 @@ namespace covplan {
 namespace {
 
 // Share of the budget the reference tour of the whole site gets.
-constexpr double kReferenceShare = 0.4;
+constexpr double kReferenceShare = 0.3;
 // Rebalancing rounds at most (each plans every robot whose piece changed).
 constexpr int kMaxRounds = 6;
 
@@ -97,6 +99,90 @@ absl::Status PlanShares(const PlanningEngine& engine, const MapSource& source,
 
 double Seconds(absl::Time since) { return absl::ToDoubleSeconds(absl::Now() - since); }
 
+// The division and its improvement on real plans, within the budget. A
+// round (planning every robot's share) is started only when the last one
+// would still fit in what is left of the budget.
+struct FleetSearch {
+  const PlanningEngine& engine;
+  const MapSource& source;
+  const FleetRequest& request;
+  std::shared_ptr<const CoverageArea> area;
+  const TourUnits& units;
+  UnitCosts costs;
+  double lower_bound;
+  bool connected;  // STC: each robot's region connected
+  absl::Time t0;
+  bool time_left = true;
+  double last_round_s = 0.0;
+
+  double budget() const { return request.base.common.time_limit_s; }
+  bool RoundFits() {
+    time_left = Seconds(t0) + last_round_s < budget() && !request.base.common.stop.ShouldStop();
+    return time_left;
+  }
+  // Plans a division's shares; `share` of what is left of the budget goes to
+  // the tour searches of this round.
+  absl::Status PlanDivision(std::vector<std::vector<int64_t>> cells, double share, FleetPlan* out) {
+    if (connected) MakeRegionsConnected(*area->drive, &cells);
+    const size_t k = request.robots.size();
+    const int threads = std::clamp<int>(request.base.common.num_threads, 1, static_cast<int>(k));
+    const double batches = std::ceil(static_cast<double>(k) / threads);
+    const double limit = std::max(0.05, (budget() - Seconds(t0)) * share / batches);
+    const absl::Time start = absl::Now();
+    out->division = request.division;
+    out->lower_bound_s = lower_bound;
+    RETURN_IF_ERROR(PlanShares(engine, source, request, *area, cells, limit, out));
+    FillFleetFigures(request, area->cover_cells, out);
+    last_round_s = Seconds(start);
+    return absl::OkStatus();
+  }
+  std::vector<std::vector<int64_t>> Regions() const {
+    std::vector<std::optional<Pose2>> starts;
+    for (const FleetRobot& r : request.robots) starts.push_back(r.robot.start);
+    return EqualAreaRegions(*area->drive, *area->cover, starts);
+  }
+
+  absl::Status Run(FleetPlan* best) {
+    if (request.division == FleetDivision::kEqualArea) return PlanDivision(Regions(), 0.5, best);
+    TourSplit split = SplitTour(costs);
+    RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), 0.5, best));
+    FleetPlan last = *best;  // the plans of `split`
+    // The equal-area regions are one more candidate: the makespan division is
+    // never worse than the baseline where the tour's pieces are.
+    if (RoundFits()) {
+      FleetPlan candidate;
+      RETURN_IF_ERROR(PlanDivision(Regions(), 0.5, &candidate));
+      if (candidate.makespan_s < best->makespan_s) {
+        candidate.from_regions = true;
+        *best = std::move(candidate);
+      }
+    }
+    // Rebalance: learn each robot's real cost over the split's estimate
+    // (from the last split's own plans) and split again.
+    int rounds = 0;
+    while (rounds < kMaxRounds && RoundFits()) {
+      for (size_t r = 0; r < request.robots.size(); ++r) {
+        const auto [a, b] = split.pieces[r];
+        if (a > b || last.robots[r].idle) continue;
+        const double estimate = costs.Piece(static_cast<int>(r), a, b);
+        if (estimate > 0.0 && std::isfinite(estimate))
+          costs.SetScale(static_cast<int>(r),
+                         costs.scale(static_cast<int>(r)) * last.robots[r].duration_s / estimate);
+      }
+      TourSplit next = SplitTour(costs);
+      if (next.pieces == split.pieces) break;
+      split = std::move(next);
+      FleetPlan candidate;
+      RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), 0.25, &candidate));
+      ++rounds;
+      last = candidate;
+      if (candidate.makespan_s < best->makespan_s) *best = std::move(candidate);
+    }
+    best->rebalance_rounds = rounds;
+    return absl::OkStatus();
+  }
+};
+
 }  // namespace
 
 void FillFleetFigures(const FleetRequest& request, int64_t cover_cells, FleetPlan* plan) {
@@ -171,85 +257,17 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
   ASSIGN_OR_RETURN(UnitCosts costs,
                    UnitCosts::Build(units, *area->drive, request.robots, request.base.common.stop));
   const double lower_bound = MakespanLowerBound(units, request.robots).value();
-  const bool connected = whole->plan.planner == "stc";
 
-  std::vector<std::vector<int64_t>> cells;
-  TourSplit split;
-  if (request.division == FleetDivision::kEqualArea) {
-    std::vector<std::optional<Pose2>> starts;
-    for (const FleetRobot& r : request.robots) starts.push_back(r.robot.start);
-    cells = EqualAreaRegions(*area->drive, *area->cover, starts);
-  } else {
-    split = SplitTour(costs);
-    cells = CellsOfSplit(units, split);
-  }
-  if (connected) MakeRegionsConnected(*area->drive, &cells);
-  const int threads = std::clamp<int>(request.base.common.num_threads, 1, static_cast<int>(k));
-  const double batches = std::ceil(static_cast<double>(k) / threads);
-  // The first round gets half of what is left, each later round a quarter.
-  auto round_limit = [&](double share) {
-    return std::max(0.05, (budget - Seconds(t0)) * share / batches);
-  };
-  best.lower_bound_s = lower_bound;
-  RETURN_IF_ERROR(PlanShares(engine, source, request, *area, cells, round_limit(0.5), &best));
-  FillFleetFigures(request, area->cover_cells, &best);
-  int rounds = 0;
-  bool time_left = true;
-  while (request.division == FleetDivision::kMakespan && rounds < kMaxRounds) {
-    if ((time_left = Seconds(t0) < 0.9 * budget && !request.base.common.stop.ShouldStop()) ==
-        false) {
-      break;
-    }
-    // Learn each robot's real cost over the split's estimate and split again.
-    for (size_t r = 0; r < k; ++r) {
-      const auto [a, b] = split.pieces[r];
-      if (a > b || best.robots[r].idle) continue;
-      const double estimate = costs.Piece(static_cast<int>(r), a, b);
-      if (estimate > 0.0 && std::isfinite(estimate))
-        costs.SetScale(static_cast<int>(r),
-                       costs.scale(static_cast<int>(r)) * best.robots[r].duration_s / estimate);
-    }
-    TourSplit next = SplitTour(costs);
-    if (next.pieces == split.pieces) break;
-    split = std::move(next);
-    cells = CellsOfSplit(units, split);
-    if (connected) MakeRegionsConnected(*area->drive, &cells);
-    FleetPlan candidate;
-    candidate.division = request.division;
-    candidate.lower_bound_s = lower_bound;
-    RETURN_IF_ERROR(
-        PlanShares(engine, source, request, *area, cells, round_limit(0.25), &candidate));
-    FillFleetFigures(request, area->cover_cells, &candidate);
-    ++rounds;
-    if (candidate.makespan_s < best.makespan_s) best = std::move(candidate);
-  }
-  best.rebalance_rounds = rounds;
-  if (request.division == FleetDivision::kMakespan && Seconds(t0) < 0.9 * budget &&
-      !request.base.common.stop.ShouldStop()) {
-    // The equal-area regions are one more candidate division: the makespan
-    // division is never worse than the baseline where the tour's pieces are.
-    std::vector<std::optional<Pose2>> starts;
-    for (const FleetRobot& r : request.robots) starts.push_back(r.robot.start);
-    std::vector<std::vector<int64_t>> regions =
-        EqualAreaRegions(*area->drive, *area->cover, starts);
-    if (connected) MakeRegionsConnected(*area->drive, &regions);
-    FleetPlan candidate;
-    candidate.division = request.division;
-    candidate.lower_bound_s = lower_bound;
-    RETURN_IF_ERROR(
-        PlanShares(engine, source, request, *area, regions, round_limit(0.5), &candidate));
-    FillFleetFigures(request, area->cover_cells, &candidate);
-    if (candidate.makespan_s < best.makespan_s) {
-      candidate.rebalance_rounds = rounds;
-      candidate.from_regions = true;
-      best = std::move(candidate);
-    }
-  }
-  best.termination = Termination::Converged(absl::StrFormat("%d rebalancing rounds", rounds));
+  FleetSearch search{engine, source,           request,     area,
+                     units,  std::move(costs), lower_bound, whole->plan.planner == "stc",
+                     t0};
+  RETURN_IF_ERROR(search.Run(&best));
+  best.termination =
+      Termination::Converged(absl::StrFormat("%d rebalancing rounds", best.rebalance_rounds));
   for (const FleetRobotPlan& rp : best.robots) {
     if (rp.result.plan.termination.limit_reached()) best.termination = rp.result.plan.termination;
   }
-  if (!time_left && best.termination.reason == TerminationReason::kConverged) {
+  if (!search.time_left && best.termination.reason == TerminationReason::kConverged) {
     best.termination = Termination::LimitReached(request.base.common.stop.ShouldStop()
                                                      ? TerminationLimit::kDeadline
                                                      : TerminationLimit::kTime,

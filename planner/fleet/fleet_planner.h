@@ -10,7 +10,7 @@
 // is exactly the single-robot plan.
 //
 // Budget: the request's time_limit_s (and its stop token) covers the whole
-// fleet plan: about 40 % for the reference tour, the rest for the robots'
+// fleet plan: about 30 % for the reference tour's search, the rest for the robots'
 // plans and the rebalancing rounds. Robots are planned concurrently on up to
 // common.num_threads threads.
 //

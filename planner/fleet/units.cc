@@ -107,33 +107,53 @@ absl::StatusOr<UnitCosts> UnitCosts::Build(const TourUnits& units, const Grid& d
       c.prefix_[r][m + 1] = c.prefix_[r][m] + own[m % n] + c.move_[r][m % n];
     }
   }
+  // Distances (metres) from each distinct pose to every unit's entry and
+  // exit: one any-angle search per pose (a robot that ends where it starts,
+  // or robots sharing a dock, share one).
   AnyAngleSearch search(drive);
   const double cell = drive.cell_size();
+  struct Field {
+    double x, y;
+    std::vector<double> entry, exit;
+  };
+  std::vector<Field> fields;
+  auto field = [&](const Pose2& pose, const std::string& what) -> absl::StatusOr<const Field*> {
+    for (const Field& f : fields) {
+      if (f.x == pose.x && f.y == pose.y) return &f;
+    }
+    ASSIGN_OR_RETURN(AnyAngleSearch * s, SearchFrom(&search, drive, pose, what, stop));
+    Field f{pose.x, pose.y, std::vector<double>(n), std::vector<double>(n)};
+    auto at = [&](Point2 p) {
+      const CellIndex c = drive.CellAt(p);
+      return drive.IsFree(c) && s->Reached(c) ? s->DistanceCells(c) * cell : INFINITY;
+    };
+    for (int u = 0; u < n; ++u) {
+      f.entry[u] = at(units.units[u].entry);
+      f.exit[u] = at(units.units[u].exit);
+    }
+    fields.push_back(std::move(f));
+    return &fields.back();
+  };
+  fields.reserve(2 * k);
   for (int r = 0; r < k; ++r) {
     const RobotModel& robot = robots[r].robot;
     if (robot.start.has_value()) {
-      ASSIGN_OR_RETURN(AnyAngleSearch * s,
-                       SearchFrom(&search, drive, *robot.start,
-                                  absl::StrFormat("robots[%d].robot.start", r), stop));
+      ASSIGN_OR_RETURN(const Field* f,
+                       field(*robot.start, absl::StrFormat("robots[%d].robot.start", r)));
       const Point2 from{robot.start->x, robot.start->y};
       for (int u = 0; u < n; ++u) {
-        const CellIndex at = drive.CellAt(units.units[u].entry);
-        const double d =
-            drive.IsFree(at) && s->Reached(at) ? s->DistanceCells(at) * cell : INFINITY;
+        const double d = f->entry[u];
         c.reach_[r][u] = std::isfinite(d) ? TripTime(robot, from, robot.start->theta,
                                                      units.units[u].entry, std::nullopt, d)
                                           : INFINITY;
       }
     }
     if (robot.end.has_value()) {
-      ASSIGN_OR_RETURN(
-          AnyAngleSearch * s,
-          SearchFrom(&search, drive, *robot.end, absl::StrFormat("robots[%d].robot.end", r), stop));
+      ASSIGN_OR_RETURN(const Field* f,
+                       field(*robot.end, absl::StrFormat("robots[%d].robot.end", r)));
       const Point2 to{robot.end->x, robot.end->y};
       for (int u = 0; u < n; ++u) {
-        const CellIndex at = drive.CellAt(units.units[u].exit);
-        const double d =
-            drive.IsFree(at) && s->Reached(at) ? s->DistanceCells(at) * cell : INFINITY;
+        const double d = f->exit[u];
         c.ret_[r][u] = std::isfinite(d) ? TripTime(robot, units.units[u].exit,
                                                    units.units[u].exit_heading, to, std::nullopt, d)
                                         : INFINITY;

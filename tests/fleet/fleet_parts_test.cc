@@ -1,0 +1,67 @@
+// The fleet's parts alone: the assignment solver against brute force, and
+// the equal-area regions on an open grid.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "gtest/gtest.h"
+#include "planner/fleet/assignment.h"
+#include "planner/fleet/division.h"
+
+namespace covplan {
+namespace {
+
+double BruteForce(const std::vector<double>& c, int n) {
+  std::vector<int> p(n);
+  std::iota(p.begin(), p.end(), 0);
+  double best = INFINITY;
+  do {
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += c[i * n + p[i]];
+    best = std::min(best, s);
+  } while (std::next_permutation(p.begin(), p.end()));
+  return best;
+}
+
+TEST(Assignment, MatchesBruteForceOnRandomMatricesWithForbiddenPairs) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> cost(0.0, 100.0);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 1 + trial % 7;
+    std::vector<double> c(n * n);
+    for (double& x : c) x = rng() % 5 == 0 ? INFINITY : cost(rng);
+    const double want = BruteForce(c, n);
+    const std::optional<double> got = MinAssignmentCost(c, n);
+    if (!std::isfinite(want)) {
+      EXPECT_FALSE(got.has_value()) << "trial " << trial;
+    } else {
+      ASSERT_TRUE(got.has_value()) << "trial " << trial;
+      EXPECT_NEAR(*got, want, 1e-9) << "trial " << trial;
+    }
+  }
+}
+
+TEST(EqualArea, RegionsOfAnOpenGridAreEqualConnectedAndCoverEverything) {
+  std::vector<uint8_t> free(30 * 40, 1);
+  const Grid g(30, 40, 1.0, {0.0, 0.0}, free);
+  for (int k : {2, 3, 5}) {
+    std::vector<std::optional<Pose2>> starts;
+    for (int r = 0; r < k; ++r) starts.push_back(Pose2{0.5 + 8.0 * r, 0.5 + 5.0 * r, 0.0});
+    std::vector<std::vector<int64_t>> regions = EqualAreaRegions(g, g, starts);
+    int64_t total = 0, lo = INT64_MAX, hi = 0;
+    for (const auto& r : regions) {
+      total += static_cast<int64_t>(r.size());
+      lo = std::min<int64_t>(lo, r.size());
+      hi = std::max<int64_t>(hi, r.size());
+    }
+    EXPECT_EQ(total, g.size()) << "k=" << k;
+    EXPECT_LE(hi - lo, 2) << "k=" << k;
+    std::vector<std::vector<int64_t>> copy = regions;
+    EXPECT_EQ(MakeRegionsConnected(g, &copy), 0) << "k=" << k << ": a region was not connected";
+  }
+}
+
+}  // namespace
+}  // namespace covplan
