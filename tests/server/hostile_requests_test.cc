@@ -173,6 +173,36 @@ class Hostile {
     }
     return r;
   }
+  // A fleet on the good map: mostly plausible robots (starts anywhere on the
+  // 4.8 x 3.2 m map, walls included), some hostile values.
+  v1::PlanFleetRequest Fleet(const std::string& good_map_id) {
+    v1::PlanFleetRequest r;
+    *r.mutable_plan() = Plan(good_map_id);
+    if (Chance(0.5)) r.mutable_plan()->set_map_id(good_map_id);
+    if (Chance(0.5)) r.mutable_plan()->clear_planner();
+    const int robots = Chance(0.05) ? 70 : Below(5);
+    const bool plausible = Chance(0.6);
+    for (int i = 0; i < robots; ++i) {
+      v1::FleetRobot* robot = r.add_robots();
+      robot->set_id(Chance(0.8) ? absl::StrCat("r", i) : Text());
+      robot->mutable_robot()->set_tool_width_m(plausible || Chance(0.5) ? 0.4 : Number());
+      if (Chance(0.6)) {
+        v1::Pose* start = robot->mutable_robot()->mutable_start();
+        start->set_x(plausible ? std::uniform_real_distribution<double>(0, 4.8)(rng_) : Number());
+        start->set_y(plausible ? std::uniform_real_distribution<double>(0, 3.2)(rng_) : Number());
+      }
+      if (Chance(0.2)) {
+        v1::Battery* battery = robot->mutable_battery();
+        battery->set_capacity(plausible ? 20.0 : Number());
+        battery->mutable_station()->set_x(plausible ? 0.6 : Number());
+        battery->mutable_station()->set_y(plausible ? 0.6 : Number());
+        robot->set_recharge_s(plausible ? 60.0 : Number());
+      }
+    }
+    r.set_division(static_cast<v1::FleetDivision>(Below(3)));
+    if (Chance(0.3)) r.set_clearance_m(Number());
+    return r;
+  }
   bool Chance(double p) { return std::uniform_real_distribution<double>(0, 1)(rng_) < p; }
   int Below(size_t n) {
     return static_cast<int>(std::uniform_int_distribution<size_t>(0, n - 1)(rng_));
@@ -216,7 +246,7 @@ TEST(HostileRequestsTest, EveryReplyIsOkOrAClientErrorAndTheServerSurvives) {
       context.set_deadline(deadline());
       grpc::Status status;
       std::string method;
-      switch (hostile.Below(7)) {
+      switch (hostile.Below(8)) {
         case 0: {
           method = "PutMap";
           v1::PutMapRequest r;
@@ -260,12 +290,18 @@ TEST(HostileRequestsTest, EveryReplyIsOkOrAClientErrorAndTheServerSurvives) {
           status = stub->Plan(&context, hostile.Plan(good_id), &out);
           break;
         }
-        default: {
+        case 6: {
           method = "GetPlan";
           v1::GetPlanRequest r;
           r.set_plan_id(hostile.Text());
           v1::PlanResponse out;
           status = stub->GetPlan(&context, r, &out);
+          break;
+        }
+        default: {
+          method = "PlanFleet";
+          v1::PlanFleetResponse out;
+          status = stub->PlanFleet(&context, hostile.Fleet(good_id), &out);
           break;
         }
       }
