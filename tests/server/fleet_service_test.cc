@@ -8,6 +8,9 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iostream>
+#include <map>
+#include <random>
 #include <set>
 #include <string>
 
@@ -245,6 +248,61 @@ TEST_F(FleetServiceTest, IdleRobotsGetPlansThatAreNotReplanned) {
   }
   EXPECT_EQ(ids.size(), 24u);
   EXPECT_GT(idle, 0);
+}
+
+// Random plausible fleets on a small inline map (every planner, both
+// divisions, starts anywhere including walls, some battery robots): each is
+// planned or refused as INVALID_ARGUMENT, and a plan covers every cell.
+TEST_F(FleetServiceTest, RandomFleetsArePlannedOrRefusedNeverFailed) {
+  std::mt19937 rng(5);
+  auto uniform = [&rng](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
+  const char* planners[] = {"oarp", "stc", "boustrophedon"};
+  std::map<std::string, int> outcomes;
+  for (int trial = 0; trial < 36; ++trial) {
+    v1::PlanFleetRequest request;
+    *request.mutable_plan()->mutable_map() =
+        testing::RasterMap(testing::AsciiToPgm(testing::TwoRooms(), 4), 0.1);
+    request.mutable_plan()->set_planner(planners[trial % 3]);
+    request.mutable_plan()->set_time_limit_s(0.3);
+    request.mutable_plan()->set_seed(trial);
+    request.set_division(trial % 2 == 0 ? v1::FLEET_DIVISION_MAKESPAN
+                                        : v1::FLEET_DIVISION_EQUAL_AREA);
+    const int k = 1 + static_cast<int>(uniform(0, 5));
+    for (int i = 0; i < k; ++i) {
+      v1::FleetRobot* robot =
+          AddRobot(&request, absl::StrCat("r", i), 0.4, uniform(0, 4.8), uniform(0, 3.2));
+      if (uniform(0, 1) < 0.3) robot->mutable_robot()->clear_start();
+      if (uniform(0, 1) < 0.3) {
+        robot->mutable_robot()->mutable_end()->set_x(uniform(0, 4.8));
+        robot->mutable_robot()->mutable_end()->set_y(uniform(0, 3.2));
+      }
+      if (uniform(0, 1) < 0.2) {
+        robot->mutable_battery()->set_capacity(uniform(5, 40));
+        robot->mutable_battery()->mutable_station()->set_x(0.6);
+        robot->mutable_battery()->mutable_station()->set_y(0.6);
+        robot->set_recharge_s(uniform(0, 100));
+      }
+    }
+    v1::PlanFleetResponse fleet;
+    const grpc::Status status = PlanFleet(request, &fleet);
+    ++outcomes[absl::StrCat(planners[trial % 3], " ", status.error_code())];
+    if (!status.ok()) {
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+          << "trial " << trial << ": " << status.error_message();
+      continue;
+    }
+    ASSERT_EQ(fleet.robots_size(), k) << "trial " << trial;
+    EXPECT_EQ(fleet.covered_cells(), fleet.cover_cells()) << "trial " << trial;
+    std::set<int> together;
+    for (const v1::FleetRobotPlan& robot : fleet.robots()) {
+      const std::set<int> cells = SweptCells(robot.plan());
+      together.insert(cells.begin(), cells.end());
+    }
+    EXPECT_EQ(static_cast<int>(together.size()), fleet.covered_cells()) << "trial " << trial;
+  }
+  for (const auto& [key, n] : outcomes) std::cout << "  " << key << ": " << n << "\n";
 }
 
 TEST_F(FleetServiceTest, BadFleetsAreInvalidArgumentNamingTheField) {
