@@ -190,11 +190,25 @@ TEST(FleetFlags, MakeFleetRequestSharesTheModelAndKeepsEachStart) {
   EXPECT_EQ(request.robots[1].robot.start->theta, 0.5);
   EXPECT_EQ(request.robots[0].robot.tool_width_m, 0.6);
   EXPECT_EQ(request.robots[1].robot.max_speed_mps, 0.7);
-  EXPECT_FALSE(request.robots[0].robot.end.has_value());
+  // Without --end the model's default: back to the robot's own start.
+  EXPECT_FALSE(request.robots[1].robot.end.has_value());
   EXPECT_TRUE(request.Validate().ok());
   base.common.robot.end = Pose2{5, 5, 0};
   request = MakeFleetRequest(base, **flags);
   for (const FleetRobot& r : request.robots) EXPECT_EQ(r.robot.end->x, 5.0);
+  // --robots K: no start (the planner places them), each with the battery.
+  ParsedArgs spread;
+  spread.values["robots"] = "2";
+  absl::StatusOr<std::optional<FleetFlags>> k = ParseFleetFlags(spread);
+  ASSERT_TRUE(k.ok() && k->has_value());
+  base.common.robot.end.reset();
+  base.battery = BatteryOptions();
+  request = MakeFleetRequest(base, **k);
+  ASSERT_EQ(request.robots.size(), 2u);
+  EXPECT_EQ(request.robots[1].id, "r2");
+  EXPECT_FALSE(request.robots[1].robot.start.has_value());
+  EXPECT_FALSE(request.robots[1].robot.end.has_value());
+  EXPECT_TRUE(request.robots[1].battery.has_value());
 
   ParsedArgs none;
   absl::StatusOr<std::optional<FleetFlags>> no_fleet = ParseFleetFlags(none);
