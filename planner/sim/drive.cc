@@ -233,6 +233,7 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
     stoppage = std::max(0.0, compute_s - TimeToFirstEntry(flags));
   }
   r_.stoppage_s += stoppage;
+  clock_s_ += stoppage;
   ++r_.num_replans;
   r_.num_encounters += st.num_encounters;
   r_.num_greedy_detours += static_cast<int>(st.greedy_detours.size());
@@ -244,6 +245,7 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
     Waypoint cut = b;
     cut.x = pos_.x, cut.y = pos_.y;
     drive_s_ += robot_.StraightTime(d_seg_);
+    clock_s_ += robot_.StraightTime(d_seg_) + robot_.TurnTime(HeadingChange(a.theta, b.theta));
     PushDriven(cut);
     junction_ = true;
   }
@@ -314,85 +316,135 @@ absl::Status SimulatedDrive::HandleViolation(CellIndex cell) {
   return DoReplan(ReplanMethod::kGreedyDetour);
 }
 
-absl::StatusOr<SimulationResult> SimulatedDrive::Run() {
+void SimulatedDrive::Start() {
+  started_ = true;
   IndexSweeps();
   r_.planned_duration_s = plan_.plan.stats.estimated_duration_s;
-  const int planned_cycles = static_cast<int>(plan_.plan.cycles.size());
-  const double planned_energy = plan_.plan.stats.energy_total;
-  const double time_cap = options_.max_time_factor * r_.planned_duration_s + 3600.0;
+  planned_cycles_ = static_cast<int>(plan_.plan.cycles.size());
+  planned_energy_ = plan_.plan.stats.energy_total;
+  time_cap_ = options_.max_time_factor * r_.planned_duration_s + 3600.0;
   pos_ = At(path()[0]);
   here_ = grid_.CellAt(pos_);
   r_.driven.push_back(path()[0]);
   Sense();
-  while (r_.completed) {
-    if (!pending_.empty() && !pending_checked_) {
-      if (PendingOnPath()) {
-        if (r_.num_replans >= options_.max_replans) {
-          r_.completed = false;
-          r_.termination = absl::StrFormat("stopped: %d replans", r_.num_replans);
-          break;
-        }
-        RETURN_IF_ERROR(DoReplan(method_));
-        continue;
+}
+
+double SimulatedDrive::clock_s() const {
+  double t = clock_s_;
+  if (started_ && !finished_ && seg_ < static_cast<int>(path().size()) && t_seg_ > 0.0) {
+    t += robot_.TurnTime(HeadingChange(path()[seg_ - 1].theta, path()[seg_].theta)) + t_seg_;
+  }
+  return t;
+}
+
+Pose2 SimulatedDrive::pose() const {
+  if (!started_) return {path()[0].x, path()[0].y, path()[0].theta};
+  const int n = static_cast<int>(path().size());
+  const double theta = seg_ >= n      ? path().back().theta
+                       : t_seg_ > 0.0 ? path()[seg_].theta
+                                      : path()[seg_ - 1].theta;
+  return {pos_.x, pos_.y, theta};
+}
+
+absl::StatusOr<bool> SimulatedDrive::Step(double until_s) {
+  if (!pending_.empty() && !pending_checked_) {
+    if (PendingOnPath()) {
+      if (r_.num_replans >= options_.max_replans) {
+        r_.completed = false;
+        r_.termination = absl::StrFormat("stopped: %d replans", r_.num_replans);
+        return finished_ = true, false;
       }
-      pending_checked_ = true;
-    }
-    if (seg_ >= static_cast<int>(path().size())) break;
-    if (drive_s_ > time_cap) {
-      r_.completed = false;
-      r_.termination = absl::StrFormat("stopped: %.0f s of driving", drive_s_);
-      break;
-    }
-    const Waypoint& a = path()[seg_ - 1];
-    const Waypoint& b = path()[seg_];
-    const double length = Dist(At(a), At(b));
-    const double total = robot_.StraightTime(length);
-    const double t_next = std::min(total, t_seg_ + options_.step_s);
-    const double d_next = t_next >= total ? length : DistanceAt(robot_, length, t_next);
-    // What the move enters: a cell blocked on the true grid is either a candidate not
-    // found yet (touched: the sensor could not see it) or a planning error.
-    const Point2 to = length > 0.0 ? Lerp(At(a), At(b), d_next / length) : At(b);
-    std::optional<CellIndex> touch, violation, last;
-    TraverseCells(grid_, pos_, to, [&](CellIndex c) {
-      last = c;
-      if (c == here_ || !grid_.InBounds(c.row, c.col) || grid_.IsFree(c)) return false;
-      (candidate_[Index(c)] && !found_[Index(c)] ? touch : violation) = c;
+      RETURN_IF_ERROR(DoReplan(method_));
       return true;
-    });
-    if (touch) {
-      ++r_.num_touch_detections;
-      Observe(*touch);
-      continue;
     }
-    if (violation) {
-      RETURN_IF_ERROR(HandleViolation(*violation));
-      if (end_blocked_) break;
-      continue;
+    pending_checked_ = true;
+  }
+  if (seg_ >= static_cast<int>(path().size())) return finished_ = true, false;
+  if (drive_s_ > time_cap_) {
+    r_.completed = false;
+    r_.termination = absl::StrFormat("stopped: %.0f s of driving", drive_s_);
+    return finished_ = true, false;
+  }
+  const Waypoint& a = path()[seg_ - 1];
+  const Waypoint& b = path()[seg_];
+  const double length = Dist(At(a), At(b));
+  const double total = robot_.StraightTime(length);
+  const double turn = robot_.TurnTime(HeadingChange(a.theta, b.theta));
+  // The straight time this segment may reach before the clock passes until_s.
+  const double straight_left = until_s - clock_s_ - turn;
+  if (straight_left <= t_seg_ + 1e-9) return false;
+  const double t_next = std::min({total, t_seg_ + options_.step_s, straight_left});
+  const double d_next = t_next >= total ? length : DistanceAt(robot_, length, t_next);
+  // What the move enters: a cell blocked on the true grid is either a candidate not
+  // found yet (touched: the sensor could not see it) or a planning error.
+  const Point2 to = length > 0.0 ? Lerp(At(a), At(b), d_next / length) : At(b);
+  std::optional<CellIndex> touch, violation, last;
+  TraverseCells(grid_, pos_, to, [&](CellIndex c) {
+    last = c;
+    if (c == here_ || !grid_.InBounds(c.row, c.col) || grid_.IsFree(c)) return false;
+    (candidate_[Index(c)] && !found_[Index(c)] ? touch : violation) = c;
+    return true;
+  });
+  if (touch) {
+    ++r_.num_touch_detections;
+    Observe(*touch);
+    return true;
+  }
+  if (violation) {
+    RETURN_IF_ERROR(HandleViolation(*violation));
+    if (end_blocked_ || !r_.completed) return finished_ = true, false;
+    return true;
+  }
+  if (last) here_ = *last;
+  if (b.kind == SegmentKind::kCoverage && sweep_of_[seg_] >= 0) {
+    const double t = length > 0.0 ? d_next / length : 1.0;
+    for (const CellIndex& c : plan_.plan.sweeps[sweep_of_[seg_]].cells) {
+      if (t >= 1.0 || Param(At(a), At(b), grid_.CellCenter(c)) <= t + 1e-9) swept_[Index(c)] = 1;
     }
-    if (last) here_ = *last;
-    if (b.kind == SegmentKind::kCoverage && sweep_of_[seg_] >= 0) {
-      const double t = length > 0.0 ? d_next / length : 1.0;
-      for (const CellIndex& c : plan_.plan.sweeps[sweep_of_[seg_]].cells) {
-        if (t >= 1.0 || Param(At(a), At(b), grid_.CellCenter(c)) <= t + 1e-9) swept_[Index(c)] = 1;
-      }
-    }
-    t_seg_ = t_next;
-    d_seg_ = d_next;
-    pos_ = to;
-    if (t_next >= total) {
-      drive_s_ += total + robot_.TurnTime(HeadingChange(a.theta, b.theta));
-      PushDriven(b);
-      ++seg_;
-      t_seg_ = d_seg_ = 0.0;
-      pos_ = At(b);
-    }
-    Sense();
+  }
+  t_seg_ = t_next;
+  d_seg_ = d_next;
+  pos_ = to;
+  if (t_next >= total) {
+    drive_s_ += total + turn;
+    clock_s_ += total + turn;
+    PushDriven(b);
+    ++seg_;
+    t_seg_ = d_seg_ = 0.0;
+    pos_ = At(b);
+  }
+  Sense();
+  return true;
+}
+
+absl::Status SimulatedDrive::RunUntil(double until_s) {
+  if (!started_) Start();
+  while (!finished_ && clock_s() < until_s - 1e-9) {
+    ASSIGN_OR_RETURN(const bool more, Step(until_s));
+    if (!more) break;
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SimulationResult> SimulatedDrive::Run() {
+  RETURN_IF_ERROR(RunUntil(std::numeric_limits<double>::infinity()));
+  return Finish();
+}
+
+SimulationResult SimulatedDrive::Finish() {
+  if (!started_) Start();
+  if (!finished_ && d_seg_ > 0.0) {  // stopped mid-segment: the path ends here
+    Waypoint cut = path()[seg_];
+    cut.x = pos_.x, cut.y = pos_.y;
+    PushDriven(cut);
   }
   if (end_blocked_) {
     r_.termination = absl::StrFormat(
         "completed: the end pose (%.3f, %.3f) lies in a blocked cell; stopped next to it at (%.3f, "
         "%.3f)",
         path().back().x, path().back().y, pos_.x, pos_.y);
+  } else if (!finished_) {
+    r_.termination = absl::StrFormat("stopped at %.3f s before the end of the plan", clock_s());
   } else if (r_.completed) {
     r_.termination = "completed: the end of the plan was reached";
   }
@@ -401,12 +453,13 @@ absl::StatusOr<SimulationResult> SimulatedDrive::Run() {
   r_.total_time_s = r_.drive_time_s + r_.stoppage_s;
   if (options_.plan.battery) {
     r_.battery = DriveBattery(r_.driven, *options_.plan.battery, robot_, options_.recharge_s);
-    r_.battery->charge_cycles_planned = planned_cycles;
-    r_.battery->energy_planned = planned_energy;
+    r_.battery->charge_cycles_planned = planned_cycles_;
+    r_.battery->energy_planned = planned_energy_;
     r_.total_time_s += r_.battery->recharge_time_s;
   }
   r_.num_turns = static_cast<int>(s.num_turns);
   r_.path_length_m = s.coverage_length_m + s.transition_length_m;
+  r_.swept = swept_;
   return r_;
 }
 

@@ -10,6 +10,12 @@
 //   ASSIGN_OR_RETURN(SimulationResult r, drive.Run());
 //   drive.swept()  // per cell: swept
 //
+// A run may stop at a given time of its own clock and go on later (a fleet
+// whose robot fails redivides the work at that moment, planner/sim/fleet_simulator.h):
+//
+//   RETURN_IF_ERROR(drive.RunUntil(120.0));  // drive.pose(), drive.swept() at 120 s
+//   if (!drive.finished()) ...;              // RunUntil again, or Finish() to stop here
+//
 // Thread-safety: not thread-safe; one drive per thread (Simulate makes its own).
 #ifndef COVPLAN_PLANNER_SIM_DRIVE_H_
 #define COVPLAN_PLANNER_SIM_DRIVE_H_
@@ -57,8 +63,25 @@ class SimulatedDrive {
   // length_in_obstacles_m). Internal when
   // a replan fails even as a greedy detour. Call once.
   absl::StatusOr<SimulationResult> Run();
+  // Drives on until the run's clock (clock_s) would pass `until_s`, or to the
+  // plan's end (or a bound of the options); a later call drives on from
+  // there. The robot stops mid-segment at exactly `until_s`, or before a
+  // segment whose turn in place would pass it. Errors as Run.
+  absl::Status RunUntil(double until_s);
+  // The plan's end (or a bound) was reached: nothing is left to drive.
+  bool finished() const { return finished_; }
+  // Seconds since the run started: straight moves and turns in place under
+  // the robot model, plus the stoppage of the replans so far.
+  double clock_s() const;
+  // Where the robot stands and the heading it drives or last drove.
+  Pose2 pose() const;
+  // The result so far (as Run's); a run stopped mid-segment ends its driven
+  // path where the robot stands. Call once, after the last RunUntil.
+  SimulationResult Finish();
   // Per cell of the grid: swept by the driven path.
   const std::vector<uint8_t>& swept() const { return swept_; }
+  // Per cell of the grid: found blocked by the sensor (or by touch).
+  const std::vector<uint8_t>& found() const { return found_; }
 
  private:
   const std::vector<Waypoint>& path() const { return plan_.plan.path; }
@@ -75,6 +98,9 @@ class SimulatedDrive {
   absl::Status HandleViolation(CellIndex cell);
   void PushDriven(const Waypoint& w);
   void IndexSweeps();
+  void Start();
+  // One step of the loop: false when the run is over (finished_) or stopped at `until_s`.
+  absl::StatusOr<bool> Step(double until_s);
   // A problem line if `path` enters a cell already given to a replan.
   std::optional<std::string> CrossesReported(const std::vector<Waypoint>& path) const;
 
@@ -101,6 +127,12 @@ class SimulatedDrive {
   bool end_blocked_ = false;  // the plan's end pose lies in a blocked cell
   bool junction_ = false;     // driven.back() is where a replan cut a segment
   double drive_s_ = 0.0;      // rough drive time, for the time bound
+  double clock_s_ = 0.0;      // finished and cut segments (turns included) and stoppage
+  bool started_ = false;
+  bool finished_ = false;
+  int planned_cycles_ = 0;
+  double planned_energy_ = 0.0;
+  double time_cap_ = 0.0;
   int violations_ = 0;
   SimulationResult r_;
 };

@@ -12,6 +12,7 @@
 #include "planner/sim/clutter.h"
 #include "planner/sim/drive.h"
 #include "planner/sim/map_frame.h"
+#include "planner/sim/run_setup.h"
 
 namespace covplan {
 
@@ -40,37 +41,11 @@ absl::Status SimulationOptions::Validate() const {
   return plan.robot.Validate();
 }
 
-namespace {
-// Plans and replans in process.
-class LocalPlanSource final : public PlanSource {
- public:
-  absl::StatusOr<RetainedPlan> InitialPlan(const OccupancyMap& known,
-                                           const PlanOptions& options) override {
-    ASSIGN_OR_RETURN(EngineResult planned, PlanCoverageWithArea(known, options));
-    RetainedPlan retained;
-    retained.plan_id = "simulation";
-    retained.map_id = "known";
-    retained.plan = std::move(planned.plan);
-    retained.request = options.ToRequest();
-    retained.area = std::move(planned.area);
-    return retained;
-  }
-  absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at,
-                                      const Observations& seen,
-                                      const ReplanOptions& options) override {
-    return covplan::Replan(plan, at, seen, options, &estimator_);
-  }
-
- private:
-  ReplanEstimator estimator_;
-};
-}  // namespace
-
 absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const OccupancyMap& truth,
                                           const SimulationOptions& options, PlanSource* source) {
   RETURN_IF_ERROR(options.Validate());
   RETURN_IF_ERROR(sim_internal::CheckSameFrame(known, truth));
-  LocalPlanSource local;
+  sim_internal::LocalPlanSource local;
   if (source == nullptr) source = &local;
   ASSIGN_OR_RETURN(RetainedPlan retained, source->InitialPlan(known, options.plan));
   if (retained.plan.grid == nullptr || retained.plan.path.empty()) {
@@ -79,19 +54,14 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
   // Nothing stands where the robot starts or on its dock (the end pose).
   // Battery runs start and end at the station, which the true map itself
   // must leave free (checked below; the CLI keeps its clutter off it).
-  std::shared_ptr<OccupancyMap> cleared;
-  int64_t cleared_px = 0;
-  for (const Waypoint* w : {&retained.plan.path.front(), &retained.plan.path.back()}) {
-    if (options.plan.battery) break;
-    OccupancyMap probe = cleared != nullptr ? *cleared : truth;
-    const int64_t freed = ClearAround(known, {w->x, w->y}, options.plan.robot.tool_width_m, &probe);
-    if (freed > 0) cleared = std::make_shared<OccupancyMap>(std::move(probe)), cleared_px += freed;
+  std::vector<Point2> clear_at;
+  if (!options.plan.battery) {
+    for (const Waypoint* w : {&retained.plan.path.front(), &retained.plan.path.back()})
+      clear_at.push_back({w->x, w->y});
   }
-  const OccupancyMap& true_map = cleared != nullptr ? *cleared : truth;
-  const GridOptions go = sim_internal::PlanGridOptions(options.plan);
-  ASSIGN_OR_RETURN(GridFrame frame, PlanGridFrame(true_map, go));
-  const std::vector<double> fractions = CellFreeFractions(true_map, frame);
-  ASSIGN_OR_RETURN(Grid true_grid, BuildGridFromFractions(true_map, go, frame, fractions));
+  ASSIGN_OR_RETURN(sim_internal::TrueSite site,
+                   sim_internal::MakeTrueSite(known, truth, clear_at, options.plan));
+  const Grid& true_grid = site.grid;
   if (options.plan.battery) {
     // The robot must be able to dock: nothing the sensor could find there.
     const Pose2& st = options.plan.battery->station;
@@ -102,26 +72,15 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
     }
   }
   const Grid& drive = retained.area != nullptr ? *retained.area->drive : *retained.plan.grid;
-  if (drive.rows() != true_grid.rows() || drive.cols() != true_grid.cols()) {
-    return absl::InternalError("the plan's grid and the true grid differ in shape");
-  }
-  std::vector<uint8_t> candidate(static_cast<size_t>(drive.size()), 0);
-  for (int64_t i = 0; i < drive.size(); ++i) {
-    candidate[i] = drive.free_flags()[i] && !true_grid.free_flags()[i];
-  }
-  sim_internal::SimulatedDrive sim(true_map, true_grid, options, std::move(retained),
+  ASSIGN_OR_RETURN(std::vector<uint8_t> candidate, sim_internal::Candidates(drive, true_grid));
+  sim_internal::SimulatedDrive sim(site.map(), true_grid, options, std::move(retained),
                                    std::move(candidate), source);
   ASSIGN_OR_RETURN(SimulationResult result, sim.Run());
-  result.truth_cleared_px = cleared_px;
-  result.truth_used = cleared;
+  result.truth_cleared_px = site.cleared_px;
+  result.truth_used = site.cleared;
   // Coverage against the true map: its free area inside the swept cells.
-  const int64_t true_free = true_map.CountFree();
-  double swept_free_px = 0.0;
-  for (size_t i = 0; i < sim.swept().size(); ++i) {
-    if (sim.swept()[i]) swept_free_px += fractions[i] * frame.px_per_cell * frame.px_per_cell;
-  }
-  result.covered_free_area_ratio = true_free > 0 ? swept_free_px / true_free : 0.0;
-  result.length_in_obstacles_m = sim_internal::LengthInObstacles(true_map, result.driven);
+  result.covered_free_area_ratio = sim_internal::CoveredFreeAreaRatio(site, sim.swept());
+  result.length_in_obstacles_m = sim_internal::LengthInObstacles(site.map(), result.driven);
   return result;
 }
 

@@ -121,6 +121,8 @@ struct SimulationResult {
   // Replanner errors and paths that entered a cell reported blocked, with
   // the input that caused them; each was worked around by a greedy detour.
   std::vector<std::string> problems;
+  // Per cell of the plan's grid (Grid::Index): swept by the driven path.
+  std::vector<uint8_t> swept;
   bool completed = true;  // false: a bound of SimulationOptions stopped the run
   std::string termination;
   std::optional<BatteryRun> battery;  // battery plans only
