@@ -104,6 +104,17 @@ class BoundInput {
     }
     return best;
   }
+  // Into variant v (= 2u + direction) from robot r's start; out of variant v
+  // to robot r's end (0 without a start or end).
+  double FromStartVariant(int r, int v) const {
+    const std::optional<Pose2>& s = robot(r).start;
+    return s ? Move({s->x, s->y}, s->theta, ends_[v].in, ends_[v].h_in) : 0.0;
+  }
+  double ToEndVariant(int r, int v) const {
+    const std::optional<Pose2>& e = robot(r).end;
+    return e ? fastest_.StraightTime(std::hypot(e->x - ends_[v].out.x, e->y - ends_[v].out.y))
+             : 0.0;
+  }
   double Between(int w, int u) const {
     double best = INFINITY;
     for (int a = 0; a < 2; ++a) {
@@ -197,7 +208,43 @@ std::optional<double> AssignedMoves(const BoundInput& in) {
   return MinAssignmentCost(c, size);
 }
 
-// Units and robots up to which the assignment bound is computed (O(n^3)).
+// The least total cost of the moves of any k paths start_r -> units ->
+// end_r: the moves pair up the units' two ends, the starts and the ends, so
+// they form a perfect matching of those 2n + 2k points (a unit's own two ends
+// never; a start only with a unit or its own robot's end, an idle robot).
+// The minimum-cost perfect matching is a lower bound that, unlike the
+// assignment, keeps each unit driven in one direction.
+std::optional<double> MatchedMoves(const BoundInput& in) {
+  const int n = in.n(), k = in.k(), size = 2 * n + 2 * k;
+  std::vector<double> c(static_cast<size_t>(size) * size, INFINITY);
+  auto set = [&](int a, int b, double v) {
+    c[static_cast<size_t>(a) * size + b] = v;
+    c[static_cast<size_t>(b) * size + a] = v;
+  };
+  // Point 2u + v is unit u's end where variant v enters it (and variant 1 - v
+  // leaves it): leaving there heads along variant 1 - v's exit heading.
+  for (int a = 0; a < 2 * n; ++a) {
+    const End& leave = in.end(a ^ 1);  // the variant that ends at point a
+    for (int b = a + 1; b < 2 * n; ++b) {
+      if (a / 2 == b / 2) continue;
+      const End& enter = in.end(b);
+      set(a, b, in.Move(leave.out, leave.h_out, enter.in, enter.h_in));
+    }
+  }
+  for (int r = 0; r < k; ++r) {
+    const int start = 2 * n + r, end = 2 * n + k + r;
+    for (int a = 0; a < 2 * n; ++a) {
+      set(start, a, in.FromStartVariant(r, a));
+      set(end, a, in.ToEndVariant(r, a ^ 1));
+    }
+    set(start, end, 0.0);  // a robot given nothing
+  }
+  return MinPerfectMatchingCost(c, size);
+}
+
+// Sizes up to which the matching (points) and the assignment (units and
+// robots) bounds are computed: both are O(n^3), Boost's blossoms the slower.
+constexpr int kMaxMatching = 300;
 constexpr int kMaxAssignment = 400;
 
 }  // namespace
@@ -210,7 +257,8 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
   double work = 0.0;
   for (int u = 0; u < n; ++u) work += in.fastest_time(u);
   std::optional<double> moves;
-  if (n + k <= kMaxAssignment) moves = AssignedMoves(in);
+  if (2 * (n + k) <= kMaxMatching) moves = MatchedMoves(in);
+  if (!moves && n + k <= kMaxAssignment) moves = AssignedMoves(in);
   work += moves.has_value() ? *moves : CheapestEntries(in);
   bound.work_s = std::max(0.0, work) / k;
   // Some robot must drive each unit, from its start and back to its end.

@@ -109,7 +109,6 @@ struct FleetSearch {
   std::shared_ptr<const CoverageArea> area;
   const TourUnits& units;
   UnitCosts costs;
-  double lower_bound;
   bool connected;  // STC: each robot's region connected
   absl::Time t0;
   bool time_left = true;
@@ -130,7 +129,6 @@ struct FleetSearch {
     const double limit = std::max(0.05, (budget() - Seconds(t0)) * share / batches);
     const absl::Time start = absl::Now();
     out->division = request.division;
-    out->lower_bound_s = lower_bound;
     RETURN_IF_ERROR(PlanShares(engine, source, request, *area, cells, limit, out));
     FillFleetFigures(request, area->cover_cells, out);
     last_round_s = Seconds(start);
@@ -149,7 +147,9 @@ struct FleetSearch {
     FleetPlan last = *best;  // the plans of `split`
     // The equal-area regions are one more candidate: the makespan division is
     // never worse than the baseline where the tour's pieces are.
-    if (RoundFits()) {
+    // It is planned even when the budget is spent (unless the caller's
+    // deadline passed): one round more, so that the baseline never wins.
+    if (!request.base.common.stop.ShouldStop()) {
       FleetPlan candidate;
       RETURN_IF_ERROR(PlanDivision(Regions(), 0.5, &candidate));
       if (candidate.makespan_s < best->makespan_s) {
@@ -256,12 +256,18 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
   const TourUnits units = UnitsOfPlan(whole->plan, *area->cover);
   ASSIGN_OR_RETURN(UnitCosts costs,
                    UnitCosts::Build(units, *area->drive, request.robots, request.base.common.stop));
-  const double lower_bound = MakespanLowerBound(units, request.robots).value();
+  // The bound needs no plan: it is computed beside the search.
+  double lower_bound = 0.0;
+  std::thread bound_thread(
+      [&] { lower_bound = MakespanLowerBound(units, request.robots).value(); });
 
-  FleetSearch search{engine, source,           request,     area,
-                     units,  std::move(costs), lower_bound, whole->plan.planner == "stc",
-                     t0};
-  RETURN_IF_ERROR(search.Run(&best));
+  FleetSearch search{
+      engine, source, request, area, units, std::move(costs), whole->plan.planner == "stc", t0};
+  const absl::Status searched = search.Run(&best);
+  bound_thread.join();
+  RETURN_IF_ERROR(searched);
+  best.lower_bound_s = lower_bound;
+  best.gap = lower_bound > 0.0 ? best.makespan_s / lower_bound - 1.0 : 0.0;
   best.termination =
       Termination::Converged(absl::StrFormat("%d rebalancing rounds", best.rebalance_rounds));
   for (const FleetRobotPlan& rp : best.robots) {

@@ -43,6 +43,46 @@ TEST(Assignment, MatchesBruteForceOnRandomMatricesWithForbiddenPairs) {
   }
 }
 
+double BruteForceMatching(const std::vector<double>& c, int n, std::vector<int>& used) {
+  int i = 0;
+  while (i < n && used[i]) ++i;
+  if (i == n) return 0.0;
+  used[i] = 1;
+  double best = INFINITY;
+  for (int j = i + 1; j < n; ++j) {
+    if (used[j] || !std::isfinite(c[i * n + j])) continue;
+    used[j] = 1;
+    best = std::min(best, c[i * n + j] + BruteForceMatching(c, n, used));
+    used[j] = 0;
+  }
+  used[i] = 0;
+  return best;
+}
+
+TEST(PerfectMatching, MatchesBruteForceOnRandomGraphsWithMissingEdges) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> cost(0.0, 50.0);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 2 + 2 * (trial % 5);
+    std::vector<double> c(n * n, INFINITY);
+    for (int i = 0; i < n; ++i) {
+      for (int j = i + 1; j < n; ++j) {
+        if (rng() % 4 == 0) continue;
+        c[i * n + j] = c[j * n + i] = std::round(cost(rng) * 1000.0) / 1000.0;
+      }
+    }
+    std::vector<int> used(n, 0);
+    const double want = BruteForceMatching(c, n, used);
+    const std::optional<double> got = MinPerfectMatchingCost(c, n);
+    if (!std::isfinite(want)) {
+      EXPECT_FALSE(got.has_value()) << "trial " << trial;
+    } else {
+      ASSERT_TRUE(got.has_value()) << "trial " << trial;
+      EXPECT_NEAR(*got, want, 1e-5) << "trial " << trial;
+    }
+  }
+}
+
 TEST(EqualArea, RegionsOfAnOpenGridAreEqualConnectedAndCoverEverything) {
   std::vector<uint8_t> free(30 * 40, 1);
   const Grid g(30, 40, 1.0, {0.0, 0.0}, free);
