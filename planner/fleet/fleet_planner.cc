@@ -147,9 +147,9 @@ struct FleetSearch {
     FleetPlan last = *best;  // the plans of `split`
     // The equal-area regions are one more candidate: the makespan division is
     // never worse than the baseline where the tour's pieces are.
-    // It is planned even when the budget is spent (unless the caller's
-    // deadline passed): one round more, so that the baseline never wins.
-    if (!request.base.common.stop.ShouldStop()) {
+    // It may overrun the budget by a quarter (never the caller's deadline),
+    // so that on small sites the baseline never wins.
+    if (!request.base.common.stop.ShouldStop() && Seconds(t0) + last_round_s <= 1.25 * budget()) {
       FleetPlan candidate;
       RETURN_IF_ERROR(PlanDivision(Regions(), 0.5, &candidate));
       if (candidate.makespan_s < best->makespan_s) {

@@ -3,11 +3,11 @@
 # lower bound and the equal-area baseline on the ten IPA buildings in
 # ../shared/data (plain maps, tool 0.8 m), k = 2, 3, 4, 8 robots starting at
 # spread-out places, and the generated warehouse (tool 0.3 m, k = 8).
-#   bash scripts/bench/fleet.sh            # BUDGET=1 TOOL=0.8 ROBOTS=2,3,4,8
+#   bash scripts/bench/fleet.sh            # BUDGET=0.8 TOOL=0.8 ROBOTS=2,3,4,8
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 IPA=${IPA:-../shared/data/maps/ipa}
-BUDGET=${BUDGET:-1}
+BUDGET=${BUDGET:-0.8}
 [ -x build/bin/fleet_bench ] || bash scripts/build.sh >/dev/null
 # The IPA scans mark free space at 0.021 (docs/benchmarks.md, map_bench).
 build/bin/fleet_bench --tool "${TOOL:-0.8}" --budget "$BUDGET" --robots "${ROBOTS:-2,3,4,8}" \
@@ -16,6 +16,6 @@ if [ "${WAREHOUSE:-1}" = 1 ]; then
   out=$(mktemp -d)
   /usr/bin/python3 scripts/maps/gen_warehouse.py warehouse "$out"
   /usr/bin/time -f "warehouse peak RSS %M KiB, %e s" build/bin/fleet_bench --tool 0.3 \
-    --budget "${WAREHOUSE_BUDGET:-8}" --robots 8 "$out/warehouse.yaml"
+    --budget "${WAREHOUSE_BUDGET:-6}" --threads 2 --robots 8 "$out/warehouse.yaml"
   rm -rf "$out"
 fi
