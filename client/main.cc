@@ -24,6 +24,7 @@
 #include "client/plan_command.h"
 #include "client/replan_command.h"
 #include "client/simulate_command.h"
+#include "client/simulate_fleet.h"
 #include "client/simulate_remote.h"
 
 namespace {
@@ -60,7 +61,8 @@ int main(int argc, char** argv) {
   if (command == "load") return covplan::RunLoadCommand(args);
   if (command == "gtsp") return covplan::RunGtspCommand(args);
   if (command == "simulate")
-    return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource);
+    return covplan::RunSimulateCommand(args, &covplan::ConnectServerPlanSource,
+                                       &covplan::FleetSimulation());
   if (command == "compare") return covplan::RunCompareCommand(args);
   if (command == "partition") return covplan::RunPartitionCommand(args);
   if (command == "health") return covplan::RunHealthCommand(args);

@@ -46,6 +46,8 @@ constexpr char kUsage[] =
     "                         [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second "
     "E]\n"
     "                         [--interruptible [--atomic-units ID,ID...]] [--recharge-s S]]\n"
+    "                        [--robot [ID=]X,Y[,THETA]... | --robots K] [--fail-robot ID@S]...\n"
+    "                        [--division makespan|equal_area] [--clearance M] [--out FILE]\n"
     "Plans OARP on KNOWN, drives the plan through the true map (TRUE, or KNOWN with\n"
     "random rotated rectangles over PCT % of its free area, placed with --seed) with a\n"
     "radial line-of-sight sensor (default 5.6 m), replans with --method (default auto)\n"
@@ -85,7 +87,15 @@ constexpr char kUsage[] =
     "cycles are not re-split, so a detour that makes a cycle too long shows in those\n"
     "figures. Clutter never covers the station (its surroundings within a tool width\n"
     "are kept as in KNOWN); the offline bounds include recharge-s per charge cycle.\n"
-    "Battery runs are local only (not with --server).\n";
+    "Battery runs are local only (not with --server).\n"
+    "Fleets (local only, no battery): --robot [ID=]X,Y[,THETA] (repeatable) or --robots K\n"
+    "plan K robots as `covplan plan` does (--division, --clearance); each drives its share\n"
+    "through the true map, sensing and replanning as one robot does. --fail-robot\n"
+    "ID@SECONDS (repeatable) stops that robot for good at that simulated time; what nobody\n"
+    "has swept then is planned again among the survivors from where they stand. Prints per\n"
+    "robot its swept cells and finish time, the makespan, each redivision's estimated\n"
+    "makespan against the one achieved, and the reachable cells left unswept; --out writes\n"
+    "them as JSON, --svg the driven paths (one colour per robot) on the true map.\n";
 
 std::string JsonNumber(double v) { return std::isfinite(v) ? absl::StrFormat("%.6f", v) : "null"; }
 
@@ -404,10 +414,15 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
 }  // namespace
 
 absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
-                                                const RemotePlanSourceFactory& make_remote) {
-  ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, WithConnectionFlags(SimulateValueFlags()),
-                                           {"local", "negate", "clutter-may-disconnect",
-                                            "no-offline-bound", "interruptible"}));
+                                                const RemotePlanSourceFactory& make_remote,
+                                                const FleetSimulateHook* fleet) {
+  std::set<std::string> value_flags = WithConnectionFlags(SimulateValueFlags());
+  if (fleet != nullptr) value_flags.insert(fleet->value_flags.begin(), fleet->value_flags.end());
+  ASSIGN_OR_RETURN(
+      ParsedArgs a,
+      ParseArgs(args, value_flags,
+                {"local", "negate", "clutter-may-disconnect", "no-offline-bound", "interruptible"},
+                fleet != nullptr ? fleet->repeatable_flags : std::set<std::string>()));
   if (a.Get("server") && a.Has("local"))
     return absl::InvalidArgumentError("give --local or --server, not both");
   if (a.Get("server") && a.Get("server")->empty())
@@ -431,6 +446,12 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   ASSIGN_OR_RETURN(OccupancyMap known, LoadMapFile(*a.Get("map"), load));
   ASSIGN_OR_RETURN(TrueMap true_map, LoadTrueMap(a, known, load, o));
   OccupancyMap& truth = true_map.map;
+  if (fleet != nullptr && fleet->wanted(a)) {
+    if (a.Get("server")) return absl::InvalidArgumentError("fleet simulations are local only");
+    if (o.plan.battery)
+      return absl::InvalidArgumentError("--battery-capacity: fleet simulations take no battery");
+    return fleet->run(a, known, truth, true_map.name, o);
+  }
   std::unique_ptr<PlanSource> remote;
   if (auto server = a.Get("server")) {
     if (!make_remote) return absl::InvalidArgumentError("--server is not available in this build");
@@ -467,21 +488,24 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
 namespace {
 
 const RemotePlanSourceFactory* g_remote = nullptr;
+const FleetSimulateHook* g_fleet = nullptr;
 
 absl::Status Run(const std::vector<std::string>& args) {
   ASSIGN_OR_RETURN(std::string json,
-                   SimulateCommandJson(args, g_remote != nullptr ? *g_remote : nullptr));
+                   SimulateCommandJson(args, g_remote != nullptr ? *g_remote : nullptr, g_fleet));
   std::printf("%s\n", json.c_str());
   return absl::OkStatus();
 }
 
 }  // namespace
 
-int RunSimulateCommand(const std::vector<std::string>& args,
-                       const RemotePlanSourceFactory& remote) {
+int RunSimulateCommand(const std::vector<std::string>& args, const RemotePlanSourceFactory& remote,
+                       const FleetSimulateHook* fleet) {
   g_remote = &remote;
+  g_fleet = fleet;
   const int rc = RunSubcommand("simulate", kUsage, args, &Run);
   g_remote = nullptr;
+  g_fleet = nullptr;
   return rc;
 }
 

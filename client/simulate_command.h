@@ -18,11 +18,14 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "client/args.h"
 #include "client/connection.h"
+#include "planner/grid/occupancy_map.h"
 #include "planner/sim/simulator.h"
 
 namespace covplan {
@@ -40,15 +43,32 @@ using RemotePlanSourceFactory = std::function<absl::StatusOr<std::unique_ptr<Pla
     const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
     const SimulationOptions& options)>;
 
+// A fleet of simulated robots (--robot ... or --robots K, --fail-robot ...):
+// the flags it adds to `covplan simulate`, whether the parsed flags ask for
+// a fleet, and the run, given the maps and the single-robot options
+// simulate parsed; `run` returns the text to print. The covplan binary
+// passes client/simulate_fleet.h's; without one the fleet flags are unknown.
+struct FleetSimulateHook {
+  std::set<std::string> value_flags, repeatable_flags;
+  std::function<bool(const ParsedArgs&)> wanted;
+  std::function<absl::StatusOr<std::string>(
+      const ParsedArgs& args, const OccupancyMap& known, const OccupancyMap& truth,
+      const std::string& truth_name, const SimulationOptions& options)>
+      run;
+};
+
 // Returns the process exit code; the JSON goes to stdout, errors to stderr.
 int RunSimulateCommand(const std::vector<std::string>& args,
-                       const RemotePlanSourceFactory& remote = nullptr);
+                       const RemotePlanSourceFactory& remote = nullptr,
+                       const FleetSimulateHook* fleet = nullptr);
 
 // Parses the flags, runs the simulation and the offline lower bound, writes
-// --svg if asked, and returns the JSON object RunSimulateCommand prints.
-// InvalidArgument for bad flags or maps.
+// --svg if asked, and returns the JSON object RunSimulateCommand prints (with
+// `fleet` and fleet flags: what fleet->run returns). InvalidArgument for bad
+// flags or maps.
 absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& args,
-                                                const RemotePlanSourceFactory& remote = nullptr);
+                                                const RemotePlanSourceFactory& remote = nullptr,
+                                                const FleetSimulateHook* fleet = nullptr);
 
 }  // namespace covplan
 

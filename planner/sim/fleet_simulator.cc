@@ -293,6 +293,7 @@ void FleetRun::Measure() {
       r.completed &= leg.completed;
       for (const std::string& p : leg.problems) r.problems.push_back(run.id + ": " + p);
     }
+    run.swept = s->swept;
     run.swept_cells = std::count(s->swept.begin(), s->swept.end(), 1);
     run.length_in_obstacles_m = sim_internal::LengthInObstacles(site_.map(), run.driven);
     r.length_in_obstacles_m += run.length_in_obstacles_m;

@@ -73,8 +73,9 @@ struct FleetRobotRun {
   std::vector<FleetLeg> legs;    // in time order; empty for a robot given nothing at all
   std::vector<Waypoint> driven;  // every leg's driven path, joined
   bool failed = false;
-  double finish_s = 0.0;    // when it stopped for good (its end, or its failure)
-  int64_t swept_cells = 0;  // distinct cells it swept
+  double finish_s = 0.0;       // when it stopped for good (its end, or its failure)
+  std::vector<uint8_t> swept;  // per cell (Grid::Index): swept by this robot
+  int64_t swept_cells = 0;     // distinct cells it swept
   int num_replans = 0;
   double stoppage_s = 0.0;
   double length_in_obstacles_m = 0.0;
