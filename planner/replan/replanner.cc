@@ -172,6 +172,16 @@ const char* ReplanMethodName(ReplanMethod m) {
   return "unknown";
 }
 
+absl::StatusOr<ReplanResult> Remaining(const RetainedPlan& old, const RobotProgress& progress,
+                                       const Observations& observations) {
+  if (old.area == nullptr || old.area->drive == nullptr) {
+    return absl::FailedPreconditionError("the plan has no coverage area to continue from");
+  }
+  ReplanResult out;
+  RETURN_IF_ERROR(replan_internal::ComputeRemainder(old, progress, observations, &out).status());
+  return out;
+}
+
 absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress& progress,
                                     const Observations& observations, const ReplanOptions& options,
                                     ReplanEstimator* estimator) {

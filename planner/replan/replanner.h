@@ -121,6 +121,17 @@ absl::StatusOr<ReplanResult> Replan(const RetainedPlan& old, const RobotProgress
                                     const Observations& observations, const ReplanOptions& options,
                                     ReplanEstimator* estimator);
 
+// What is left of `old` with the robot at `progress` and the obstacles in
+// `observations`, without planning: `area` (the drive grid less the
+// obstacles, cut to the robot's component, and as its cover grid the cells
+// still to sweep that the robot can reach), `unreachable` (cells to cover cut
+// off) and the stats that describe the remainder. For any planner's plan with
+// its coverage area (FailedPrecondition without one); InvalidArgument as
+// Replan for malformed progress or observations. Fleets redivide what is
+// left of several robots' plans from it (planner/fleet/mission.h).
+absl::StatusOr<ReplanResult> Remaining(const RetainedPlan& old, const RobotProgress& progress,
+                                       const Observations& observations);
+
 // The checks Replan applies to `observations` on a plan of `grid`'s size
 // (cells inside the grid, finite points, valid polygons), without planning.
 absl::Status ValidateObservations(const Grid& grid, const Observations& observations);

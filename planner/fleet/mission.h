@@ -1,0 +1,63 @@
+// Redividing a fleet mission while the robots drive: a robot stopped for
+// good (breakdown, called away, battery dead) hands what it has left to the
+// others; a robot that joins takes a share. What is left is every robot's
+// remainder (planner/replan's Remaining: the cells of its current plan still
+// to sweep, from its progress); the active robots are planned over it as a
+// fleet (PlanFleet with a cover mask), each from where it stands now to its
+// own end pose.
+//
+//   std::vector<MissionRobot> robots = ...;  // current plans, progress, poses
+//   robots[1].active = false;                // robot 1 broke down
+//   ASSIGN_OR_RETURN(MissionRedivision r, RedivideMission(engine, source, base, robots, options));
+//   r.plan.robots[i] is the new plan of r.robot_ids[i]
+//
+// Thread-safety: reentrant; thread-safe when the engine is.
+#ifndef COVPLAN_PLANNER_FLEET_MISSION_H_
+#define COVPLAN_PLANNER_FLEET_MISSION_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "planner/fleet/fleet_request.h"
+#include "planner/replan/replanner.h"
+
+namespace covplan {
+
+struct MissionRobot {
+  FleetRobot robot;  // id, model (its end pose, speeds), battery
+  // Its current plan (with its coverage area); null for a robot joining now.
+  std::shared_ptr<const RetainedPlan> plan;
+  RobotProgress progress;  // where it is on `plan` (waypoint -1: not started)
+  // Where it stands now: the start of its new plan. Unset: the progress's
+  // position, else its plan's start (required for a robot without a plan).
+  std::optional<Pose2> pose;
+  bool active = true;  // false: stopped for good; its remainder goes to the others
+};
+
+struct MissionOptions {
+  FleetDivision division = FleetDivision::kMakespan;
+  double clearance_m = 0.0;
+};
+
+struct MissionRedivision {
+  FleetPlan plan;                      // the active robots' new plans
+  std::vector<std::string> robot_ids;  // robot of plan.robots[i], in the order given
+  int64_t remaining_cells = 0;         // cells left to cover over the whole mission
+  int64_t handed_over_cells = 0;       // of those, left by robots stopped for good
+  int64_t cut_off_cells = 0;           // cells of plans no robot can reach any more
+};
+
+// InvalidArgument naming the robot ("robots[2] ('c'): ...") for malformed
+// progress, a robot without plan or pose, or no active robot while cells are
+// left.
+absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
+                                                  const MapSource& source, const PlanRequest& base,
+                                                  const std::vector<MissionRobot>& robots,
+                                                  const MissionOptions& options);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_PLANNER_FLEET_MISSION_H_
