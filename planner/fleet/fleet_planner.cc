@@ -206,6 +206,8 @@ void FillFleetFigures(const FleetRequest& request, int64_t cover_cells, FleetPla
           swept[p.grid->Index(c.row, c.col)] = 1;
       }
     }
+    // A robot with no path (idle, placed nowhere) is nowhere on the site.
+    if (p.path.empty()) continue;
     ids.push_back(rp.id);
     paths.emplace_back(p.path, request.robots[i].robot, p.cycles, request.robots[i].recharge_s);
   }

@@ -3,8 +3,9 @@
 // speed profile; a battery robot waits recharge_s at the station between
 // cycles; a robot that has finished stays at its last waypoint). The report
 // samples every pair's distance and gives the closest approach and each
-// interval during which a pair is closer than the clearance. Avoidance is not
-// planned: this says where the timed plans would meet.
+// interval during which a pair is closer than the clearance. A robot with
+// no path (idle, without a start) stands nowhere and is not in the report.
+// Avoidance is not planned: this says where the timed plans would meet.
 //
 // Thread-safety: reentrant.
 #ifndef COVPLAN_PLANNER_FLEET_SAFETY_H_
