@@ -1,7 +1,8 @@
 // The PlanFleet RPC in process: two robots on the shipped office map get
 // two retained plans (GetPlan returns them, Replan continues one, and after
 // a restart the stored ones are found again) that together sweep every cell
-// the single-robot Plan sweeps; more robots than work on an inline map
+// the single-robot Plan sweeps, a Drive session continues one, the mission
+// is kept; more robots than work on an inline map
 // leaves some idle, whose plans are retained but not replanned; bad fleets
 // are INVALID_ARGUMENT naming the field.
 #include <grpcpp/grpcpp.h>
@@ -10,9 +11,11 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -189,6 +192,44 @@ TEST_F(FleetServiceTest, TwoRobotsGetRetainedPlansThatCoverWhatOnePlanCovers) {
   // Nothing of the other robot's share was added to it.
   const std::set<int> own = SweptCells(b);
   for (int cell : SweptCells(replanned.plan())) EXPECT_TRUE(own.count(cell)) << cell;
+}
+
+TEST_F(FleetServiceTest, TheMissionIsKeptAndARobotPlanIsDriven) {
+  v1::PlanFleetResponse fleet;
+  grpc::Status status = PlanFleet(TwoRobots(), &fleet);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::optional<FleetMission> mission = server_->service().missions().Get(fleet.mission_id());
+  ASSERT_TRUE(mission.has_value());
+  EXPECT_EQ(mission->map_id, map_id_);
+  EXPECT_EQ(mission->robot_ids, (std::vector<std::string>{"west", "east"}));
+  EXPECT_EQ(mission->plan_ids, (std::vector<std::string>{fleet.robots(0).plan().plan_id(),
+                                                         fleet.robots(1).plan().plan_id()}));
+
+  // A Drive session on the west robot's plan: an observation gets a new plan.
+  const v1::PlanResponse& plan = fleet.robots(0).plan();
+  grpc::ClientContext context;
+  std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> stream =
+      stub_->Drive(&context);
+  v1::DriveRequest first;
+  first.set_plan_id(plan.plan_id());
+  first.set_sequence(1);
+  ASSERT_TRUE(stream->Write(first));
+  v1::DriveEvent event;
+  ASSERT_TRUE(stream->Read(&event));
+  ASSERT_TRUE(event.has_ready()) << event.DebugString();
+  const v1::ReplanRequest seen = ObstacleAhead(plan);
+  v1::DriveRequest observation;
+  observation.set_sequence(2);
+  *observation.mutable_progress() = seen.progress();
+  *observation.mutable_obstacles() = seen.obstacles();
+  ASSERT_TRUE(stream->Write(observation));
+  ASSERT_TRUE(stream->Read(&event));
+  ASSERT_TRUE(event.has_replan()) << event.DebugString();
+  EXPECT_EQ(event.sequence(), 2u);
+  EXPECT_EQ(static_cast<int>(SweptCells(event.replan().plan()).size()),
+            event.replan().replan().remaining_cells());
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
 }
 
 TEST_F(FleetServiceTest, StoredRobotPlansAreReplannedAfterARestart) {
