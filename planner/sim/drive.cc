@@ -180,9 +180,23 @@ RobotProgress SimulatedDrive::Progress() const {
   return at;
 }
 
+void SimulatedDrive::SweepTo(double d) {
+  const Waypoint& a = path()[seg_ - 1];
+  const Waypoint& b = path()[seg_];
+  if (b.kind != SegmentKind::kCoverage || sweep_of_[seg_] < 0) return;
+  const double length = Dist(At(a), At(b));
+  const double t = length > 0.0 ? d / length : 1.0;
+  for (const CellIndex& c : plan_.plan.sweeps[sweep_of_[seg_]].cells) {
+    if (t >= 1.0 || Param(At(a), At(b), grid_.CellCenter(c)) <= t + 1e-9) swept_[Index(c)] = 1;
+  }
+}
+
 absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   const Waypoint& a = path()[seg_ - 1];
   const Waypoint& b = path()[seg_];
+  // The replan takes what the tool covers where the robot stands as swept
+  // (on a coverage segment's first cell, before any step: its start).
+  SweepTo(d_seg_);
   const bool mid_segment = d_seg_ > 0.0 && d_seg_ < Dist(At(a), At(b));
   const RobotProgress at = Progress();
   pos_ = *at.position;
@@ -396,12 +410,7 @@ absl::StatusOr<bool> SimulatedDrive::Step(double until_s) {
     return true;
   }
   if (last) here_ = *last;
-  if (b.kind == SegmentKind::kCoverage && sweep_of_[seg_] >= 0) {
-    const double t = length > 0.0 ? d_next / length : 1.0;
-    for (const CellIndex& c : plan_.plan.sweeps[sweep_of_[seg_]].cells) {
-      if (t >= 1.0 || Param(At(a), At(b), grid_.CellCenter(c)) <= t + 1e-9) swept_[Index(c)] = 1;
-    }
-  }
+  SweepTo(d_next);
   t_seg_ = t_next;
   d_seg_ = d_next;
   pos_ = to;

@@ -98,6 +98,9 @@ class SimulatedDrive {
   absl::Status HandleViolation(CellIndex cell);
   void PushDriven(const Waypoint& w);
   void IndexSweeps();
+  // Marks the cells of the coverage segment being driven that the tool has
+  // swept `d` metres into it (its centre at or behind the robot).
+  void SweepTo(double d);
   void Start();
   // One step of the loop: false when the run is over (finished_) or stopped at `until_s`.
   absl::StatusOr<bool> Step(double until_s);
