@@ -101,19 +101,24 @@ std::string ResultJson(const FleetSimulationResult& r, const ParsedArgs& a,
   for (const FleetRobotRun& run : r.robots) robots.push_back(RobotJson(run));
   for (const FleetRedivision& d : r.redivisions) redivisions.push_back(RedivisionJson(d));
   for (const std::string& p : r.problems) problems.push_back(JsonString(p));
+  std::vector<std::string> unswept;
+  for (const CellIndex& c : r.unswept_reachable)
+    unswept.push_back(absl::StrFormat("[%d, %d]", c.row, c.col));
   return absl::StrFormat(
       "{\n  \"map\": %s,\n  \"true_map\": %s,\n  \"planner\": %s,\n  \"method\": %s,\n"
       "  \"planned_makespan_s\": %s,\n  \"makespan_s\": %s,\n  \"mission_cells\": %d,\n"
       "  \"swept_cells\": %d,\n  \"reachable_cells\": %d,\n  \"unswept_reachable_cells\": %d,\n"
+      "  \"unswept_reachable\": [%s],\n"
       "  \"covered_free_area_ratio\": %s,\n  \"length_in_obstacles_m\": %s,\n"
       "  \"completed\": %s,\n  \"problems\": [%s],\n  \"redivisions\": [\n%s\n  ],\n"
       "  \"robots\": [\n%s\n  ]\n}\n",
       JsonString(a.Get("map").value_or("")), JsonString(truth_name), JsonString(o.plan.planner),
       JsonString(ReplanMethodName(o.method)), Number(r.initial.makespan_s), Number(r.makespan_s),
       r.mission_cells, r.swept_cells, r.reachable_cells, r.unswept_reachable_cells,
-      Number(r.covered_free_area_ratio), Number(r.length_in_obstacles_m),
-      r.completed ? "true" : "false", absl::StrJoin(problems, ", "),
-      absl::StrJoin(redivisions, ",\n"), absl::StrJoin(robots, ",\n"));
+      absl::StrJoin(unswept, ", "), Number(r.covered_free_area_ratio),
+      Number(r.length_in_obstacles_m), r.completed ? "true" : "false",
+      absl::StrJoin(problems, ", "), absl::StrJoin(redivisions, ",\n"),
+      absl::StrJoin(robots, ",\n"));
 }
 
 // The driven paths on the true map, each robot's swept cells tinted.

@@ -325,7 +325,9 @@ void FleetRun::Measure() {
   for (size_t c = 0; c < comp.size(); ++c) {
     if (!mission_->cover->free_flags()[c] || comp[c] < 0 || !start_comp[comp[c]]) continue;
     ++r.reachable_cells;
-    r.unswept_reachable_cells += !r.swept[c];
+    if (r.swept[c]) continue;
+    ++r.unswept_reachable_cells;
+    r.unswept_reachable.push_back(site_.grid.FromIndex(static_cast<int64_t>(c)));
   }
   for (const auto& s : robots_) r.robots.push_back(std::move(s->run));
 }

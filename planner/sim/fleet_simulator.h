@@ -106,11 +106,12 @@ struct FleetSimulationResult {
   // robot's start, and of these the ones nobody swept (0 when all went well).
   int64_t reachable_cells = 0;
   int64_t unswept_reachable_cells = 0;
-  std::vector<uint8_t> swept;            // per cell: swept by some robot
-  double covered_free_area_ratio = 0.0;  // of the true map's free area
-  double length_in_obstacles_m = 0.0;    // summed over the robots
-  std::vector<std::string> problems;     // every leg's, prefixed with the robot's id
-  bool completed = true;                 // false: a bound of the options stopped a leg
+  std::vector<CellIndex> unswept_reachable;  // those cells
+  std::vector<uint8_t> swept;                // per cell: swept by some robot
+  double covered_free_area_ratio = 0.0;      // of the true map's free area
+  double length_in_obstacles_m = 0.0;        // summed over the robots
+  std::vector<std::string> problems;         // every leg's, prefixed with the robot's id
+  bool completed = true;                     // false: a bound of the options stopped a leg
   // The true map the robots drove when clearing their start and end poses
   // changed it (see SimulationResult::truth_used), else null.
   std::shared_ptr<const OccupancyMap> truth_used;
