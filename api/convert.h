@@ -104,6 +104,9 @@ absl::StatusOr<RetainedPlan> RetainedPlanFromInline(const v1::InlinePlan& plan,
 // Canonical protobuf JSON, snake_case field names, primitive fields always
 // printed, indented. This is the CLI's plan.json.
 absl::StatusOr<std::string> PlanToJson(const v1::PlanResponse& response);
+// Any message in protobuf's JSON mapping as PlanToJson prints a plan (field
+// names as in the proto, defaults printed), e.g. a PlanFleetResponse.
+absl::StatusOr<std::string> ProtoToJson(const google::protobuf::Message& message);
 
 v1::MapInfo MapInfoFor(const OccupancyMap& map, const std::string& map_id);
 v1::MapInfo MapInfoFor(const SiteMap& site, const std::string& map_id);

@@ -480,6 +480,10 @@ absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {
 }
 
 absl::StatusOr<std::string> PlanToJson(const v1::PlanResponse& response) {
+  return ProtoToJson(response);
+}
+
+absl::StatusOr<std::string> ProtoToJson(const google::protobuf::Message& response) {
   google::protobuf::util::JsonPrintOptions options;
   options.add_whitespace = true;
   options.always_print_primitive_fields = true;
@@ -487,7 +491,8 @@ absl::StatusOr<std::string> PlanToJson(const v1::PlanResponse& response) {
   std::string json;
   const auto status = google::protobuf::util::MessageToJsonString(response, &json, options);
   if (!status.ok()) {
-    return absl::InternalError(absl::StrCat("cannot print plan as JSON: ", status.ToString()));
+    return absl::InternalError(
+        absl::StrCat("cannot print ", response.GetTypeName(), " as JSON: ", status.ToString()));
   }
   return json;
 }

@@ -12,7 +12,9 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "api/convert.h"
+#include "api/convert_fleet.h"
 #include "client/local_engine.h"
+#include "client/remote.h"
 #include "planner/common/status_macros.h"
 #include "planner/fleet/fleet_planner.h"
 #include "planner/plan/fleet_svg.h"
@@ -302,6 +304,54 @@ absl::Status RunLocalFleet(const v1::PlanRequest& request, const FleetFlags& fla
     RETURN_IF_ERROR(WriteTextFile(*options.svg, FleetToSvg(run, site.raster.get(), zones)));
   }
   return absl::OkStatus();
+}
+
+namespace {
+
+// Writes the summary, --out and --svg of a fleet plan.
+absl::Status WriteFleetRun(const LocalFleetRun& run, const v1::PlanRequest& request,
+                           const EngineLimits& limits, const FleetRunOptions& options,
+                           const std::string& json) {
+  if (options.out) RETURN_IF_ERROR(WriteTextFile(*options.out, json));
+  if (options.svg) {
+    ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), limits));
+    SvgZones zones;
+    zones.regions = PolygonsFromProto(request.regions());
+    zones.no_go = PolygonsFromProto(request.no_go());
+    RETURN_IF_ERROR(WriteTextFile(*options.svg, FleetToSvg(run, site.raster.get(), zones)));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status RunRemoteFleet(const Connection& server, const v1::PlanRequest& request,
+                            const FleetFlags& flags, const EngineLimits& limits,
+                            const FleetRunOptions& options, std::optional<absl::Duration> timeout) {
+  if (!request.has_map()) return absl::InvalidArgumentError("the fleet's map must be inline");
+  ASSIGN_OR_RETURN(PlanRequest base, PlanRequestFromProto(request));
+  LocalFleetRun run;
+  run.request = MakeFleetRequest(base, flags);
+  std::unique_ptr<RemotePlanner> remote = RemotePlanner::Connect(server);
+  v1::PutMapRequest put;
+  *put.mutable_map() = request.map();
+  put.set_name(options.map_path);
+  absl::StatusOr<v1::PutMapResponse> stored = remote->PutMap(put, absl::Seconds(60));
+  if (!stored.ok())
+    return absl::Status(stored.status().code(), ServerError(server.target, stored.status()));
+  v1::PlanRequest by_id = request;
+  by_id.set_map_id(stored->map_id());
+  v1::PlanFleetRequest fleet_request;
+  FleetRequestToProto(run.request, by_id, &fleet_request);
+  absl::StatusOr<v1::PlanFleetResponse> response = remote->PlanFleet(fleet_request, timeout);
+  if (!response.ok())
+    return absl::Status(response.status().code(), ServerError(server.target, response.status()));
+  ASSIGN_OR_RETURN(run.plan, FleetPlanFromProto(*response));
+  run.map_id = stored->map_id();
+  std::fputs(FormatFleetSummary(run.request, run.plan).c_str(), stdout);
+  std::printf("mission    %s\n", response->mission_id().c_str());
+  ASSIGN_OR_RETURN(std::string json, ProtoToJson(*response));
+  return WriteFleetRun(run, request, limits, options, json);
 }
 
 }  // namespace covplan

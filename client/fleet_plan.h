@@ -1,6 +1,7 @@
-// `covplan plan --local --robot ... --robot ...` (or `--robots K`): several
-// robots on one site, planned in this process by PlanFleet
-// (planner/fleet/fleet_planner.h) on the CLI's LocalEngine. The plan flags
+// `covplan plan --robot ... --robot ...` (or `--robots K`): several robots
+// on one site, planned by PlanFleet (planner/fleet/fleet_planner.h): with
+// --local in this process on the CLI's LocalEngine, else by a server's
+// PlanFleet RPC. The plan flags
 // give the site, the planner and its options, the budget and the robot model
 // every robot shares (tool width, speed, acceleration, turn rate, --end,
 // battery); each --robot gives one robot's id and start pose.
@@ -24,7 +25,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "client/args.h"
+#include "client/connection.h"
 #include "covplan/v1/covplan.pb.h"
 #include "planner/engine/engine.h"
 #include "planner/fleet/fleet_request.h"
@@ -91,6 +94,15 @@ struct FleetRunOptions {
 };
 absl::Status RunLocalFleet(const v1::PlanRequest& request, const FleetFlags& flags,
                            const EngineLimits& limits, const FleetRunOptions& options);
+
+// The same through a server: stores the map (PutMap), calls PlanFleet,
+// prints the summary with the mission id, writes --out as the server's
+// PlanFleetResponse in protobuf's JSON mapping (the mission id and each
+// robot's plan_id, which Replan, Drive, Resume and GetPlan take) and --svg.
+// `request` carries the map inline.
+absl::Status RunRemoteFleet(const Connection& server, const v1::PlanRequest& request,
+                            const FleetFlags& flags, const EngineLimits& limits,
+                            const FleetRunOptions& options, std::optional<absl::Duration> timeout);
 
 }  // namespace covplan
 

@@ -62,7 +62,7 @@ constexpr char kUsage[] =
     "                    [--battery-capacity E --station X,Y[,THETA] [--reserve E]\n"
     "                     [--energy-per-metre E] [--energy-per-turn E] [--energy-per-second E]\n"
     "                     [--interruptible [--atomic-units ID,ID...]]]\n"
-    "                    [--robot [ID=]X,Y[,THETA]]... | [--robots K]   (a fleet; --local)\n"
+    "                    [--robot [ID=]X,Y[,THETA]]... | [--robots K]   (a fleet)\n"
     "                    [--division makespan|equal_area] [--clearance M]\n"
     "--algorithm is another name for --planner. The --stc-* flags and --sweep-direction\n"
     "set the stc planner's options (--sweep-direction: the prim tree only).\n"
@@ -114,11 +114,6 @@ absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pos
   return absl::OkStatus();
 }
 
-std::string ServerError(const std::string& target, const absl::Status& status) {
-  return absl::StrCat("server ", target, " replied ", absl::StatusCodeToString(status.code()), ": ",
-                      status.message());
-}
-
 // --region / --no-go: a GeoJSON file, or "x,y x,y x,y ..." (one ring, closed
 // here if open).
 absl::Status ParseArea(const std::string& flag, const std::string& text,
@@ -164,7 +159,7 @@ struct PlanCommand {
   std::optional<int64_t> deadline_ms;
   int threads = 1;                        // --local only
   std::optional<GtspEffort> tour_effort;  // --local only
-  std::optional<FleetFlags> fleet;        // --robot / --robots: a fleet plan (--local only)
+  std::optional<FleetFlags> fleet;        // --robot / --robots: a fleet plan
 };
 
 // The value flags `covplan plan` accepts, besides the connection flags.
@@ -341,15 +336,11 @@ absl::Status ParseSolverFlags(const ParsedArgs& a, v1::PlanRequest* r) {
   return absl::OkStatus();
 }
 
-// --robot / --robots and the fleet flags (fleet_plan.h): --local only, and
-// each robot's start comes from its --robot, not --start.
+// --robot / --robots and the fleet flags (fleet_plan.h): each robot's start
+// comes from its --robot, not --start.
 absl::Status ParseFleetPlanFlags(const ParsedArgs& a, PlanCommand* c) {
   ASSIGN_OR_RETURN(c->fleet, ParseFleetFlags(a));
   if (!c->fleet) return absl::OkStatus();
-  if (!c->local) {
-    return absl::InvalidArgumentError(
-        "--robot and --robots plan a fleet in this process: they need --local");
-  }
   if (a.Get("start")) {
     return absl::InvalidArgumentError(
         "--start is the single robot's start: give each robot's start with --robot "
@@ -452,8 +443,11 @@ absl::Status Run(const std::vector<std::string>& args) {
   if (c.fleet) {
     v1::PlanRequest request = c.request;
     *request.mutable_map() = map;
-    return RunLocalFleet(request, *c.fleet, limits,
-                         {c.map_path, c.out, c.svg, c.threads, c.tour_effort});
+    const FleetRunOptions options{c.map_path, c.out, c.svg, c.threads, c.tour_effort};
+    if (c.local) return RunLocalFleet(request, *c.fleet, limits, options);
+    std::optional<absl::Duration> timeout;
+    if (c.deadline_ms) timeout = absl::Milliseconds(*c.deadline_ms);
+    return RunRemoteFleet(c.server, request, *c.fleet, limits, options, timeout);
   }
   ASSIGN_OR_RETURN(v1::PlanResponse response, Execute(c, map, limits));
   std::fputs(FormatPlanSummary(response).c_str(), stdout);

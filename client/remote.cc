@@ -187,6 +187,17 @@ absl::StatusOr<v1::ReplanResponse> RemotePlanner::Replan(const v1::ReplanRequest
                    request.has_plan() ? RoutingMapId(request.plan().request()) : map_id);
 }
 
+std::string ServerError(const std::string& target, const absl::Status& status) {
+  return absl::StrCat("server ", target, " replied ", absl::StatusCodeToString(status.code()), ": ",
+                      status.message());
+}
+
+absl::StatusOr<v1::PlanFleetResponse> RemotePlanner::PlanFleet(
+    const v1::PlanFleetRequest& request, std::optional<absl::Duration> timeout) {
+  return CallUnary(impl_->connection, impl_->stub.get(), &v1::CoveragePlanner::Stub::PlanFleet,
+                   request, timeout, RoutingMapId(request.plan()));
+}
+
 absl::StatusOr<v1::ReplanResponse> RemotePlanner::Resume(const v1::ResumeRequest& request,
                                                          std::optional<absl::Duration> timeout) {
   return CallUnary(impl_->connection, impl_->stub.get(), &v1::CoveragePlanner::Stub::Resume,

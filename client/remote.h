@@ -33,6 +33,8 @@ namespace covplan {
 // A channel with the connection's transport security (plaintext, TLS or
 // mutual TLS), and the per-call metadata it needs (the bearer token).
 std::shared_ptr<grpc::Channel> ChannelFor(const Connection& connection);
+// "server TARGET replied CODE: message", how the CLI reports a server's error.
+std::string ServerError(const std::string& target, const absl::Status& status);
 void AddCallCredentials(const Connection& connection, grpc::ClientContext* context);
 
 class RemotePlanner {
@@ -57,6 +59,8 @@ class RemotePlanner {
                                             const std::string& map_id = "");
   absl::StatusOr<v1::ReplanResponse> Resume(const v1::ResumeRequest& request,
                                             std::optional<absl::Duration> timeout);
+  absl::StatusOr<v1::PlanFleetResponse> PlanFleet(const v1::PlanFleetRequest& request,
+                                                  std::optional<absl::Duration> timeout);
 
   // A Drive session, driven synchronously: Open sends the first message and
   // waits for the ready event; Observe sends an observation and waits for the

@@ -2,7 +2,8 @@
 # The main job: install dependencies, build, start covplan-server with its
 # embedded defaults (on-disk map store under ./covplan-data, no external
 # services), plan the shipped sample map through the server, print the
-# figures and write plan.json and plan.svg.
+# figures and write plan.json and plan.svg; then plan the shipped office for
+# a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg.
 #   scripts/run_sample.sh [MAP] [extra `covplan plan` flags...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,3 +36,12 @@ echo "covplan-server on 127.0.0.1:$PORT (metrics on :$METRICS_PORT, log $LOG)"
 ./build/bin/covplan plan --map "$MAP" --server "127.0.0.1:$PORT" \
   --out "$OUT_DIR/plan.json" --svg "$OUT_DIR/plan.svg" "$@"
 echo "wrote $OUT_DIR/plan.json and $OUT_DIR/plan.svg"
+
+# A fleet: three robots starting at three doors of the shipped office
+# (FLEET=0 skips it).
+if [ "${FLEET:-1}" = 1 ]; then
+  ./build/bin/covplan plan --map maps/sample_office.yaml --server "127.0.0.1:$PORT" \
+    --robot west=1.5,1.5 --robot east=20,1.5 --robot hall=10,10 \
+    --out "$OUT_DIR/fleet.json" --svg "$OUT_DIR/fleet.svg"
+  echo "wrote $OUT_DIR/fleet.json and $OUT_DIR/fleet.svg"
+fi

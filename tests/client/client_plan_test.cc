@@ -294,5 +294,54 @@ TEST(ClientPlanTest, StcPlansTheSameLocallyAndThroughTheServer) {
   std::filesystem::remove_all(dir);
 }
 
+// `covplan plan --server ... --robot ...`: the fleet is planned by the
+// server's PlanFleet; --out is its PlanFleetResponse, whose robots together
+// sweep every cell, and whose plan ids the server answers GetPlan for.
+TEST(ClientPlanTest, AFleetThroughTheServerHasRetainedPlans) {
+  const std::string map = absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml");
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / absl::StrCat("covplan_client_fleet_", ::getpid()))
+          .string();
+  std::filesystem::create_directories(dir);
+  ServerConfig config;
+  config.port = 0;
+  config.metrics_port = -1;
+  config.store_dir = dir + "/store";
+  absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+  ASSERT_TRUE(server.ok()) << server.status();
+  const std::string address = absl::StrCat("127.0.0.1:", (*server)->port());
+  const std::string out = dir + "/fleet.json";
+  ::testing::internal::CaptureStdout();
+  const int rc =
+      RunPlanCommand({"--map", map, "--server", address, "--tool-width", "0.8", "--time-limit", "1",
+                      "--robot", "1.2,1.2", "--robot", "east=8.4,6", "--out", out});
+  const std::string summary = ::testing::internal::GetCapturedStdout();
+  ASSERT_EQ(rc, 0);
+  EXPECT_THAT(summary, HasSubstr("mission    mission-"));
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  v1::PlanFleetResponse fleet;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(ss.str(), &fleet).ok()) << ss.str();
+  ASSERT_EQ(fleet.robots_size(), 2);
+  EXPECT_EQ(fleet.robots(1).id(), "east");
+  EXPECT_EQ(fleet.covered_cells(), fleet.cover_cells());
+  auto stub = v1::CoveragePlanner::NewStub(
+      grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  int64_t swept = 0;
+  for (const v1::FleetRobotPlan& robot : fleet.robots()) {
+    swept += robot.plan().stats().covered_cells();
+    v1::GetPlanRequest get;
+    get.set_plan_id(robot.plan().plan_id());
+    v1::PlanResponse got;
+    grpc::ClientContext context;
+    ASSERT_TRUE(stub->GetPlan(&context, get, &got).ok()) << robot.plan().plan_id();
+    EXPECT_EQ(got.path_size(), robot.plan().path_size());
+  }
+  EXPECT_GE(swept, fleet.cover_cells());
+  server->reset();
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace covplan

@@ -167,10 +167,10 @@ TEST_F(FleetPlanCommandTest, BadFleetFlagsAreRefusedNamingTheFlag) {
   ExpectRefused({"--robots", "2", "--clearance", "-1"}, "--clearance");
   ExpectRefused({"--division", "makespan"}, "--division");
   ExpectRefused({"--robot", "1.2,1.2", "--start", "2,2"}, "--start");
-  // A fleet plans in this process only.
+  // Without --local the fleet goes to the server, which says when it is away.
   ::testing::internal::CaptureStderr();
-  EXPECT_NE(RunPlanCommand({"--map", map_, "--robots", "2"}), 0);
-  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("--local"));
+  EXPECT_NE(RunPlanCommand({"--map", map_, "--robots", "2", "--server", "127.0.0.1:1"}), 0);
+  EXPECT_THAT(::testing::internal::GetCapturedStderr(), HasSubstr("server 127.0.0.1:1 replied"));
 }
 
 // --end applies to every robot; without it each keeps the model's default
