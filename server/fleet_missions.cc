@@ -32,6 +32,23 @@ std::optional<FleetMission> FleetMissions::Get(const std::string& mission_id) co
   return it->second;
 }
 
+absl::Status FleetMissions::Update(FleetMission mission,
+                                   const std::vector<std::string>& expected_plan_ids) {
+  absl::MutexLock lock(&mu_);
+  auto it = missions_.find(mission.mission_id);
+  if (it == missions_.end()) {
+    return absl::NotFoundError(
+        absl::StrCat("mission ", mission.mission_id, " was dropped while it was updated"));
+  }
+  if (it->second.plan_ids != expected_plan_ids) {
+    return absl::AbortedError(absl::StrCat("mission ", mission.mission_id,
+                                           " was updated by another call meanwhile; send the "
+                                           "update again"));
+  }
+  it->second = std::move(mission);
+  return absl::OkStatus();
+}
+
 size_t FleetMissions::size() const {
   absl::MutexLock lock(&mu_);
   return missions_.size();

@@ -1,8 +1,9 @@
 // The fleet missions the server planned (PlanFleet): a mission_id names the
 // robots of one fleet plan and the plan_id of each robot's plan (retained
 // and persisted by the PlanArchive like any plan). Kept in memory only,
-// bounded in count, oldest dropped first; nothing reads them over the API
-// yet, a later GetMission will.
+// bounded in count, oldest dropped first; UpdateMission replaces a
+// mission's plan ids, marks robots stopped and adds joining ones
+// (server/mission_handlers.h), GetMission reads it.
 //
 //   FleetMissions missions(/*max_missions=*/1000);
 //   missions.Put({NewMissionId(tenant), map_id, {"r1", "r2"}, {plan_a, plan_b}});
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
+#include "absl/status/status.h"
 #include "absl/synchronization/mutex.h"
 
 namespace covplan {
@@ -33,6 +35,9 @@ struct FleetMission {
   std::string map_id;
   std::vector<std::string> robot_ids;  // in request order
   std::vector<std::string> plan_ids;   // robot i's plan
+  std::vector<bool> stopped;           // robot i stopped for good (missing: no)
+
+  bool Stopped(size_t i) const { return i < stopped.size() && stopped[i]; }
 };
 
 class FleetMissions {
@@ -41,6 +46,10 @@ class FleetMissions {
 
   void Put(FleetMission mission);
   std::optional<FleetMission> Get(const std::string& mission_id) const;
+  // Replaces the mission of mission.mission_id if its plan ids are still
+  // `expected_plan_ids`: NOT_FOUND once it was dropped, ABORTED when another
+  // update came first.
+  absl::Status Update(FleetMission mission, const std::vector<std::string>& expected_plan_ids);
   size_t size() const;
 
  private:

@@ -20,6 +20,8 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
              &warm_pool_, background_stop_),
       missions_(4 * options.max_retained_plans + 16),
       fleets_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &missions_),
+      missions_rpc_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &progress_,
+                    &missions_),
       replans_(&gate_, &admission_, &replan_work_),
       drive_(options_, metrics, &gate_, &admission_, &replan_work_, &progress_),
       io_pool_(/*threads=*/2, /*max_queue=*/64),

@@ -11,6 +11,8 @@
 //   PlanHandlers    Plan, GetPlan
 //   FleetHandlers   PlanFleet (each robot's plan retained like a Plan's;
 //                   FleetMissions keeps mission_id -> robots, plan ids)
+//   MissionHandlers UpdateMission (RedivideMission: new plans, new plan ids),
+//                   GetMission
 //   ReplanHandlers  Replan, Resume (their work: ReplanWork)
 //   DriveHandler    Drive, and the DriveHost of its sessions
 //
@@ -53,6 +55,7 @@
 #include "server/map_handlers.h"
 #include "server/map_repository.h"
 #include "server/metrics.h"
+#include "server/mission_handlers.h"
 #include "server/plan_archive.h"
 #include "server/plan_handlers.h"
 #include "server/progress_log.h"
@@ -110,6 +113,16 @@ class CoveragePlannerService final
                                       v1::PlanFleetResponse* response) override {
     return fleets_.PlanFleet(context, request, response);
   }
+  grpc::ServerUnaryReactor* UpdateMission(grpc::CallbackServerContext* context,
+                                          const v1::UpdateMissionRequest* request,
+                                          v1::UpdateMissionResponse* response) override {
+    return missions_rpc_.UpdateMission(context, request, response);
+  }
+  grpc::ServerUnaryReactor* GetMission(grpc::CallbackServerContext* context,
+                                       const v1::GetMissionRequest* request,
+                                       v1::GetMissionResponse* response) override {
+    return missions_rpc_.GetMission(context, request, response);
+  }
   grpc::ServerUnaryReactor* Replan(grpc::CallbackServerContext* context,
                                    const v1::ReplanRequest* request,
                                    v1::ReplanResponse* response) override {
@@ -161,6 +174,7 @@ class CoveragePlannerService final
   PlanHandlers plans_;
   FleetMissions missions_;
   FleetHandlers fleets_;
+  MissionHandlers missions_rpc_;
   ReplanHandlers replans_;
   DriveHandler drive_;
   // Last: their threads stop before the rest is destroyed.

@@ -1,0 +1,254 @@
+// UpdateMission and GetMission in process: three robots planned by
+// PlanFleet on the shipped office; robot b stops for good a third of the
+// way along its plan, and a and c get new plans (new plan ids) whose sweeps
+// hold everything b had left; the mission then shows b stopped and a, c on
+// their new plans, which GetPlan returns. A joining robot gets a share;
+// unknown missions are NOT_FOUND, unknown robots INVALID_ARGUMENT naming
+// the field.
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "api/convert.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/covplan_server.h"
+#include "tests/testing/test_maps.h"
+
+namespace covplan {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::set<int> SweptCells(const v1::PlanResponse& plan) {
+  std::set<int> cells;
+  for (const v1::CoverageSweep& s : plan.sweeps()) cells.insert(s.cells().begin(), s.cells().end());
+  return cells;
+}
+
+class MissionServiceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_mission_", ::getpid()))
+               .string();
+    ServerConfig config;
+    config.port = 0;
+    config.metrics_port = -1;
+    config.store_dir = dir_ + "/maps";
+    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = std::move(*server);
+    stub_ = v1::CoveragePlanner::NewStub(grpc::CreateChannel(
+        absl::StrCat("127.0.0.1:", server_->port()), grpc::InsecureChannelCredentials()));
+    absl::StatusOr<v1::Map> map =
+        MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
+                         MapFileOverrides(), EngineLimits());
+    ASSERT_TRUE(map.ok()) << map.status();
+    grpc::ClientContext context;
+    v1::PutMapRequest put;
+    *put.mutable_map() = *map;
+    v1::PutMapResponse stored;
+    ASSERT_TRUE(stub_->PutMap(&context, put, &stored).ok());
+    map_id_ = stored.map_id();
+  }
+  void TearDown() override {
+    server_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  // Robots a (west end), b (placed by the planner) and c (east end).
+  void PlanThree() {
+    v1::PlanFleetRequest r;
+    r.mutable_plan()->set_map_id(map_id_);
+    r.mutable_plan()->mutable_robot()->set_tool_width_m(0.8);
+    r.mutable_plan()->set_time_limit_s(1.0);
+    const double x[] = {1.5, 0.0, 20.0};
+    const char* ids[] = {"a", "b", "c"};
+    for (int i = 0; i < 3; ++i) {
+      v1::FleetRobot* robot = r.add_robots();
+      robot->set_id(ids[i]);
+      robot->mutable_robot()->set_tool_width_m(0.8);
+      if (i == 1) continue;
+      robot->mutable_robot()->mutable_start()->set_x(x[i]);
+      robot->mutable_robot()->mutable_start()->set_y(1.5);
+    }
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    grpc::Status status = stub_->PlanFleet(&context, r, &fleet_);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_EQ(fleet_.robots_size(), 3);
+    for (const v1::FleetRobotPlan& robot : fleet_.robots()) ASSERT_FALSE(robot.idle());
+  }
+  grpc::Status Update(const v1::UpdateMissionRequest& request, v1::UpdateMissionResponse* out) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    return stub_->UpdateMission(&context, request, out);
+  }
+  grpc::Status GetMission(const std::string& mission_id, v1::GetMissionResponse* out) {
+    grpc::ClientContext context;
+    v1::GetMissionRequest get;
+    get.set_mission_id(mission_id);
+    return stub_->GetMission(&context, get, out);
+  }
+  grpc::Status GetPlan(const std::string& plan_id, v1::PlanResponse* out) {
+    grpc::ClientContext context;
+    v1::GetPlanRequest get;
+    get.set_plan_id(plan_id);
+    return stub_->GetPlan(&context, get, out);
+  }
+
+  std::string dir_;
+  std::string map_id_;
+  std::unique_ptr<CovplanServer> server_;
+  std::unique_ptr<v1::CoveragePlanner::Stub> stub_;
+  v1::PlanFleetResponse fleet_;
+};
+
+TEST_F(MissionServiceTest, AStoppedRobotsRemainderGoesToTheOthers) {
+  PlanThree();
+  const v1::PlanResponse& b = fleet_.robots(1).plan();
+  // b stops for good a third of the way along its plan.
+  const int k = std::max(1, b.path_size() / 3);
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* stop = update.add_robots();
+  stop->set_robot_id("b");
+  stop->set_stopped(true);
+  stop->mutable_progress()->set_waypoint(k);
+  stop->mutable_progress()->mutable_position()->set_x(b.path(k - 1).x());
+  stop->mutable_progress()->mutable_position()->set_y(b.path(k - 1).y());
+  v1::UpdateMissionResponse updated;
+  grpc::Status status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(updated.mission_id(), fleet_.mission_id());
+  ASSERT_EQ(updated.robots_size(), 2);
+  EXPECT_EQ(updated.robots(0).id(), "a");
+  EXPECT_EQ(updated.robots(1).id(), "c");
+  EXPECT_GT(updated.handed_over_cells(), 0);
+  EXPECT_GE(updated.remaining_cells(), updated.handed_over_cells());
+  EXPECT_EQ(updated.cut_off_cells(), 0);
+  EXPECT_GT(updated.makespan_s(), 0.0);
+  std::set<std::string> old_ids;
+  for (const v1::FleetRobotPlan& robot : fleet_.robots()) old_ids.insert(robot.plan().plan_id());
+  std::set<int> together;
+  for (const v1::FleetRobotPlan& robot : updated.robots()) {
+    EXPECT_FALSE(robot.plan().plan_id().empty());
+    EXPECT_EQ(old_ids.count(robot.plan().plan_id()), 0u) << robot.id();
+    EXPECT_EQ(robot.plan().map_id(), map_id_);
+    for (int cell : SweptCells(robot.plan())) together.insert(cell);
+  }
+  // Everything b would have swept after waypoint k (and had not swept by
+  // then) is in a's or c's new plan.
+  std::set<int> before;
+  for (const v1::CoverageSweep& s : b.sweeps()) {
+    if (s.waypoint() <= k) before.insert(s.cells().begin(), s.cells().end());
+  }
+  int handed = 0;
+  for (const v1::CoverageSweep& s : b.sweeps()) {
+    if (s.waypoint() <= k) continue;
+    for (int cell : s.cells()) {
+      if (before.count(cell)) continue;
+      ++handed;
+      EXPECT_TRUE(together.count(cell)) << "cell " << cell << " of b's remainder swept by none";
+    }
+  }
+  EXPECT_GT(handed, 0);
+
+  // The mission: b stopped, a and c on their new plans.
+  v1::GetMissionResponse mission;
+  status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(mission.map_id(), map_id_);
+  ASSERT_EQ(mission.robots_size(), 3);
+  EXPECT_EQ(mission.robots(0).robot_id(), "a");
+  EXPECT_EQ(mission.robots(0).plan_id(), updated.robots(0).plan().plan_id());
+  EXPECT_FALSE(mission.robots(0).stopped());
+  EXPECT_EQ(mission.robots(1).robot_id(), "b");
+  EXPECT_EQ(mission.robots(1).plan_id(), b.plan_id());
+  EXPECT_TRUE(mission.robots(1).stopped());
+  EXPECT_EQ(mission.robots(2).robot_id(), "c");
+  EXPECT_EQ(mission.robots(2).plan_id(), updated.robots(1).plan().plan_id());
+  EXPECT_FALSE(mission.robots(2).stopped());
+
+  // A new plan is retained like any plan.
+  v1::PlanResponse retained;
+  status = GetPlan(updated.robots(0).plan().plan_id(), &retained);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(retained.SerializeAsString(), updated.robots(0).plan().SerializeAsString());
+
+  // b stopped for good: it is not an active robot again.
+  v1::UpdateMissionRequest again;
+  again.set_mission_id(fleet_.mission_id());
+  again.add_robots()->set_robot_id("b");
+  status = Update(again, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("robots[0].robot_id"));
+}
+
+TEST_F(MissionServiceTest, AJoiningRobotGetsAShare) {
+  PlanThree();
+  const v1::PlanResponse& a = fleet_.robots(0).plan();
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* join = update.add_robots();
+  join->set_robot_id("d");
+  join->mutable_joining()->mutable_robot()->set_tool_width_m(0.8);
+  // It joins where a started.
+  join->mutable_joining()->mutable_robot()->mutable_start()->set_x(a.path(0).x());
+  join->mutable_joining()->mutable_robot()->mutable_start()->set_y(a.path(0).y());
+  v1::UpdateMissionResponse updated;
+  grpc::Status status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(updated.robots_size(), 4);
+  EXPECT_EQ(updated.handed_over_cells(), 0);
+  EXPECT_EQ(updated.robots(3).id(), "d");
+  EXPECT_FALSE(updated.robots(3).idle());
+  EXPECT_FALSE(SweptCells(updated.robots(3).plan()).empty());
+  v1::GetMissionResponse mission;
+  status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(mission.robots_size(), 4);
+  EXPECT_EQ(mission.robots(3).robot_id(), "d");
+  EXPECT_EQ(mission.robots(3).plan_id(), updated.robots(3).plan().plan_id());
+
+  // Its id is taken now.
+  status = Update(update, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("robots[0].robot_id"));
+}
+
+TEST_F(MissionServiceTest, UnknownMissionsAndRobotsAreRefused) {
+  PlanThree();
+  v1::UpdateMissionRequest update;
+  update.set_mission_id("mission-0123456789abcdef");
+  update.add_robots()->set_robot_id("a");
+  v1::UpdateMissionResponse updated;
+  grpc::Status status = Update(update, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(status.error_message(), HasSubstr("mission-0123456789abcdef"));
+  v1::GetMissionResponse mission;
+  status = GetMission("mission-0123456789abcdef", &mission);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+
+  update.set_mission_id(fleet_.mission_id());
+  update.add_robots()->set_robot_id("zz");
+  status = Update(update, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("robots[1].robot_id"));
+  EXPECT_THAT(status.error_message(), HasSubstr("zz"));
+
+  update.mutable_robots(1)->set_robot_id("a");
+  status = Update(update, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("robots[1].robot_id"));
+}
+
+}  // namespace
+}  // namespace covplan
