@@ -221,7 +221,7 @@ std::string FormatFleetSimulation(const FleetSimulationResult& r) {
   absl::StrAppendFormat(&out, "makespan   %.1f s driven (planned %.1f s)\n", r.makespan_s,
                         r.initial.makespan_s);
   for (const FleetRedivision& d : r.redivisions) {
-    if (d.left_cells == 0 || d.robots.empty()) {
+    if (d.left_cells == 0 || d.robots.empty() || d.plan.robots.empty()) {
       absl::StrAppendFormat(&out, "failure    %s at %.1f s: %d cells left, %d robots left\n",
                             d.failed_robot, d.time_s, d.left_cells, d.robots.size());
       continue;

@@ -247,31 +247,41 @@ absl::Status FleetRun::Fail(const RobotFailure& failure) {
 
 // Plans what is left among the survivors on the known map with every cell
 // found blocked so far drawn in as the true map has it, and sets them off.
+// Cells the drawn-in obstacles cut off are left out; when none is left the
+// survivors drive on.
 absl::Status FleetRun::Redivide(FleetRedivision* redivision) {
   auto updated = std::make_shared<OccupancyMap>(*known_);
   const double half = 0.5 * (site_.grid.cell_size() - known_->resolution());
+  for (const auto& s : robots_) {
+    for (size_t c = 0; c < s->found.size(); ++c) {
+      if (s->found[c] || (s->drive != nullptr && s->drive->found()[c]))
+        ClearAround(site_.map(), site_.grid.CellCenter(site_.grid.FromIndex(c)), half,
+                    updated.get());
+    }
+  }
+  const std::string map_id = absl::StrFormat("known+found-%d", result_.redivisions.size() + 1);
+  const MapSource source = SourceOf(std::move(updated), map_id);
+  ASSIGN_OR_RETURN(std::shared_ptr<const CoverageArea> area,
+                   engine_.AreaFor(source, options_.fleet.RobotRequest(0)));
+  int64_t plannable = 0;
+  for (size_t c = 0; c < redivision->left.size(); ++c)
+    plannable += redivision->left[c] && area->cover->free_flags()[c];
+  if (plannable == 0) return absl::OkStatus();
   FleetRequest request = options_.fleet;
   request.robots.clear();
   request.cover_mask = redivision->left;
   std::vector<size_t> who;
   for (size_t i = 0; i < robots_.size(); ++i) {
     RobotState& s = *robots_[i];
-    if (s.drive != nullptr) EndLeg(i);  // the survivors stop where they are
-    for (size_t c = 0; c < s.found.size(); ++c) {
-      if (s.found[c])
-        ClearAround(site_.map(), site_.grid.CellCenter(site_.grid.FromIndex(c)), half,
-                    updated.get());
-    }
     if (s.run.failed) continue;
+    if (s.drive != nullptr) EndLeg(i);  // the survivors stop where they are
     FleetRobot robot = options_.fleet.robots[i];
     robot.robot.start = s.where;
     robot.robot.end = s.end;
     request.robots.push_back(std::move(robot));
     who.push_back(i);
   }
-  const std::string map_id = absl::StrFormat("known+found-%d", result_.redivisions.size() + 1);
-  ASSIGN_OR_RETURN(redivision->plan,
-                   PlanFleet(engine_, SourceOf(std::move(updated), map_id), request));
+  ASSIGN_OR_RETURN(redivision->plan, PlanFleet(engine_, source, request));
   for (size_t j = 0; j < who.size(); ++j) {
     RETURN_IF_ERROR(
         StartLeg(who[j], request, j, redivision->plan.robots[j], redivision->time_s, map_id));

@@ -89,7 +89,9 @@ struct FleetRedivision {
   std::vector<uint8_t> left;
   int64_t left_cells = 0;
   std::vector<std::string> robots;  // the survivors it divided among
-  FleetPlan plan;                   // PlanFleet of `left` among them
+  // PlanFleet of `left` among them; no robots when nothing was left, no
+  // survivor was, or the obstacles found had cut every cell left off.
+  FleetPlan plan;
   // The survivors' last finish after time_s, minus time_s: to compare with
   // plan.makespan_s (the fresh plan's estimate of the same work).
   double achieved_s = 0.0;
