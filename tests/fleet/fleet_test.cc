@@ -33,7 +33,9 @@ TEST(Fleet, OfOneIsTheSingleRobotPlan) {
   EngineLimits limits;
   limits.plan_memory = false;
   PlanningEngine fleet_engine(&registry, &cache_a, limits), single(&registry, &cache_b, limits);
-  FleetRequest f = Fleet("oarp", 0.5);
+  // A budget the search converges within (its plan is then the seed's alone,
+  // however loaded the machine is).
+  FleetRequest f = Fleet("oarp", 20.0);
   f.robots = {Robot("only", 0.8, 1.5, 1.5)};
   absl::StatusOr<FleetPlan> fleet = PlanFleet(fleet_engine, testing::SourceOfMap(map, "office"), f);
   ASSERT_TRUE(fleet.ok()) << fleet.status();
