@@ -1,7 +1,8 @@
 // UpdateMission and GetMission in process: three robots planned by
 // PlanFleet on the shipped office; robot b stops for good a third of the
 // way along its plan, and a and c get new plans (new plan ids) whose sweeps
-// hold everything b had left; the mission then shows b stopped and a, c on
+// hold everything b had left (from its request's progress, or else from
+// the progress its Drive session recorded); the mission then shows b stopped and a, c on
 // their new plans, which GetPlan returns. A joining robot gets a share;
 // unknown missions are NOT_FOUND, unknown robots INVALID_ARGUMENT naming
 // the field.
@@ -224,6 +225,50 @@ TEST_F(MissionServiceTest, AJoiningRobotGetsAShare) {
   EXPECT_THAT(status.error_message(), HasSubstr("robots[0].robot_id"));
 }
 
+TEST_F(MissionServiceTest, WithoutProgressTheDriveSessionsRecordedProgressCounts) {
+  PlanThree();
+  const v1::PlanResponse& b = fleet_.robots(1).plan();
+  const int k = std::max(1, b.path_size() / 3);
+  // b reports a third of its plan driven in a Drive session, then stops.
+  {
+    grpc::ClientContext context;
+    std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> stream =
+        stub_->Drive(&context);
+    v1::DriveRequest first;
+    first.set_plan_id(b.plan_id());
+    first.set_sequence(1);
+    ASSERT_TRUE(stream->Write(first));
+    v1::DriveEvent event;
+    ASSERT_TRUE(stream->Read(&event));
+    ASSERT_TRUE(event.has_ready()) << event.DebugString();
+    v1::DriveRequest report;
+    report.set_sequence(2);
+    report.mutable_progress()->set_waypoint(k);
+    report.mutable_progress()->mutable_position()->set_x(b.path(k - 1).x());
+    report.mutable_progress()->mutable_position()->set_y(b.path(k - 1).y());
+    ASSERT_TRUE(stream->Write(report));
+    stream->WritesDone();
+    EXPECT_TRUE(stream->Finish().ok());
+  }
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* stop = update.add_robots();
+  stop->set_robot_id("b");
+  stop->set_stopped(true);
+  v1::UpdateMissionResponse updated;
+  grpc::Status status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  // At most what b had left from waypoint k on, not its whole share.
+  std::set<int> done;
+  for (const v1::CoverageSweep& s : b.sweeps()) {
+    if (s.waypoint() < k) done.insert(s.cells().begin(), s.cells().end());
+  }
+  const std::set<int> all = SweptCells(b);
+  EXPECT_GT(updated.handed_over_cells(), 0);
+  EXPECT_LE(updated.handed_over_cells(), static_cast<int64_t>(all.size() - done.size()));
+  EXPECT_GT(done.size(), 0u);
+}
+
 TEST_F(MissionServiceTest, UnknownMissionsAndRobotsAreRefused) {
   PlanThree();
   v1::UpdateMissionRequest update;
@@ -248,6 +293,17 @@ TEST_F(MissionServiceTest, UnknownMissionsAndRobotsAreRefused) {
   status = Update(update, &updated);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("robots[1].robot_id"));
+
+  // Progress beyond the plan's end, named by the request's index.
+  v1::UpdateMissionRequest far;
+  far.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* c = far.add_robots();
+  c->set_robot_id("c");
+  c->mutable_progress()->set_waypoint(fleet_.robots(2).plan().path_size() + 10);
+  c->mutable_progress()->mutable_position()->set_x(1.0);
+  status = Update(far, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("robots[0] ('c')"));
 }
 
 }  // namespace
