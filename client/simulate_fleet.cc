@@ -76,10 +76,12 @@ std::string RobotJson(const FleetRobotRun& run) {
   std::vector<std::string> legs;
   for (const FleetLeg& leg : run.legs) legs.push_back(LegJson(leg));
   return absl::StrFormat(
-      "    {\"id\": %s, \"failed\": %s, \"finish_s\": %s, \"swept_cells\": %d, \"num_replans\": "
+      "    {\"id\": %s, \"failed\": %s, \"failed_at_s\": %s, \"finish_s\": %s, \"swept_cells\": "
+      "%d, \"num_replans\": "
       "%d, \"stoppage_s\": %s, \"length_in_obstacles_m\": %s,\n     \"legs\": [%s]}",
-      JsonString(run.id), run.failed ? "true" : "false", Number(run.finish_s), run.swept_cells,
-      run.num_replans, Number(run.stoppage_s), Number(run.length_in_obstacles_m),
+      JsonString(run.id), run.failed ? "true" : "false",
+      run.failed ? Number(run.failed_at_s) : std::string("null"), Number(run.finish_s),
+      run.swept_cells, run.num_replans, Number(run.stoppage_s), Number(run.length_in_obstacles_m),
       absl::StrJoin(legs, ", "));
 }
 
@@ -216,7 +218,10 @@ std::string FormatFleetSimulation(const FleetSimulationResult& r) {
     absl::StrAppendFormat(
         &out, "           %-12s %11d %10.1f %5d %8d%s\n", run.id, run.swept_cells, run.finish_s,
         run.legs.size(), run.num_replans,
-        run.failed ? absl::StrFormat("  failed, stopped at %.1f s", run.finish_s) : std::string());
+        !run.failed ? std::string()
+        : run.failed_at_s > run.finish_s + 1e-6
+            ? absl::StrFormat("  failed at %.1f s, after its end", run.failed_at_s)
+            : absl::StrFormat("  failed, stopped at %.1f s", run.finish_s));
   }
   absl::StrAppendFormat(&out, "makespan   %.1f s driven (planned %.1f s)\n", r.makespan_s,
                         r.initial.makespan_s);

@@ -228,6 +228,7 @@ absl::Status FleetRun::Fail(const RobotFailure& failure) {
   RobotState& f = *robots_[failed];
   if (f.drive != nullptr) EndLeg(failed);
   f.run.failed = true;
+  f.run.failed_at_s = failure.time_s;
   FleetRedivision redivision;
   redivision.time_s = failure.time_s;
   redivision.failed_robot = failure.robot_id;

@@ -73,6 +73,7 @@ struct FleetRobotRun {
   std::vector<FleetLeg> legs;    // in time order; empty for a robot given nothing at all
   std::vector<Waypoint> driven;  // every leg's driven path, joined
   bool failed = false;
+  double failed_at_s = -1.0;   // its failure's time (after finish_s when it had already ended)
   double finish_s = 0.0;       // when it stopped for good (its end, or its failure)
   std::vector<uint8_t> swept;  // per cell (Grid::Index): swept by this robot
   int64_t swept_cells = 0;     // distinct cells it swept
@@ -93,7 +94,8 @@ struct FleetRedivision {
   // survivor was, or the obstacles found had cut every cell left off.
   FleetPlan plan;
   // The survivors' last finish after time_s, minus time_s: to compare with
-  // plan.makespan_s (the fresh plan's estimate of the same work).
+  // plan.makespan_s (the fresh plan's estimate of the same work). A later
+  // failure of a survivor cuts it short.
   double achieved_s = 0.0;
 };
 
