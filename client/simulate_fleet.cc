@@ -219,7 +219,7 @@ std::string FormatFleetSimulation(const FleetSimulationResult& r) {
         &out, "           %-12s %11d %10.1f %5d %8d%s\n", run.id, run.swept_cells, run.finish_s,
         run.legs.size(), run.num_replans,
         !run.failed ? std::string()
-        : run.failed_at_s > run.finish_s + 1e-6
+        : run.legs.empty() || !run.legs.back().interrupted
             ? absl::StrFormat("  failed at %.1f s, after its end", run.failed_at_s)
             : absl::StrFormat("  failed, stopped at %.1f s", run.finish_s));
   }

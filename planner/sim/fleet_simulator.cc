@@ -322,9 +322,15 @@ void FleetRun::Measure() {
   r.swept_cells = std::count(r.swept.begin(), r.swept.end(), 1);
   r.covered_free_area_ratio = sim_internal::CoveredFreeAreaRatio(site_, r.swept);
   // Reachable: the mission's cells free on the true grid, in a component
-  // that holds a robot's start.
+  // that holds a robot's start, as the robots' cell model moves: the true
+  // grid's free cells with the known map's walls (new obstacles are blocked
+  // cells to it, whatever they touch).
+  std::vector<uint8_t> free(mission_->drive->free_flags().begin(),
+                            mission_->drive->free_flags().end());
+  for (size_t c = 0; c < free.size(); ++c) free[c] = free[c] && site_.grid.free_flags()[c];
+  const Grid model = mission_->drive->WithFreeFlags(std::move(free));
   int32_t num = 0;
-  const std::vector<int32_t> comp = FreeComponents(site_.grid, &num);
+  const std::vector<int32_t> comp = FreeComponents(model, &num);
   std::vector<uint8_t> start_comp(static_cast<size_t>(num), 0);
   for (const FleetRobotPlan& rp : r.initial.robots) {
     if (rp.result.plan.path.empty()) continue;

@@ -73,7 +73,7 @@ struct FleetRobotRun {
   std::vector<FleetLeg> legs;    // in time order; empty for a robot given nothing at all
   std::vector<Waypoint> driven;  // every leg's driven path, joined
   bool failed = false;
-  double failed_at_s = -1.0;   // its failure's time (after finish_s when it had already ended)
+  double failed_at_s = -1.0;   // its failure's time (its last leg not interrupted: it had ended)
   double finish_s = 0.0;       // when it stopped for good (its end, or its failure)
   std::vector<uint8_t> swept;  // per cell (Grid::Index): swept by this robot
   int64_t swept_cells = 0;     // distinct cells it swept
@@ -106,8 +106,9 @@ struct FleetSimulationResult {
   double makespan_s = 0.0;    // the latest finish
   int64_t mission_cells = 0;  // cells to cover on the known map
   int64_t swept_cells = 0;    // distinct cells any robot swept
-  // Free cells of the true grid among the mission's, connected on it to a
-  // robot's start, and of these the ones nobody swept (0 when all went well).
+  // Free cells of the true grid among the mission's, connected to a robot's
+  // start over such cells through the known map's walls (the robots' cell
+  // model), and of these the ones nobody swept (0 when all went well).
   int64_t reachable_cells = 0;
   int64_t unswept_reachable_cells = 0;
   std::vector<CellIndex> unswept_reachable;  // those cells

@@ -14,6 +14,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "planner/grid/grid.h"
+#include "planner/sim/clutter.h"
 #include "planner/tour/grid_paths.h"
 #include "tests/sim/sim_checks.h"
 #include "tests/testing/shipped_maps.h"
@@ -60,8 +61,13 @@ void Print(const FleetSimulationResult& r) {
   for (const std::string& p : r.problems) std::printf("  problem: %s\n", p.c_str());
 }
 
-// Per cell: free on the true grid and connected on it to one of the fleet's starts.
-std::vector<uint8_t> Reachable(const Grid& grid, const FleetSimulationOptions& o) {
+// Per cell: free on the true grid and connected to one of the fleet's starts
+// over such cells through the known map's walls (the robots' cell model).
+std::vector<uint8_t> Reachable(const Grid& known, const Grid& truth,
+                               const FleetSimulationOptions& o) {
+  std::vector<uint8_t> free(known.free_flags().begin(), known.free_flags().end());
+  for (size_t i = 0; i < free.size(); ++i) free[i] = free[i] && truth.free_flags()[i];
+  const Grid grid = known.WithFreeFlags(std::move(free));
   int32_t num = 0;
   const std::vector<int32_t> comp = FreeComponents(grid, &num);
   std::vector<uint8_t> keep(static_cast<size_t>(num), 0), reachable(comp.size(), 0);
@@ -144,7 +150,7 @@ TEST(FleetSimulation, ThreeRobotsOneFailingAtAThirdOfTheMakespanLeaveNoReachable
   // The survivors' new plans start where they stood at t_f and together
   // cover every cell left then that the true map lets a robot reach.
   const Grid true_grid = TrueGrid(truth);
-  const std::vector<uint8_t> reachable = Reachable(true_grid, o);
+  const std::vector<uint8_t> reachable = Reachable(TrueGrid(known), true_grid, o);
   std::vector<uint8_t> planned(d.left.size(), 0);
   for (const FleetRobotPlan& rp : d.plan.robots) {
     for (const CoverageSweep& s : rp.result.plan.sweeps) {
@@ -165,6 +171,33 @@ TEST(FleetSimulation, ThreeRobotsOneFailingAtAThirdOfTheMakespanLeaveNoReachable
     EXPECT_NEAR(from.y, to.y, 1e-9);
     EXPECT_GT(s.finish_s, t_f);
   }
+}
+
+TEST(FleetSimulation, TwoFailuresLeaveTheLastRobotEveryReachableCell) {
+  const OccupancyMap known = testing::LoadShippedMap("small_rooms.yaml");
+  absl::StatusOr<OccupancyMap> truth = AddClutter(known, 5.0, 2);
+  ASSERT_TRUE(truth.ok()) << truth.status();
+  FleetSimulationOptions o = OfficeFleet();
+  o.fleet.base.common.time_limit_s = 0.3;
+  o.fleet.robots = {Robot("a", 1.2, 1.2), Robot("b", 2.0, 3.0), Robot("c", 6.0, 6.0)};
+  o.failures = {{"b", 40.0}, {"a", 20.0}};  // any order
+  absl::StatusOr<FleetSimulationResult> r = SimulateFleet(known, *truth, o);
+  ASSERT_TRUE(r.ok()) << r.status();
+  Print(*r);
+  EXPECT_TRUE(r->completed);
+  EXPECT_EQ(r->unswept_reachable_cells, 0);
+  ASSERT_EQ(r->redivisions.size(), 2u);
+  EXPECT_EQ(r->redivisions[0].failed_robot, "a");
+  EXPECT_THAT(r->redivisions[0].robots, ::testing::ElementsAre("b", "c"));
+  EXPECT_EQ(r->redivisions[1].failed_robot, "b");
+  EXPECT_THAT(r->redivisions[1].robots, ::testing::ElementsAre("c"));
+  for (size_t k : {size_t{0}, size_t{1}}) {
+    const FleetRobotRun& f = r->robots[k];
+    EXPECT_TRUE(f.failed);
+    for (const FleetLeg& leg : f.legs) EXPECT_LE(leg.end_s, f.failed_at_s + 1e-9) << f.id;
+  }
+  EXPECT_FALSE(r->robots[2].failed);
+  EXPECT_DOUBLE_EQ(r->makespan_s, r->robots[2].finish_s);
 }
 
 TEST(FleetSimulation, BadFailuresAreRefusedNamingTheField) {
