@@ -5,9 +5,6 @@
 #include <cstdint>
 #include <limits>
 
-#include "boost/graph/adjacency_list.hpp"
-#include "boost/graph/maximum_weighted_matching.hpp"
-
 namespace covplan {
 
 std::optional<double> MinAssignmentCost(const std::vector<double>& costs, int n) {
@@ -57,37 +54,12 @@ std::optional<double> MinAssignmentCost(const std::vector<double>& costs, int n)
   return total;
 }
 
-std::optional<double> MinPerfectMatchingCost(const std::vector<double>& costs, int n) {
-  if (n % 2 != 0) return std::nullopt;
-  using Graph =
-      boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, boost::no_property,
-                            boost::property<boost::edge_weight_t, int64_t>>;
-  int64_t max_cost = 0;
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      const double c = costs[static_cast<size_t>(i) * n + j];
-      if (std::isfinite(c)) max_cost = std::max(max_cost, static_cast<int64_t>(c * 1e6));
-    }
-  }
-  // Every perfect matching outweighs every smaller one.
-  const int64_t big = (static_cast<int64_t>(n) / 2 + 1) * (max_cost + 1);
-  Graph g(n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      const double c = costs[static_cast<size_t>(i) * n + j];
-      if (!std::isfinite(c)) continue;
-      boost::add_edge(i, j, big - static_cast<int64_t>(std::max(0.0, c) * 1e6), g);
-    }
-  }
-  std::vector<boost::graph_traits<Graph>::vertex_descriptor> mate(n);
-  boost::maximum_weighted_matching(g, mate.data());
-  double total = 0.0;
-  for (int i = 0; i < n; ++i) {
-    if (mate[i] == boost::graph_traits<Graph>::null_vertex()) return std::nullopt;
-    const int j = static_cast<int>(mate[i]);
-    if (i < j) total += std::floor(costs[static_cast<size_t>(i) * n + j] * 1e6) / 1e6;
-  }
-  return total;
+std::optional<double> PerfectMatchingLowerBound(const std::vector<double>& costs, int n) {
+  std::vector<double> c = costs;
+  for (int i = 0; i < n; ++i) c[static_cast<size_t>(i) * n + i] = INFINITY;
+  const std::optional<double> assigned = MinAssignmentCost(c, n);
+  if (!assigned) return std::nullopt;
+  return *assigned / 2.0;
 }
 
 }  // namespace covplan

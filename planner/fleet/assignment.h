@@ -1,4 +1,4 @@
-// Two classic relaxations' solvers for the fleet's lower bound.
+// Two classic relaxations for the fleet's lower bound.
 //
 // The minimum-cost assignment (linear assignment problem) of a dense square
 // cost matrix: each row to a distinct column, minimising the summed cost.
@@ -19,13 +19,13 @@ namespace covplan {
 // `costs` is row-major n x n. nullopt when no assignment avoids +inf.
 std::optional<double> MinAssignmentCost(const std::vector<double>& costs, int n);
 
-// The minimum-cost perfect matching of a complete graph on n vertices
-// (symmetric row-major n x n costs, +inf: no edge), by Boost.Graph's
-// maximum_weighted_matching (Edmonds' blossoms) on integer weights
-// C - cost (costs in microseconds, rounded down, so the result is never
-// above the true minimum; C large enough that every maximum-weight
-// matching is perfect). nullopt when no perfect matching exists.
-std::optional<double> MinPerfectMatchingCost(const std::vector<double>& costs, int n);
+// A lower bound on the minimum-cost perfect matching of a complete graph on
+// n vertices (symmetric row-major n x n costs, +inf: no edge): half the
+// minimum-cost assignment with the diagonal forbidden. A perfect matching
+// read both ways is such an assignment of twice its cost. Bounded O(n^3)
+// (Boost.Graph's weighted matching in Debian's Boost 1.74 can loop forever
+// on some inputs, so it is not used). nullopt when no assignment exists.
+std::optional<double> PerfectMatchingLowerBound(const std::vector<double>& costs, int n);
 
 }  // namespace covplan
 

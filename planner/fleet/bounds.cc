@@ -212,8 +212,10 @@ std::optional<double> AssignedMoves(const BoundInput& in) {
 // end_r: the moves pair up the units' two ends, the starts and the ends, so
 // they form a perfect matching of those 2n + 2k points (a unit's own two ends
 // never; a start only with a unit or its own robot's end, an idle robot).
-// The minimum-cost perfect matching is a lower bound that, unlike the
-// assignment, keeps each unit driven in one direction.
+// A lower bound of the minimum-cost perfect matching (half the assignment
+// over the points, PerfectMatchingLowerBound) keeps, unlike the assignment
+// over the units, each unit driven in one direction; the larger of the two is
+// taken.
 std::optional<double> MatchedMoves(const BoundInput& in) {
   const int n = in.n(), k = in.k(), size = 2 * n + 2 * k;
   std::vector<double> c(static_cast<size_t>(size) * size, INFINITY);
@@ -239,12 +241,12 @@ std::optional<double> MatchedMoves(const BoundInput& in) {
     }
     set(start, end, 0.0);  // a robot given nothing
   }
-  return MinPerfectMatchingCost(c, size);
+  return PerfectMatchingLowerBound(c, size);
 }
 
 // Sizes up to which the matching (points) and the assignment (units and
-// robots) bounds are computed: both are O(n^3), Boost's blossoms the slower.
-constexpr int kMaxMatching = 300;
+// robots) bounds are computed: both are O(n^3) assignments.
+constexpr int kMaxMatching = 600;
 constexpr int kMaxAssignment = 400;
 
 }  // namespace
@@ -258,7 +260,10 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
   for (int u = 0; u < n; ++u) work += in.fastest_time(u);
   std::optional<double> moves;
   if (2 * (n + k) <= kMaxMatching) moves = MatchedMoves(in);
-  if (!moves && n + k <= kMaxAssignment) moves = AssignedMoves(in);
+  if (n + k <= kMaxAssignment) {
+    const std::optional<double> assigned = AssignedMoves(in);
+    if (assigned && (!moves || *assigned > *moves)) moves = assigned;
+  }
   work += moves.has_value() ? *moves : CheapestEntries(in);
   bound.work_s = std::max(0.0, work) / k;
   // Some robot must drive each unit, from its start and back to its end.

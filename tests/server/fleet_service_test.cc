@@ -248,19 +248,7 @@ TEST_F(FleetServiceTest, StoredRobotPlansAreReplannedAfterARestart) {
   }
 }
 
-// PlanFleet since 690e2ee computes its lower bound with Boost.Graph's
-// maximum_weighted_matching (planner/fleet/assignment.cc), which in Boost
-// 1.74 can loop forever (boostorg/graph#223); it runs beside the search
-// without the stop token, so these requests never return and the server's
-// shutdown waits for them. The two tests below hit it; they run again once
-// the bound is bounded (COVPLAN_RUN_FLEET_HANG_TESTS=1 runs them now).
-bool SkipWhileTheBoundHangs() {
-  const char* run = std::getenv("COVPLAN_RUN_FLEET_HANG_TESTS");
-  return run == nullptr || std::string(run) != "1";
-}
-
 TEST_F(FleetServiceTest, IdleRobotsGetPlansThatAreNotReplanned) {
-  if (SkipWhileTheBoundHangs()) GTEST_SKIP() << "planner/fleet's matching bound hangs here";
   v1::PlanFleetRequest request;
   *request.mutable_plan()->mutable_map() =
       testing::RasterMap(testing::AsciiToPgm(testing::TwoRooms(), 4), 0.1);
@@ -308,7 +296,6 @@ TEST_F(FleetServiceTest, IdleRobotsGetPlansThatAreNotReplanned) {
 // divisions, starts anywhere including walls, some battery robots): each is
 // planned or refused as INVALID_ARGUMENT, and a plan covers every cell.
 TEST_F(FleetServiceTest, RandomFleetsArePlannedOrRefusedNeverFailed) {
-  if (SkipWhileTheBoundHangs()) GTEST_SKIP() << "planner/fleet's matching bound hangs here";
   std::mt19937 rng(5);
   auto uniform = [&rng](double lo, double hi) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);
