@@ -1,5 +1,7 @@
 #include "server/fleet_handlers.h"
 
+#include "server/solve_call.h"
+
 #include <memory>
 #include <string>
 #include <utility>
@@ -29,30 +31,15 @@ std::string FleetDetail(const v1::PlanFleetResponse& response) {
 grpc::ServerUnaryReactor* FleetHandlers::PlanFleet(grpc::CallbackServerContext* context,
                                                    const v1::PlanFleetRequest* request,
                                                    v1::PlanFleetResponse* response) {
-  auto* reactor = new CancellableReactor();
-  CallInfo call;
-  if (!gate_->Open(context, "PlanFleet", reactor, *request, WhileDraining::kRefuse, &call)) {
-    return reactor;
-  }
-  if (absl::Status admitted = admission_->AdmitPlan(call, /*likely_hit=*/false); !admitted.ok()) {
-    gate_->Finish(reactor, call, admitted);
-    return reactor;
-  }
-  auto status = std::make_shared<absl::Status>();
-  SolveAdmission::Task task;
-  task.solve = [this, reactor, call, request, response, status] {
-    admission_->UpdateQueueGauge();
-    *status = RunPlanFleet(call, *request, reactor->cancel(), response);
-  };
-  task.reply = [this, reactor, call, response, status] {
-    gate_->Finish(reactor, call, *status, status->ok() ? FleetDetail(*response) : "");
-    admission_->TrimMemoryIfIdle(absl::Now() - call.start);
-  };
-  task.cut_short = reactor->cancel();
-  const bool queued = admission_->Submit(std::move(task));
-  admission_->UpdateQueueGauge();
-  if (!queued) gate_->Finish(reactor, call, admission_->Full());
-  return reactor;
+  return ServeSolve(
+      gate_, admission_, context, "PlanFleet", *request,
+      [this](const CallInfo& call) { return admission_->AdmitPlan(call, /*likely_hit=*/false); },
+      [this, request, response](const CallInfo& call, const StopToken& cancel,
+                                std::string* detail) {
+        absl::Status status = RunPlanFleet(call, *request, cancel, response);
+        if (status.ok()) *detail = FleetDetail(*response);
+        return status;
+      });
 }
 
 absl::Status FleetHandlers::RunPlanFleet(const CallInfo& call, const v1::PlanFleetRequest& request,

@@ -1,5 +1,7 @@
 #include "server/mission_handlers.h"
 
+#include "server/solve_call.h"
+
 #include <map>
 #include <memory>
 #include <optional>
@@ -98,30 +100,15 @@ v1::PlanRequest OriginFor(v1::PlanRequest origin, const FleetRobot& robot) {
 grpc::ServerUnaryReactor* MissionHandlers::UpdateMission(grpc::CallbackServerContext* context,
                                                          const v1::UpdateMissionRequest* request,
                                                          v1::UpdateMissionResponse* response) {
-  auto* reactor = new CancellableReactor();
-  CallInfo call;
-  if (!gate_->Open(context, "UpdateMission", reactor, *request, WhileDraining::kRefuse, &call)) {
-    return reactor;
-  }
-  if (absl::Status admitted = admission_->AdmitPlan(call, /*likely_hit=*/false); !admitted.ok()) {
-    gate_->Finish(reactor, call, admitted);
-    return reactor;
-  }
-  auto status = std::make_shared<absl::Status>();
-  SolveAdmission::Task task;
-  task.solve = [this, reactor, call, request, response, status] {
-    admission_->UpdateQueueGauge();
-    *status = RunUpdateMission(call, *request, reactor->cancel(), response);
-  };
-  task.reply = [this, reactor, call, response, status] {
-    gate_->Finish(reactor, call, *status, status->ok() ? UpdateDetail(*response) : "");
-    admission_->TrimMemoryIfIdle(absl::Now() - call.start);
-  };
-  task.cut_short = reactor->cancel();
-  const bool queued = admission_->Submit(std::move(task));
-  admission_->UpdateQueueGauge();
-  if (!queued) gate_->Finish(reactor, call, admission_->Full());
-  return reactor;
+  return ServeSolve(
+      gate_, admission_, context, "UpdateMission", *request,
+      [this](const CallInfo& call) { return admission_->AdmitPlan(call, /*likely_hit=*/false); },
+      [this, request, response](const CallInfo& call, const StopToken& cancel,
+                                std::string* detail) {
+        absl::Status status = RunUpdateMission(call, *request, cancel, response);
+        if (status.ok()) *detail = UpdateDetail(*response);
+        return status;
+      });
 }
 
 grpc::ServerUnaryReactor* MissionHandlers::GetMission(grpc::CallbackServerContext* context,

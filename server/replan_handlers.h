@@ -21,6 +21,7 @@
 #include "server/admission.h"
 #include "server/call_gate.h"
 #include "server/replan_work.h"
+#include "server/solve_call.h"
 
 namespace covplan {
 
@@ -36,11 +37,11 @@ class ReplanHandlers {
                                    const v1::ResumeRequest* request, v1::ReplanResponse* response);
 
  private:
-  // A unary solve: the gate, admission, the pool, the reply (with the
-  // detail `work` sets when it succeeds).
-  using Work = std::function<absl::Status(const CallInfo&, const StopToken&, std::string* detail)>;
-  grpc::ServerUnaryReactor* ServeSolve(grpc::CallbackServerContext* context, const char* method,
-                                       const google::protobuf::Message& request, Work work);
+  // A unary solve (server/solve_call.h) admitted with a plain slot.
+  grpc::ServerUnaryReactor* ServeReplanSolve(grpc::CallbackServerContext* context,
+                                             const char* method,
+                                             const google::protobuf::Message& request,
+                                             SolveWork work);
 
   CallGate* const gate_;
   SolveAdmission* const admission_;
