@@ -19,6 +19,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "planner/tour/robot_model.h"
 
 namespace covplan {
 
@@ -63,6 +64,10 @@ absl::StatusOr<T> ParseChoice(const char* flag, const std::string& text,
 // Writes `contents` to `path` (replacing it); InvalidArgument when it cannot
 // be opened, Internal when the write fails.
 absl::Status WriteTextFile(const std::string& path, const std::string& contents);
+
+// "X,Y" or "X,Y,THETA", finite numbers (theta 0 when absent); nullopt
+// otherwise. The pose flags (--start, --end, --robot) read poses with it.
+std::optional<Pose2> ParseXyTheta(const std::string& text);
 
 // `s` as a JSON string literal (quotes, backslashes and control characters escaped).
 std::string JsonString(const std::string& s);

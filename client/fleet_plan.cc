@@ -24,27 +24,6 @@ namespace {
 
 constexpr char kRobotSyntax[] = "[ID=]X,Y[,THETA] (metres, radians)";
 
-// "X,Y" or "X,Y,THETA", finite numbers; nullopt otherwise.
-std::optional<Pose2> ParseXyTheta(const std::string& text) {
-  std::vector<double> v;
-  size_t begin = 0;
-  while (true) {
-    const size_t comma = text.find(',', begin);
-    const std::string part =
-        text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(d)) {
-      return std::nullopt;
-    }
-    v.push_back(d);
-    if (comma == std::string::npos) break;
-    begin = comma + 1;
-  }
-  if (v.size() < 2 || v.size() > 3) return std::nullopt;
-  return Pose2{v[0], v[1], v.size() == 3 ? v[2] : 0.0};
-}
-
 // Non-finite numbers (the closest approach of a single robot) are null.
 std::string JsonNumber(double v) {
   return std::isfinite(v) ? absl::StrFormat("%.10g", v) : std::string("null");

@@ -88,29 +88,14 @@ constexpr char kUsage[] =
 
 // "X,Y" or "X,Y,THETA" (finite numbers) into `pose`.
 absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pose* pose) {
-  std::vector<double> v;
-  size_t begin = 0;
-  while (true) {
-    const size_t comma = text.find(',', begin);
-    const std::string part =
-        text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(d)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "--", flag, " must be X,Y or X,Y,THETA (metres, radians), got '", text, "'"));
-    }
-    v.push_back(d);
-    if (comma == std::string::npos) break;
-    begin = comma + 1;
-  }
-  if (v.size() < 2 || v.size() > 3) {
+  const std::optional<Pose2> p = ParseXyTheta(text);
+  if (!p) {
     return absl::InvalidArgumentError(
         absl::StrCat("--", flag, " must be X,Y or X,Y,THETA (metres, radians), got '", text, "'"));
   }
-  pose->set_x(v[0]);
-  pose->set_y(v[1]);
-  pose->set_theta(v.size() == 3 ? v[2] : 0.0);
+  pose->set_x(p->x);
+  pose->set_y(p->y);
+  pose->set_theta(p->theta);
   return absl::OkStatus();
 }
 
