@@ -78,7 +78,9 @@ TEST(PerfectMatching, TheHalfAssignmentBoundsTheBruteForceMatchingFromBelow) {
       EXPECT_FALSE(std::isfinite(want)) << "trial " << trial;  // no assignment: no matching
     } else {
       EXPECT_LE(*got, want + 1e-9) << "trial " << trial;
-      if (n == 2 && std::isfinite(want)) EXPECT_NEAR(*got, want, 1e-9);  // one edge: exact
+      if (n == 2 && std::isfinite(want)) {
+        EXPECT_NEAR(*got, want, 1e-9);  // one edge: exact
+      }
     }
   }
 }
