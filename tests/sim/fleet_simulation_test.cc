@@ -144,7 +144,9 @@ TEST(FleetSimulation, ThreeRobotsOneFailingAtAThirdOfTheMakespanLeaveNoReachable
   EXPECT_LE(b.finish_s, t_f + 1e-9);
   EXPECT_LE(b.legs[0].run.drive_time_s + b.legs[0].run.stoppage_s, t_f + 1e-6);
   for (size_t i = 0; i < d.left.size(); ++i) {
-    if (b.legs[0].run.swept[i]) ASSERT_FALSE(d.left[i]) << "cell " << i;
+    if (b.legs[0].run.swept[i]) {
+      ASSERT_FALSE(d.left[i]) << "cell " << i;
+    }
   }
   EXPECT_GT(b.swept_cells, 0);
   // The survivors' new plans start where they stood at t_f and together
