@@ -246,8 +246,7 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   } else {
     stoppage = std::max(0.0, compute_s - TimeToFirstEntry(flags));
   }
-  r_.stoppage_s += stoppage;
-  clock_s_ += stoppage;
+  wait_s_ += stoppage;  // waited out by Step, up to the clock bound it is given
   ++r_.num_replans;
   r_.num_encounters += st.num_encounters;
   r_.num_greedy_detours += static_cast<int>(st.greedy_detours.size());
@@ -361,6 +360,14 @@ Pose2 SimulatedDrive::pose() const {
 }
 
 absl::StatusOr<bool> SimulatedDrive::Step(double until_s) {
+  if (wait_s_ > 0.0) {  // waiting for a replan: the clock runs, the robot stands
+    const double waited = std::min(wait_s_, std::max(0.0, until_s - clock_s()));
+    clock_s_ += waited;
+    r_.stoppage_s += waited;
+    wait_s_ -= waited;
+    if (wait_s_ > 1e-12) return false;
+    wait_s_ = 0.0;
+  }
   if (!pending_.empty() && !pending_checked_) {
     if (PendingOnPath()) {
       if (r_.num_replans >= options_.max_replans) {

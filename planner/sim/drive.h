@@ -66,7 +66,10 @@ class SimulatedDrive {
   // Drives on until the run's clock (clock_s) would pass `until_s`, or to the
   // plan's end (or a bound of the options); a later call drives on from
   // there. The robot stops mid-segment at exactly `until_s`, or before a
-  // segment whose turn in place would pass it. Errors as Run.
+  // segment whose turn in place would pass it; a robot waiting for a replan
+  // waits until `until_s` and the rest of the wait carries over to the next
+  // call (Finish drops it: a robot stopped while waiting waited only so
+  // long). Errors as Run.
   absl::Status RunUntil(double until_s);
   // The plan's end (or a bound) was reached: nothing is left to drive.
   bool finished() const { return finished_; }
@@ -131,6 +134,7 @@ class SimulatedDrive {
   bool junction_ = false;     // driven.back() is where a replan cut a segment
   double drive_s_ = 0.0;      // rough drive time, for the time bound
   double clock_s_ = 0.0;      // finished and cut segments (turns included) and stoppage
+  double wait_s_ = 0.0;       // stoppage of the last replan not waited out yet
   bool started_ = false;
   bool finished_ = false;
   int planned_cycles_ = 0;
