@@ -4,6 +4,8 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "covplan/v1/covplan.pb.h"
+#include "server/log.h"
 #include "server/plan_archive.h"
 
 namespace covplan {
@@ -14,9 +16,38 @@ std::string NewMissionId(const std::string& tenant_tag) {
   return absl::StrCat("mission-", id);
 }
 
-void FleetMissions::Put(FleetMission mission) {
-  absl::MutexLock lock(&mu_);
-  if (max_missions_ == 0) return;
+namespace {
+
+std::string Serialized(const FleetMission& m) {
+  v1::GetMissionResponse record;
+  record.set_mission_id(m.mission_id);
+  record.set_map_id(m.map_id);
+  for (size_t i = 0; i < m.robot_ids.size(); ++i) {
+    v1::MissionRobotState* r = record.add_robots();
+    r->set_robot_id(m.robot_ids[i]);
+    r->set_plan_id(i < m.plan_ids.size() ? m.plan_ids[i] : "");
+    r->set_stopped(m.Stopped(i));
+  }
+  return record.SerializeAsString();
+}
+
+std::optional<FleetMission> Parsed(const std::string& mission_id, const std::string& bytes) {
+  v1::GetMissionResponse record;
+  if (!record.ParseFromString(bytes) || record.mission_id() != mission_id) return std::nullopt;
+  FleetMission m;
+  m.mission_id = record.mission_id();
+  m.map_id = record.map_id();
+  for (const v1::MissionRobotState& r : record.robots()) {
+    m.robot_ids.push_back(r.robot_id());
+    m.plan_ids.push_back(r.plan_id());
+    m.stopped.push_back(r.stopped());
+  }
+  return m;
+}
+
+}  // namespace
+
+void FleetMissions::Keep(FleetMission mission) const {
   const std::string id = mission.mission_id;
   if (missions_.insert_or_assign(id, std::move(mission)).second) order_.push_back(id);
   while (order_.size() > max_missions_) {
@@ -25,27 +56,71 @@ void FleetMissions::Put(FleetMission mission) {
   }
 }
 
+void FleetMissions::Store(const std::string& mission_id) const {
+  if (store_ == nullptr) return;
+  absl::MutexLock write(&store_mu_);
+  std::string bytes;
+  {
+    absl::MutexLock lock(&mu_);
+    auto it = missions_.find(mission_id);
+    if (it == missions_.end()) return;  // dropped meanwhile: the stored copy stays
+    bytes = Serialized(it->second);
+  }
+  if (absl::Status s = store_->PutPlan(mission_id, bytes); !s.ok()) {
+    LogLine("warn", "mission not persisted",
+            {{"mission", mission_id}, {"detail", std::string(s.message())}});
+  }
+}
+
+void FleetMissions::Put(FleetMission mission) {
+  if (max_missions_ == 0) return;
+  const std::string id = mission.mission_id;
+  {
+    absl::MutexLock lock(&mu_);
+    Keep(std::move(mission));
+  }
+  Store(id);
+}
+
 std::optional<FleetMission> FleetMissions::Get(const std::string& mission_id) const {
+  {
+    absl::MutexLock lock(&mu_);
+    auto it = missions_.find(mission_id);
+    if (it != missions_.end()) return it->second;
+  }
+  if (store_ == nullptr || max_missions_ == 0 || !absl::StartsWith(mission_id, "mission-")) {
+    return std::nullopt;
+  }
+  absl::StatusOr<std::string> bytes = store_->GetPlan(mission_id);
+  if (!bytes.ok()) return std::nullopt;
+  std::optional<FleetMission> stored = Parsed(mission_id, *bytes);
+  if (!stored.has_value()) {
+    LogLine("warn", "stored mission could not be read", {{"mission", mission_id}});
+    return std::nullopt;
+  }
   absl::MutexLock lock(&mu_);
-  auto it = missions_.find(mission_id);
-  if (it == missions_.end()) return std::nullopt;
-  return it->second;
+  auto it = missions_.find(mission_id);  // another call may have loaded it first
+  if (it != missions_.end()) return it->second;
+  Keep(*stored);
+  return stored;
 }
 
 absl::Status FleetMissions::Update(FleetMission mission,
                                    const std::vector<std::string>& expected_plan_ids) {
-  absl::MutexLock lock(&mu_);
-  auto it = missions_.find(mission.mission_id);
-  if (it == missions_.end()) {
-    return absl::NotFoundError(
-        absl::StrCat("mission ", mission.mission_id, " was dropped while it was updated"));
+  const std::string id = mission.mission_id;
+  {
+    absl::MutexLock lock(&mu_);
+    auto it = missions_.find(id);
+    if (it == missions_.end()) {
+      return absl::NotFoundError(absl::StrCat("mission ", id, " was dropped while it was updated"));
+    }
+    if (it->second.plan_ids != expected_plan_ids) {
+      return absl::AbortedError(absl::StrCat(
+          "mission ", id, " was updated by another call meanwhile; send the update again"));
+    }
+    it->second = std::move(mission);
   }
-  if (it->second.plan_ids != expected_plan_ids) {
-    return absl::AbortedError(absl::StrCat("mission ", mission.mission_id,
-                                           " was updated by another call meanwhile; send the "
-                                           "update again"));
-  }
-  it->second = std::move(mission);
+  Store(id);
   return absl::OkStatus();
 }
 

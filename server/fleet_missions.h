@@ -1,11 +1,13 @@
 // The fleet missions the server planned (PlanFleet): a mission_id names the
 // robots of one fleet plan and the plan_id of each robot's plan (retained
-// and persisted by the PlanArchive like any plan). Kept in memory only,
-// bounded in count, oldest dropped first; UpdateMission replaces a
-// mission's plan ids, marks robots stopped and adds joining ones
-// (server/mission_handlers.h), GetMission reads it.
+// and persisted by the PlanArchive like any plan). Kept in memory, bounded
+// in count (oldest dropped first), and written through to the store beside
+// the plans (MapRepository::PutPlan under the mission id), so a mission
+// survives a restart: Get reads a mission it does not hold from the store.
+// UpdateMission replaces a mission's plan ids, marks robots stopped and adds
+// joining ones (server/mission_handlers.h), GetMission reads it.
 //
-//   FleetMissions missions(/*max_missions=*/1000);
+//   FleetMissions missions(/*max_missions=*/1000, store);
 //   missions.Put({NewMissionId(tenant), map_id, {"r1", "r2"}, {plan_a, plan_b}});
 //   std::optional<FleetMission> m = missions.Get(mission_id);
 //
@@ -23,6 +25,7 @@
 #include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
 #include "absl/synchronization/mutex.h"
+#include "server/map_repository.h"
 
 namespace covplan {
 
@@ -42,21 +45,33 @@ struct FleetMission {
 
 class FleetMissions {
  public:
-  explicit FleetMissions(size_t max_missions) : max_missions_(max_missions) {}
+  // `store` (optional, not owned) keeps the missions across restarts.
+  explicit FleetMissions(size_t max_missions, MapRepository* store = nullptr)
+      : max_missions_(max_missions), store_(store) {}
 
+  // Keeps the mission and writes it to the store (a failed write is logged:
+  // the mission then lives until the restart).
   void Put(FleetMission mission);
+  // From memory, else from the store (then kept in memory again).
   std::optional<FleetMission> Get(const std::string& mission_id) const;
   // Replaces the mission of mission.mission_id if its plan ids are still
   // `expected_plan_ids`: NOT_FOUND once it was dropped, ABORTED when another
-  // update came first.
+  // update came first. Written through to the store.
   absl::Status Update(FleetMission mission, const std::vector<std::string>& expected_plan_ids);
   size_t size() const;
 
  private:
+  void Keep(FleetMission mission) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Writes the mission as memory holds it now (writes in order: the last
+  // one written is the newest state).
+  void Store(const std::string& mission_id) const;
+
   const size_t max_missions_;
+  MapRepository* const store_;
+  mutable absl::Mutex store_mu_ ABSL_ACQUIRED_BEFORE(mu_);
   mutable absl::Mutex mu_;
-  std::deque<std::string> order_ ABSL_GUARDED_BY(mu_);  // oldest first
-  std::unordered_map<std::string, FleetMission> missions_ ABSL_GUARDED_BY(mu_);
+  mutable std::deque<std::string> order_ ABSL_GUARDED_BY(mu_);  // oldest first
+  mutable std::unordered_map<std::string, FleetMission> missions_ ABSL_GUARDED_BY(mu_);
 };
 
 }  // namespace covplan

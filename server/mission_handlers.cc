@@ -28,8 +28,8 @@ namespace {
 absl::Status MissionNotFound(const std::string& mission_id) {
   return absl::NotFoundError(
       absl::StrCat("mission ", QuotePrefix(mission_id),
-                   " not found (missions live in the server's memory: a restarted server has "
-                   "forgotten them; plan the fleet again)"));
+                   " not found (never planned here, another tenant's, or trimmed from the store "
+                   "with old plans; plan the fleet again)"));
 }
 
 absl::Status Invalid(int j, absl::string_view field, absl::string_view message) {

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstdlib>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "api/convert.h"
@@ -99,6 +100,8 @@ std::shared_ptr<const RetainedPlan> PlanArchive::Find(const std::string& plan_id
     }
     return in_memory;
   }
+  // Missions are stored beside the plans (FleetMissions): not a plan.
+  if (absl::StartsWith(plan_id, "mission-")) return nullptr;
   absl::StatusOr<std::string> bytes = store_->GetPlan(plan_id);
   v1::InlinePlan record;
   const bool stored = bytes.ok() && record.ParseFromString(*bytes);

@@ -18,7 +18,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       maps_(options_, store, &cache_, metrics, &gate_, &admission_, &io_pool_, &read_pool_),
       plans_(options_, store, metrics, &engine_, &gate_, &admission_, &served_, &archive_,
              &warm_pool_, background_stop_),
-      missions_(4 * options.max_retained_plans + 16),
+      missions_(4 * options.max_retained_plans + 16, store),
       fleets_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &missions_),
       missions_rpc_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &progress_,
                     &missions_),

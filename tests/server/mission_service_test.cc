@@ -5,7 +5,7 @@
 // the progress its Drive session recorded); the mission then shows b stopped and a, c on
 // their new plans, which GetPlan returns. A joining robot gets a share;
 // unknown missions are NOT_FOUND, unknown robots INVALID_ARGUMENT naming
-// the field.
+// the field. A mission and its updates survive a server restart.
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -43,11 +43,7 @@ class MissionServiceTest : public ::testing::Test {
     config.port = 0;
     config.metrics_port = -1;
     config.store_dir = dir_ + "/maps";
-    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = std::move(*server);
-    stub_ = v1::CoveragePlanner::NewStub(grpc::CreateChannel(
-        absl::StrCat("127.0.0.1:", server_->port()), grpc::InsecureChannelCredentials()));
+    ASSERT_NO_FATAL_FAILURE(StartServer(config));
     absl::StatusOr<v1::Map> map =
         MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
                          MapFileOverrides(), EngineLimits());
@@ -58,6 +54,20 @@ class MissionServiceTest : public ::testing::Test {
     v1::PutMapResponse stored;
     ASSERT_TRUE(stub_->PutMap(&context, put, &stored).ok());
     map_id_ = stored.map_id();
+  }
+  void StartServer(const ServerConfig& config) {
+    config_ = config;
+    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = std::move(*server);
+    stub_ = v1::CoveragePlanner::NewStub(grpc::CreateChannel(
+        absl::StrCat("127.0.0.1:", server_->port()), grpc::InsecureChannelCredentials()));
+  }
+  // Stops the server (its I/O pool finishes its writes) and starts another on
+  // the same store.
+  void Restart() {
+    server_.reset();
+    StartServer(config_);
   }
   void TearDown() override {
     server_.reset();
@@ -105,6 +115,7 @@ class MissionServiceTest : public ::testing::Test {
     return stub_->GetPlan(&context, get, out);
   }
 
+  ServerConfig config_;
   std::string dir_;
   std::string map_id_;
   std::unique_ptr<CovplanServer> server_;
@@ -191,6 +202,48 @@ TEST_F(MissionServiceTest, AStoppedRobotsRemainderGoesToTheOthers) {
   status = Update(again, &updated);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("robots[0].robot_id"));
+}
+
+TEST_F(MissionServiceTest, AMissionAndItsUpdatesSurviveARestart) {
+  PlanThree();
+  ASSERT_NO_FATAL_FAILURE(Restart());
+  v1::GetMissionResponse mission;
+  grpc::Status status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(mission.map_id(), map_id_);
+  ASSERT_EQ(mission.robots_size(), 3);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(mission.robots(i).robot_id(), fleet_.robots(i).id());
+    EXPECT_EQ(mission.robots(i).plan_id(), fleet_.robots(i).plan().plan_id());
+    EXPECT_FALSE(mission.robots(i).stopped());
+  }
+  // The restarted server redivides it: b stops half-way along its plan.
+  const v1::PlanResponse& b = fleet_.robots(1).plan();
+  const int k = std::max(1, b.path_size() / 2);
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* stop = update.add_robots();
+  stop->set_robot_id("b");
+  stop->set_stopped(true);
+  stop->mutable_progress()->set_waypoint(k);
+  stop->mutable_progress()->mutable_position()->set_x(b.path(k - 1).x());
+  stop->mutable_progress()->mutable_position()->set_y(b.path(k - 1).y());
+  v1::UpdateMissionResponse updated;
+  status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(updated.robots_size(), 2);
+  EXPECT_GT(updated.handed_over_cells(), 0);
+  // And the update survives the next restart.
+  ASSERT_NO_FATAL_FAILURE(Restart());
+  status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(mission.robots_size(), 3);
+  EXPECT_EQ(mission.robots(0).plan_id(), updated.robots(0).plan().plan_id());
+  EXPECT_TRUE(mission.robots(1).stopped());
+  EXPECT_EQ(mission.robots(2).plan_id(), updated.robots(1).plan().plan_id());
+  // A mission id is not a plan id.
+  v1::PlanResponse plan;
+  EXPECT_EQ(GetPlan(fleet_.mission_id(), &plan).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
 TEST_F(MissionServiceTest, AJoiningRobotGetsAShare) {
