@@ -20,13 +20,15 @@ class RefusedDrive final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
 }  // namespace
 
 DriveHandler::DriveHandler(const ServiceOptions& options, ServerMetrics* metrics, CallGate* gate,
-                           SolveAdmission* admission, ReplanWork* work, ProgressLog* progress)
+                           SolveAdmission* admission, ReplanWork* work, ProgressLog* progress,
+                           FleetMissions* missions)
     : options_(options),
       metrics_(metrics),
       gate_(gate),
       admission_(admission),
       work_(work),
       progress_(progress),
+      missions_(missions),
       sessions_(options.max_sessions, options.session_idle) {}
 
 grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* DriveHandler::Drive(
@@ -69,7 +71,7 @@ absl::Status DriveHandler::Replan(const std::string& request_id, const std::stri
                                   const v1::ReplanRequest& request, const StopToken& stop,
                                   v1::ReplanResponse* response) {
   CallInfo call;
-  call.method = "Drive.Replan";
+  call.method = kDriveReplan.data();
   call.start = absl::Now();
   call.request_id = request_id;
   call.tenant_tag = tenant_tag;
@@ -88,6 +90,40 @@ bool DriveHandler::SubmitSolve(std::function<void()> work) {
 
 void DriveHandler::RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) {
   progress_->Record(plan_id, progress);
+}
+
+std::optional<v1::RobotProgress> DriveHandler::RecordedProgress(const std::string& plan_id) {
+  return progress_->Recorded(plan_id);
+}
+
+void DriveHandler::ShareObstacles(const std::string& plan_id, const v1::Obstacles& obstacles) {
+  if (missions_ == nullptr) return;
+  std::optional<std::pair<FleetMission, size_t>> found = missions_->MissionOfPlan(plan_id);
+  if (!found.has_value()) return;
+  const auto& [mission, from] = *found;
+  v1::MissionNotice notice;
+  notice.set_mission_id(mission.mission_id);
+  notice.set_cause(v1::MissionNotice::SHARED_OBSTACLE);
+  notice.set_from_robot(mission.robot_ids[from]);
+  for (size_t i = 0; i < mission.plan_ids.size(); ++i) {
+    if (i == from || mission.Stopped(i)) continue;
+    if (DriveSession* session = sessions_.Find(mission.plan_ids[i])) {
+      session->ShareObservation(mission.plan_ids[i], obstacles, notice);
+      session->Unref();
+    }
+  }
+}
+
+void DriveHandler::PlanAdopted(const std::string& previous, const std::string& plan_id) {
+  if (missions_ != nullptr && !previous.empty()) missions_->ReplacePlan(previous, plan_id);
+}
+
+bool DriveHandler::PushMissionPlan(const std::string& old_plan_id, const v1::DriveEvent& event) {
+  DriveSession* session = sessions_.Find(old_plan_id);
+  if (session == nullptr) return false;
+  const bool taken = session->PushMissionPlan(old_plan_id, event);
+  session->Unref();
+  return taken;
 }
 
 void DriveHandler::CountSuperseded() { metrics_->drive_superseded().Increment(); }

@@ -20,6 +20,7 @@
 #include "server/call_gate.h"
 #include "server/drive_host.h"
 #include "server/drive_session.h"
+#include "server/fleet_missions.h"
 #include "server/metrics.h"
 #include "server/progress_log.h"
 #include "server/replan_work.h"
@@ -31,13 +32,18 @@ class DriveHandler final : public DriveHost {
  public:
   // Every pointer outlives this.
   DriveHandler(const ServiceOptions& options, ServerMetrics* metrics, CallGate* gate,
-               SolveAdmission* admission, ReplanWork* work, ProgressLog* progress);
+               SolveAdmission* admission, ReplanWork* work, ProgressLog* progress,
+               FleetMissions* missions);
 
   grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* Drive(
       grpc::CallbackServerContext* context);
   // Ends every open session with UNAVAILABLE (the server is draining).
   void EndAll() { sessions_.EndAll(); }
   const SessionRegistry& sessions() const { return sessions_; }
+  // Pushes a fleet mission's new plan onto the Drive session of the robot
+  // that drives `old_plan_id` (if one is open and still drives it). False
+  // when no session took it.
+  bool PushMissionPlan(const std::string& old_plan_id, const v1::DriveEvent& event);
 
  private:
   // DriveHost, for the sessions only.
@@ -48,6 +54,9 @@ class DriveHandler final : public DriveHost {
                       v1::ReplanResponse* response) override;
   bool SubmitSolve(std::function<void()> work) override;
   void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) override;
+  std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id) override;
+  void ShareObstacles(const std::string& plan_id, const v1::Obstacles& obstacles) override;
+  void PlanAdopted(const std::string& previous, const std::string& plan_id) override;
   void CountSuperseded() override;
   void UpdateSessionGauge() override;
 
@@ -57,6 +66,7 @@ class DriveHandler final : public DriveHost {
   SolveAdmission* const admission_;
   ReplanWork* const work_;
   ProgressLog* const progress_;
+  FleetMissions* const missions_;
   SessionRegistry sessions_;
 };
 

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/status.h"
@@ -49,6 +50,17 @@ class DriveHost {
   virtual bool SubmitSolve(std::function<void()> work) = 0;
   // The robot's latest progress on a plan, kept for Resume.
   virtual void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) = 0;
+  // The latest progress recorded for a plan (Drive, Replan), if any.
+  virtual std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id) {
+    return std::nullopt;
+  }
+  // Obstacles a session's robot reported while driving `plan_id`: shared
+  // with the other robots of its fleet mission, if it has one (called
+  // without any session's lock held).
+  virtual void ShareObstacles(const std::string& plan_id, const v1::Obstacles& obstacles) {}
+  // The session's robot drives `plan_id` now instead of `previous` (a
+  // replan or a mission's plan pushed): its fleet mission follows.
+  virtual void PlanAdopted(const std::string& previous, const std::string& plan_id) {}
   // A replan whose result a newer observation made stale.
   virtual void CountSuperseded() = 0;
   // Sets the open-sessions gauge (a session ended).

@@ -28,6 +28,9 @@ struct DriveSession::Actions {
   bool read = false;
   bool finish = false;
   grpc::Status status;
+  std::string share_plan;  // obstacles seen on this plan, for the mission
+  v1::Obstacles share;
+  std::vector<std::pair<std::string, std::string>> adopted;  // previous plan, new plan
 };
 
 DriveSession::DriveSession(DriveHost* host, grpc::CallbackServerContext* context,
@@ -48,6 +51,8 @@ void DriveSession::Start() {
 }
 
 void DriveSession::Perform(const Actions& a) {
+  for (const auto& [previous, plan_id] : a.adopted) host_->PlanAdopted(previous, plan_id);
+  if (!a.share_plan.empty()) host_->ShareObstacles(a.share_plan, a.share);
   if (a.write != nullptr) StartWrite(a.write);
   if (a.read) StartRead(&in_);
   if (a.finish) Finish(a.status);  // may delete this (through OnDone): last
@@ -195,7 +200,10 @@ void DriveSession::HandleMessage(Actions* a) {
     }
     first_ = in_;
     first_.clear_obstacles();
-    pending_ = Job{/*start=*/true, seq, "", {}, v1::REPLAN_METHOD_UNSPECIFIED, {}};
+    Job job;
+    job.start = true;
+    job.sequence = seq;
+    pending_ = std::move(job);
     StartJob(a);
     if (ObstacleItems(in_.obstacles()) == 0) return;
     // Obstacles in the first message: replanned once the plan is adopted.
@@ -243,18 +251,92 @@ void DriveSession::HandleMessage(Actions* a) {
   }
   seen_.MergeFrom(in_.obstacles());
   seen_items_ += items;
-  Job job{/*start=*/false, seq, plan_id, in_.progress(), in_.method(), {}};
+  Job job;
+  job.sequence = seq;
+  job.plan_id = plan_id;
+  job.progress = in_.progress();
+  job.method = in_.method();
+  Enqueue(std::move(job), /*keep_running=*/false, a);
+  // The other robots of its fleet mission learn of them (after the lock).
+  a->share_plan = plans_.empty() ? first_.plan_id() : plans_.back();
+  a->share = in_.obstacles();
+}
+
+void DriveSession::Enqueue(Job job, bool keep_running, Actions* a) {
+  job.generation = generation_;
   if (pending_.has_value() && !pending_->start) {
     job.superseded = std::move(pending_->superseded);
-    job.superseded.push_back(pending_->sequence);
+    if (pending_->sequence != 0) job.superseded.push_back(pending_->sequence);
     pending_.reset();
   }
   if (running_ && !running_start_) {
-    running_stop_.Cancel();  // superseded: its result will not be pushed
-    job.superseded.push_back(running_sequence_);
+    // Superseded: its result will not be pushed (a kept one still records
+    // the robot's progress, which `job` may start from).
+    if (!keep_running) running_stop_.Cancel();
+    if (running_sequence_ != 0) job.superseded.push_back(running_sequence_);
   }
   pending_ = std::move(job);
   if (!running_) StartJob(a);
+}
+
+void DriveSession::Adopt(const std::string& plan_id) {
+  const std::string previous = plans_.empty() ? "" : plans_.back();
+  plans_.push_back(plan_id);
+  while (plans_.size() > kMaxSessionPlans) plans_.pop_front();
+  registry_->Track(this, previous, plan_id);
+}
+
+bool DriveSession::PushMissionPlan(const std::string& plan_id, const v1::DriveEvent& event) {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    if (ending_ || !adopted_ || plans_.empty() || plans_.back() != plan_id) return false;
+    ++generation_;  // results of jobs queued before are stale now
+    if (running_ && !running_start_) running_stop_.Cancel();
+    std::vector<uint64_t> superseded;
+    if (pending_.has_value()) {
+      superseded = std::move(pending_->superseded);
+      if (pending_->sequence != 0) superseded.push_back(pending_->sequence);
+      pending_.reset();
+    }
+    const std::string& fresh = event.replan().plan().plan_id();
+    Adopt(fresh);
+    v1::DriveEvent pushed = event;
+    pushed.set_sequence(0);
+    for (uint64_t s : superseded) pushed.add_superseded(s);
+    Push(std::move(pushed), &a);
+    if (seen_items_ > 0) {  // the new plan does not know what this robot saw
+      Job job;
+      job.plan_id = fresh;
+      job.notice = event.mission();
+      Enqueue(std::move(job), /*keep_running=*/true, &a);
+    }
+    CheckFinish(&a);
+  }
+  Perform(a);
+  return true;
+}
+
+void DriveSession::ShareObservation(const std::string& plan_id, const v1::Obstacles& obstacles,
+                                    const v1::MissionNotice& notice) {
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    if (ending_ || !adopted_ || plans_.empty() || plans_.back() != plan_id) return;
+    const int items = ObstacleItems(obstacles);
+    if (items == 0 || seen_items_ + items > kMaxObstacleItems) return;
+    if (!CheckObservation(obstacles).ok()) return;
+    seen_.MergeFrom(obstacles);
+    seen_items_ += items;
+    // A replan of the robot's own observation waits: it takes these along.
+    if (pending_.has_value() && !pending_->start) return;
+    Job job;
+    job.plan_id = plan_id;
+    job.notice = notice;
+    Enqueue(std::move(job), /*keep_running=*/true, &a);
+    CheckFinish(&a);
+  }
+  Perform(a);
 }
 
 absl::Status DriveSession::CheckObservation(const v1::Obstacles& obstacles) const {
@@ -320,6 +402,14 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     v1::ReplanRequest request;
     request.set_plan_id(job.plan_id);
     *request.mutable_progress() = job.progress;
+    if (job.notice.has_value()) {  // a mission's job: where the robot last reported it was
+      std::optional<v1::RobotProgress> recorded = host_->RecordedProgress(job.plan_id);
+      if (recorded.has_value()) {
+        *request.mutable_progress() = *recorded;
+      } else {
+        request.mutable_progress()->set_distance_m(0.0);  // not started
+      }
+    }
     *request.mutable_obstacles() = seen;
     request.set_method(job.method != v1::REPLAN_METHOD_UNSPECIFIED ? job.method : first.method());
     request.set_seed(first.seed());
@@ -336,17 +426,27 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
       } else {
         adopted_ = true;
         grid_ = grid;
-        plans_.push_back(adopted);
+        Adopt(adopted);
         Push(std::move(event), &a);
       }
-    } else if (pending_.has_value()) {
-      host_->CountSuperseded();  // a newer observation waits: this result is stale
+    } else if (pending_.has_value() || job.generation != generation_) {
+      host_->CountSuperseded();  // a newer observation waits, or a mission pushed a plan
     } else if (!status.ok()) {
-      PushError(job.sequence, status, &a);
+      if (job.notice.has_value() && job.superseded.empty()) {
+        LogLine("warn", "mission replan failed",
+                {{"session", session_id_}, {"detail", std::string(status.message())}});
+      } else {
+        PushError(job.sequence, status, &a);
+      }
+    } else if (job.notice.has_value() && job.superseded.empty() &&
+               job.notice->cause() == v1::MissionNotice::SHARED_OBSTACLE &&
+               event.replan().replan().num_encounters() == 0) {
+      // Another robot's obstacles do not touch this robot's remaining path.
     } else {
-      plans_.push_back(event.replan().plan().plan_id());
-      while (plans_.size() > kMaxSessionPlans) plans_.pop_front();
+      a.adopted.emplace_back(plans_.back(), event.replan().plan().plan_id());
+      Adopt(event.replan().plan().plan_id());
       for (uint64_t s : job.superseded) event.add_superseded(s);
+      if (job.notice.has_value()) *event.mutable_mission() = *job.notice;
       Push(std::move(event), &a);
     }
     StartJob(&a);
@@ -378,6 +478,27 @@ bool SessionRegistry::Add(DriveSession* session) {
 void SessionRegistry::Remove(DriveSession* session) {
   absl::MutexLock lock(&mu_);
   sessions_.erase(session);
+  for (auto it = by_plan_.begin(); it != by_plan_.end();) {
+    it = it->second == session ? by_plan_.erase(it) : std::next(it);
+  }
+}
+
+DriveSession* SessionRegistry::Find(const std::string& plan_id) {
+  absl::MutexLock lock(&mu_);
+  auto it = by_plan_.find(plan_id);
+  if (it == by_plan_.end()) return nullptr;
+  it->second->Ref();
+  return it->second;
+}
+
+void SessionRegistry::Track(DriveSession* session, const std::string& previous,
+                            const std::string& plan_id) {
+  absl::MutexLock lock(&mu_);
+  if (!sessions_.count(session)) return;  // removed (or never admitted)
+  if (auto it = by_plan_.find(previous); it != by_plan_.end() && it->second == session) {
+    by_plan_.erase(it);
+  }
+  by_plan_[plan_id] = session;
 }
 
 int SessionRegistry::size() const {

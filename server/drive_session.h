@@ -28,6 +28,7 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -70,6 +71,19 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   // Ends the session with `status` (server draining).
   void End(const grpc::Status& status);
 
+  // Fleet missions (server/drive_handler.h). Both act only while the
+  // session's newest plan is `plan_id` (the robot drives it).
+  // A new plan UpdateMission made for this robot: pushed as is (sequence
+  // 0, `mission` set); a replan of this session still running is dropped,
+  // and when the session has seen obstacles the new plan is replanned
+  // around them at once. False when the session does not drive `plan_id`.
+  bool PushMissionPlan(const std::string& plan_id, const v1::DriveEvent& event);
+  // Obstacles another robot of the mission saw: merged into this session's
+  // and replanned from the robot's recorded progress; the new plan is pushed
+  // (with `notice`) only when the obstacles touch its remaining path.
+  void ShareObservation(const std::string& plan_id, const v1::Obstacles& obstacles,
+                        const v1::MissionNotice& notice);
+
   void Ref() { refs_.fetch_add(1); }
   void Unref() {
     if (refs_.fetch_sub(1) == 1) delete this;
@@ -83,6 +97,10 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
     v1::RobotProgress progress;
     v1::ReplanMethod method = v1::REPLAN_METHOD_UNSPECIFIED;  // unset: the session's
     std::vector<uint64_t> superseded;
+    // A mission's job: from the progress recorded for plan_id (not
+    // `progress`), pushed with this notice, and only if the plan changed.
+    std::optional<v1::MissionNotice> notice;
+    uint64_t generation = 0;  // the session's generation when it was queued
   };
   struct Actions;
 
@@ -94,6 +112,11 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   bool KnowsPlan(const std::string& plan_id) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void StartJob(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Queues `job`, superseding a queued one (and cancelling a running one of
+  // the robot's own observations unless `keep_running`).
+  void Enqueue(Job job, bool keep_running, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // The session drives `plan_id` now (newest last; the registry's index).
+  void Adopt(const std::string& plan_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen,
               const StopToken& stop);
   void Push(v1::DriveEvent event, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -127,6 +150,8 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   v1::Obstacles seen_ ABSL_GUARDED_BY(mu_);
   int seen_items_ ABSL_GUARDED_BY(mu_) = 0;
   std::optional<Job> pending_ ABSL_GUARDED_BY(mu_);
+  // Raised when a mission pushes a plan: results of jobs queued before are stale.
+  uint64_t generation_ ABSL_GUARDED_BY(mu_) = 0;
   bool running_ ABSL_GUARDED_BY(mu_) = false;
   bool running_start_ ABSL_GUARDED_BY(mu_) = false;
   uint64_t running_sequence_ ABSL_GUARDED_BY(mu_) = 0;
@@ -148,6 +173,11 @@ class SessionRegistry {
   bool Add(DriveSession* session);
   void Remove(DriveSession* session);
   int size() const;
+  // The session whose newest plan is `plan_id`, with a reference the caller
+  // drops (Unref); null when none.
+  DriveSession* Find(const std::string& plan_id);
+  // `session` drives `plan_id` now instead of `previous` ("" = none).
+  void Track(DriveSession* session, const std::string& previous, const std::string& plan_id);
   absl::Duration idle_timeout() const { return idle_timeout_; }
   // Ends every open session with UNAVAILABLE (the server is draining).
   void EndAll();
@@ -161,6 +191,7 @@ class SessionRegistry {
   const absl::Duration idle_timeout_;
   mutable absl::Mutex mu_;
   std::set<DriveSession*> sessions_ ABSL_GUARDED_BY(mu_);
+  std::map<std::string, DriveSession*> by_plan_ ABSL_GUARDED_BY(mu_);  // newest plan -> session
   bool stop_ ABSL_GUARDED_BY(mu_) = false;
   std::thread reaper_;
 };

@@ -47,13 +47,68 @@ std::optional<FleetMission> Parsed(const std::string& mission_id, const std::str
 
 }  // namespace
 
+void FleetMissions::Index(const FleetMission& m) const {
+  for (const std::string& plan_id : m.plan_ids) {
+    if (!plan_id.empty()) mission_of_plan_[plan_id] = m.mission_id;
+  }
+}
+
+void FleetMissions::Unindex(const FleetMission& m) const {
+  for (const std::string& plan_id : m.plan_ids) {
+    auto it = mission_of_plan_.find(plan_id);
+    if (it != mission_of_plan_.end() && it->second == m.mission_id) mission_of_plan_.erase(it);
+  }
+}
+
 void FleetMissions::Keep(FleetMission mission) const {
   const std::string id = mission.mission_id;
-  if (missions_.insert_or_assign(id, std::move(mission)).second) order_.push_back(id);
+  auto it = missions_.find(id);
+  if (it != missions_.end()) {
+    Unindex(it->second);
+    it->second = std::move(mission);
+  } else {
+    it = missions_.emplace(id, std::move(mission)).first;
+    order_.push_back(id);
+  }
+  Index(it->second);
   while (order_.size() > max_missions_) {
-    missions_.erase(order_.front());
+    auto oldest = missions_.find(order_.front());
+    if (oldest != missions_.end()) {
+      Unindex(oldest->second);
+      missions_.erase(oldest);
+    }
     order_.pop_front();
   }
+}
+
+std::optional<std::pair<FleetMission, size_t>> FleetMissions::MissionOfPlan(
+    const std::string& plan_id) const {
+  absl::MutexLock lock(&mu_);
+  auto id = mission_of_plan_.find(plan_id);
+  if (id == mission_of_plan_.end()) return std::nullopt;
+  const FleetMission& m = missions_.at(id->second);
+  for (size_t i = 0; i < m.plan_ids.size(); ++i) {
+    if (m.plan_ids[i] == plan_id) return std::make_pair(m, i);
+  }
+  return std::nullopt;
+}
+
+bool FleetMissions::ReplacePlan(const std::string& old_plan_id, const std::string& new_plan_id) {
+  std::string mission_id;
+  {
+    absl::MutexLock lock(&mu_);
+    auto id = mission_of_plan_.find(old_plan_id);
+    if (id == mission_of_plan_.end()) return false;
+    mission_id = id->second;
+    FleetMission& m = missions_.at(mission_id);
+    for (std::string& plan_id : m.plan_ids) {
+      if (plan_id == old_plan_id) plan_id = new_plan_id;
+    }
+    mission_of_plan_.erase(id);
+    mission_of_plan_[new_plan_id] = mission_id;
+  }
+  Store(mission_id);
+  return true;
 }
 
 void FleetMissions::Store(const std::string& mission_id) const {
@@ -118,7 +173,7 @@ absl::Status FleetMissions::Update(FleetMission mission,
       return absl::AbortedError(absl::StrCat(
           "mission ", id, " was updated by another call meanwhile; send the update again"));
     }
-    it->second = std::move(mission);
+    Keep(std::move(mission));
   }
   Store(id);
   return absl::OkStatus();

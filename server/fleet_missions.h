@@ -20,6 +20,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
@@ -60,7 +61,18 @@ class FleetMissions {
   absl::Status Update(FleetMission mission, const std::vector<std::string>& expected_plan_ids);
   size_t size() const;
 
+  // The mission (held in memory) whose robot currently drives `plan_id`, and
+  // that robot's index in it.
+  std::optional<std::pair<FleetMission, size_t>> MissionOfPlan(const std::string& plan_id) const;
+  // A robot of a mission drives a replanned plan now (a Drive session or
+  // Replan replaced `old_plan_id`): the mission follows it, so a later
+  // UpdateMission redivides from the plan the robot really drives. False when
+  // no mission (in memory) holds `old_plan_id`.
+  bool ReplacePlan(const std::string& old_plan_id, const std::string& new_plan_id);
+
  private:
+  void Index(const FleetMission& m) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void Unindex(const FleetMission& m) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void Keep(FleetMission mission) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // Writes the mission as memory holds it now (writes in order: the last
   // one written is the newest state).
@@ -72,6 +84,8 @@ class FleetMissions {
   mutable absl::Mutex mu_;
   mutable std::deque<std::string> order_ ABSL_GUARDED_BY(mu_);  // oldest first
   mutable std::unordered_map<std::string, FleetMission> missions_ ABSL_GUARDED_BY(mu_);
+  // plan_id -> mission_id, for the plans the missions in memory hold.
+  mutable std::unordered_map<std::string, std::string> mission_of_plan_ ABSL_GUARDED_BY(mu_);
 };
 
 }  // namespace covplan

@@ -342,7 +342,27 @@ absl::Status MissionHandlers::KeepPlans(const CallInfo& call, const FleetMission
     archive_->Put(std::move(retained));
   }
   archive_->PublishRetainedCount();
-  return missions_->Update(std::move(updated), mission.plan_ids);
+  std::vector<std::string> old_plan_ids = mission.plan_ids;
+  RETURN_IF_ERROR(missions_->Update(std::move(updated), mission.plan_ids));
+  PushPlans(mission, old_plan_ids, *response);
+  return absl::OkStatus();
+}
+
+void MissionHandlers::PushPlans(const FleetMission& mission,
+                                const std::vector<std::string>& old_plan_ids,
+                                const v1::UpdateMissionResponse& response) {
+  if (drive_ == nullptr) return;
+  for (const v1::FleetRobotPlan& robot : response.robots()) {
+    size_t i = 0;
+    while (i < mission.robot_ids.size() && mission.robot_ids[i] != robot.id()) ++i;
+    if (i >= old_plan_ids.size() || robot.plan().plan_id().empty()) continue;  // joined now
+    v1::DriveEvent event;
+    *event.mutable_replan()->mutable_plan() = robot.plan();
+    event.mutable_replan()->mutable_replan()->set_method("mission/redivided");
+    event.mutable_mission()->set_mission_id(mission.mission_id);
+    event.mutable_mission()->set_cause(v1::MissionNotice::REDIVIDED);
+    drive_->PushMissionPlan(old_plan_ids[i], event);
+  }
 }
 
 }  // namespace covplan

@@ -35,6 +35,7 @@
 #include "planner/fleet/mission.h"
 #include "server/admission.h"
 #include "server/call_gate.h"
+#include "server/drive_handler.h"
 #include "server/fleet_missions.h"
 #include "server/map_repository.h"
 #include "server/metrics.h"
@@ -49,7 +50,8 @@ class MissionHandlers {
   // Every pointer outlives this.
   MissionHandlers(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics,
                   const PlanningEngine* engine, CallGate* gate, SolveAdmission* admission,
-                  PlanArchive* archive, ProgressLog* progress, FleetMissions* missions)
+                  PlanArchive* archive, ProgressLog* progress, FleetMissions* missions,
+                  DriveHandler* drive = nullptr)
       : options_(options),
         store_(store),
         metrics_(metrics),
@@ -58,7 +60,8 @@ class MissionHandlers {
         admission_(admission),
         archive_(archive),
         progress_(progress),
-        missions_(missions) {}
+        missions_(missions),
+        drive_(drive) {}
 
   grpc::ServerUnaryReactor* UpdateMission(grpc::CallbackServerContext* context,
                                           const v1::UpdateMissionRequest* request,
@@ -90,6 +93,10 @@ class MissionHandlers {
   // mission's new state.
   absl::Status KeepPlans(const CallInfo& call, const FleetMission& mission, const Roster& roster,
                          MissionRedivision* redivision, v1::UpdateMissionResponse* response);
+  // Pushes each robot's new plan onto its open Drive session, if it still
+  // drives the plan the mission held (old_plan_ids[i] for robot i).
+  void PushPlans(const FleetMission& mission, const std::vector<std::string>& old_plan_ids,
+                 const v1::UpdateMissionResponse& response);
 
   const ServiceOptions& options_;
   MapRepository* const store_;
@@ -100,6 +107,7 @@ class MissionHandlers {
   PlanArchive* const archive_;
   ProgressLog* const progress_;
   FleetMissions* const missions_;
+  DriveHandler* const drive_;  // may be null: new plans are pushed onto open Drive sessions
 };
 
 }  // namespace covplan

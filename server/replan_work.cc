@@ -22,14 +22,15 @@ std::string ReplanDetail(const v1::ReplanResponse& r) {
 
 ReplanWork::ReplanWork(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics,
                        const PlanningEngine* engine, PlanArchive* archive, ProgressLog* progress,
-                       const SolveAdmission* admission)
+                       const SolveAdmission* admission, FleetMissions* missions)
     : options_(options),
       store_(store),
       metrics_(metrics),
       engine_(engine),
       archive_(archive),
       progress_(progress),
-      admission_(admission) {}
+      admission_(admission),
+      missions_(missions) {}
 
 absl::StatusOr<ReplanOptions> ReplanWork::OptionsFor(const CallInfo& call, v1::ReplanMethod method,
                                                      uint64_t seed, const StopToken& cancel,
@@ -72,7 +73,8 @@ absl::Status ReplanWork::RunReplan(const CallInfo& call, const v1::ReplanRequest
                                    options, archive_->mutable_estimator()));
   if (request.plan_ref_case() == v1::ReplanRequest::kPlanId)
     progress_->Record(request.plan_id(), request.progress());
-  KeepReplan(std::move(result), old, call.tenant_tag, response);
+  KeepReplan(std::move(result), old, call.tenant_tag, response,
+             /*mission_follows=*/absl::string_view(call.method) != kDriveReplan);
   return absl::OkStatus();
 }
 
@@ -120,7 +122,7 @@ absl::Status ReplanWork::RunResume(const CallInfo& call, const v1::ResumeRequest
                      ") no longer fits it: ", result.status().message()));
   }
   progress_->Record(request.plan_id(), at);
-  KeepReplan(std::move(*result), old, call.tenant_tag, response);
+  KeepReplan(std::move(*result), old, call.tenant_tag, response, /*mission_follows=*/true);
   response->mutable_replan()->set_progress_source(source);
   response->mutable_replan()->set_rejoin_m(rejoin_m);
   return absl::OkStatus();
@@ -161,7 +163,8 @@ absl::Status ReplanWork::ResolvePlan(const std::string& tenant_tag, const std::s
 }
 
 void ReplanWork::KeepReplan(ReplanResult result, const ResolvedPlan& old,
-                            const std::string& tenant_tag, v1::ReplanResponse* response) {
+                            const std::string& tenant_tag, v1::ReplanResponse* response,
+                            bool mission_follows) {
   auto retained = std::make_shared<RetainedPlan>();
   retained->plan_id = NewPlanId(tenant_tag);
   retained->map_id = old.plan->map_id;
@@ -171,6 +174,11 @@ void ReplanWork::KeepReplan(ReplanResult result, const ResolvedPlan& old,
   result.plan = retained->plan;
   ReplanToProto(result, *retained, response);
   if (old.has_origin) archive_->Persist(old.origin, response->plan());
+  // A robot of a fleet mission drives the new plan now: the mission follows
+  // (a Drive session's replan only once the session adopts it).
+  if (missions_ != nullptr && mission_follows) {
+    missions_->ReplacePlan(old.plan->plan_id, retained->plan_id);
+  }
   archive_->Put(retained);
   archive_->PublishRetainedCount();
   metrics_->RecordReplan(result.stats.method, result.stats.total_ms * 1e-3,

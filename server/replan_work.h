@@ -17,6 +17,7 @@
 #include <memory>
 #include <string>
 
+#include "absl/strings/string_view.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "covplan/v1/covplan.pb.h"
@@ -26,6 +27,7 @@
 #include "server/admission.h"
 #include "server/call_info.h"
 #include "server/drive_host.h"
+#include "server/fleet_missions.h"
 #include "server/map_repository.h"
 #include "server/metrics.h"
 #include "server/plan_archive.h"
@@ -33,6 +35,9 @@
 #include "server/service_options.h"
 
 namespace covplan {
+
+// The call name of a Drive session's replans (logs, metrics).
+inline constexpr absl::string_view kDriveReplan = "Drive.Replan";
 
 // One log line's summary of a replan reply.
 std::string ReplanDetail(const v1::ReplanResponse& response);
@@ -42,7 +47,7 @@ class ReplanWork {
   // Every pointer outlives this.
   ReplanWork(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics,
              const PlanningEngine* engine, PlanArchive* archive, ProgressLog* progress,
-             const SolveAdmission* admission);
+             const SolveAdmission* admission, FleetMissions* missions = nullptr);
 
   absl::Status RunReplan(const CallInfo& call, const v1::ReplanRequest& request,
                          const StopToken& cancel, v1::ReplanResponse* response);
@@ -71,8 +76,9 @@ class ReplanWork {
                                            uint64_t seed, const StopToken& cancel,
                                            absl::Time start) const;
   // Retains (and persists) a replan's result and fills the reply.
+  // `mission_follows`: a fleet mission holding the old plan takes the new one.
   void KeepReplan(ReplanResult result, const ResolvedPlan& old, const std::string& tenant_tag,
-                  v1::ReplanResponse* response);
+                  v1::ReplanResponse* response, bool mission_follows);
 
   const ServiceOptions& options_;
   MapRepository* const store_;
@@ -81,6 +87,7 @@ class ReplanWork {
   PlanArchive* const archive_;
   ProgressLog* const progress_;
   const SolveAdmission* const admission_;
+  FleetMissions* const missions_;  // may be null: a fleet mission follows its robots' replans
 };
 
 }  // namespace covplan

@@ -169,10 +169,10 @@ class CoveragePlannerService final
   ServedReplies served_;
   PlanArchive archive_;
   ProgressLog progress_;
+  FleetMissions missions_;  // before replan_work_: a mission follows its robots' replans
   ReplanWork replan_work_;
   MapHandlers maps_;
   PlanHandlers plans_;
-  FleetMissions missions_;
   FleetHandlers fleets_;
   MissionHandlers missions_rpc_;
   ReplanHandlers replans_;

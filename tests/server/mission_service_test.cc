@@ -5,7 +5,9 @@
 // the progress its Drive session recorded); the mission then shows b stopped and a, c on
 // their new plans, which GetPlan returns. A joining robot gets a share;
 // unknown missions are NOT_FOUND, unknown robots INVALID_ARGUMENT naming
-// the field. A mission and its updates survive a server restart.
+// the field. A mission and its updates survive a server restart. With
+// Drive sessions open, an obstacle one robot reports reaches the others'
+// streams as a new plan, and a redivision is pushed onto them.
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
@@ -113,6 +115,30 @@ class MissionServiceTest : public ::testing::Test {
     v1::GetPlanRequest get;
     get.set_plan_id(plan_id);
     return stub_->GetPlan(&context, get, out);
+  }
+
+  // A robot's Drive session on `plan_id`, its ready event read.
+  struct Session {
+    std::unique_ptr<grpc::ClientContext> context;
+    std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> stream;
+  };
+  Session OpenDrive(const std::string& plan_id) {
+    Session s;
+    s.context = std::make_unique<grpc::ClientContext>();
+    s.context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    s.stream = stub_->Drive(s.context.get());
+    v1::DriveRequest first;
+    first.set_plan_id(plan_id);
+    first.set_sequence(1);
+    EXPECT_TRUE(s.stream->Write(first));
+    v1::DriveEvent ready;
+    EXPECT_TRUE(s.stream->Read(&ready));
+    EXPECT_TRUE(ready.has_ready()) << ready.DebugString();
+    return s;
+  }
+  static void Close(Session& s) {
+    s.stream->WritesDone();
+    EXPECT_TRUE(s.stream->Finish().ok());
   }
 
   ServerConfig config_;
@@ -244,6 +270,106 @@ TEST_F(MissionServiceTest, AMissionAndItsUpdatesSurviveARestart) {
   // A mission id is not a plan id.
   v1::PlanResponse plan;
   EXPECT_EQ(GetPlan(fleet_.mission_id(), &plan).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(MissionServiceTest, AnObstacleOneRobotSeesIsReplannedIntoTheOthersStreams) {
+  PlanThree();
+  const v1::PlanResponse& a = fleet_.robots(0).plan();
+  const v1::PlanResponse& c = fleet_.robots(2).plan();
+  Session sa = OpenDrive(a.plan_id());
+  Session sc = OpenDrive(c.plan_id());
+  // a sees an obstacle on a cell c sweeps near the end of its plan.
+  const int cell = c.sweeps(c.sweeps_size() - 1).cells(0);
+  v1::DriveRequest seen;
+  seen.set_sequence(2);
+  seen.mutable_progress()->set_waypoint(1);
+  seen.mutable_progress()->mutable_position()->set_x(a.path(0).x());
+  seen.mutable_progress()->mutable_position()->set_y(a.path(0).y());
+  v1::CellRef* blocked = seen.mutable_obstacles()->add_cells();
+  blocked->set_row(cell / c.grid().cols());
+  blocked->set_col(cell % c.grid().cols());
+  ASSERT_TRUE(sa.stream->Write(seen));
+  v1::DriveEvent own;
+  ASSERT_TRUE(sa.stream->Read(&own));
+  ASSERT_TRUE(own.has_replan()) << own.DebugString();
+  EXPECT_EQ(own.sequence(), 2u);
+  EXPECT_FALSE(own.has_mission());
+  // c's stream gets a new plan around it, unasked.
+  v1::DriveEvent pushed;
+  ASSERT_TRUE(sc.stream->Read(&pushed));
+  ASSERT_TRUE(pushed.has_replan()) << pushed.DebugString();
+  EXPECT_EQ(pushed.sequence(), 0u);
+  EXPECT_EQ(pushed.mission().mission_id(), fleet_.mission_id());
+  EXPECT_EQ(pushed.mission().cause(), v1::MissionNotice::SHARED_OBSTACLE);
+  EXPECT_EQ(pushed.mission().from_robot(), "a");
+  const v1::PlanResponse& c2 = pushed.replan().plan();
+  EXPECT_NE(c2.plan_id(), c.plan_id());
+  EXPECT_EQ(SweptCells(c2).count(cell), 0u) << "the new plan sweeps the blocked cell";
+  EXPECT_GT(pushed.replan().replan().num_encounters(), 0);
+  // The mission follows both robots onto their new plans.
+  v1::GetMissionResponse mission;
+  ASSERT_TRUE(GetMission(fleet_.mission_id(), &mission).ok());
+  EXPECT_EQ(mission.robots(0).plan_id(), own.replan().plan().plan_id());
+  EXPECT_EQ(mission.robots(1).plan_id(), fleet_.robots(1).plan().plan_id());
+  EXPECT_EQ(mission.robots(2).plan_id(), c2.plan_id());
+  Close(sa);
+  Close(sc);
+}
+
+TEST_F(MissionServiceTest, ARedivisionIsPushedOntoTheRobotsStreams) {
+  PlanThree();
+  Session sa = OpenDrive(fleet_.robots(0).plan().plan_id());
+  Session sc = OpenDrive(fleet_.robots(2).plan().plan_id());
+  const v1::PlanResponse& b = fleet_.robots(1).plan();
+  const int k = std::max(1, b.path_size() / 3);
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* stop = update.add_robots();
+  stop->set_robot_id("b");
+  stop->set_stopped(true);
+  stop->mutable_progress()->set_waypoint(k);
+  stop->mutable_progress()->mutable_position()->set_x(b.path(k - 1).x());
+  stop->mutable_progress()->mutable_position()->set_y(b.path(k - 1).y());
+  v1::UpdateMissionResponse updated;
+  grpc::Status status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(updated.robots_size(), 2);
+  Session* sessions[] = {&sa, &sc};
+  for (int i = 0; i < 2; ++i) {
+    v1::DriveEvent pushed;
+    ASSERT_TRUE(sessions[i]->stream->Read(&pushed)) << updated.robots(i).id();
+    ASSERT_TRUE(pushed.has_replan()) << pushed.DebugString();
+    EXPECT_EQ(pushed.sequence(), 0u);
+    EXPECT_EQ(pushed.mission().cause(), v1::MissionNotice::REDIVIDED);
+    EXPECT_EQ(pushed.replan().plan().SerializeAsString(),
+              updated.robots(i).plan().SerializeAsString());
+  }
+  // The session drives the pushed plan: an observation on it is replanned.
+  const v1::PlanResponse& a2 = updated.robots(0).plan();
+  v1::DriveRequest seen;
+  seen.set_plan_id(a2.plan_id());
+  seen.set_sequence(2);
+  seen.mutable_progress()->set_waypoint(1);
+  seen.mutable_progress()->mutable_position()->set_x(a2.path(0).x());
+  seen.mutable_progress()->mutable_position()->set_y(a2.path(0).y());
+  const int cell = a2.sweeps(a2.sweeps_size() - 1).cells(0);
+  v1::CellRef* blocked = seen.mutable_obstacles()->add_cells();
+  blocked->set_row(cell / a2.grid().cols());
+  blocked->set_col(cell % a2.grid().cols());
+  ASSERT_TRUE(sa.stream->Write(seen));
+  v1::DriveEvent own;
+  ASSERT_TRUE(sa.stream->Read(&own));
+  ASSERT_TRUE(own.has_replan()) << own.DebugString();
+  EXPECT_EQ(own.sequence(), 2u);
+  EXPECT_EQ(SweptCells(own.replan().plan()).count(cell), 0u);
+  Close(sa);
+  // c's stream also hears of a's obstacle, if it touches c's new plan.
+  sc.stream->WritesDone();
+  v1::DriveEvent rest;
+  while (sc.stream->Read(&rest)) {
+    EXPECT_EQ(rest.mission().cause(), v1::MissionNotice::SHARED_OBSTACLE) << rest.DebugString();
+  }
+  EXPECT_TRUE(sc.stream->Finish().ok());
 }
 
 TEST_F(MissionServiceTest, AJoiningRobotGetsAShare) {
