@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "planner/fleet/assignment.h"
+#include "planner/fleet/geodesic.h"
 
 namespace covplan {
 namespace {
@@ -43,15 +44,27 @@ double TurnBound(double ha, double hb, Point2 a, Point2 b) {
 namespace {
 
 // Variant 0 of a unit: forwards (entered at its entry along entry_heading,
-// left at its exit); variant 1: backwards.
+// left at its exit); variant 1: backwards. Points (for the geodesic bound):
+// 2u is unit u's entry, 2u + 1 its exit, 2n + r robot r's start, 2n + k + r
+// its end.
 struct End {
   Point2 in, out;
   double h_in, h_out;
+  int in_pt, out_pt;
 };
+
+// Sizes up to which the matching (points) and the assignment (units and
+// robots) bounds are computed: both are O(n^3) assignments.
+constexpr int kMaxMatching = 600;
+constexpr int kMaxAssignment = 400;
+// Square visits all geodesic searches of one bound may take (about 0.1 s):
+// above it the searches stop at a depth (their bounds stay valid).
+constexpr int64_t kSearchBudget = 10'000'000;
 
 class BoundInput {
  public:
-  BoundInput(const TourUnits& units, const std::vector<FleetRobot>& robots) : robots_(robots) {
+  BoundInput(const TourUnits& units, const std::vector<FleetRobot>& robots, const Grid* drive)
+      : robots_(robots) {
     n_ = static_cast<int>(units.units.size());
     k_ = static_cast<int>(robots.size());
     fastest_ = robots[0].robot;
@@ -62,15 +75,28 @@ class BoundInput {
     }
     ends_.resize(2 * n_);
     time_.assign(k_, std::vector<double>(n_));
+    points_.resize(2 * n_ + 2 * k_);
     for (int u = 0; u < n_; ++u) {
       const TourUnit& t = units.units[u];
-      ends_[2 * u] = {t.entry, t.exit, t.entry_heading, t.exit_heading};
-      ends_[2 * u + 1] = {t.exit, t.entry, Reversed(t.exit_heading), Reversed(t.entry_heading)};
+      ends_[2 * u] = {t.entry, t.exit, t.entry_heading, t.exit_heading, 2 * u, 2 * u + 1};
+      ends_[2 * u + 1] = {t.exit,    t.entry, Reversed(t.exit_heading), Reversed(t.entry_heading),
+                          2 * u + 1, 2 * u};
+      points_[2 * u] = t.entry;
+      points_[2 * u + 1] = t.exit;
       for (int r = 0; r < k_; ++r) time_[r][u] = UnitTime(units, t, robots[r].robot);
     }
+    for (int r = 0; r < k_; ++r) {
+      const std::optional<Pose2>& s = robot(r).start;
+      const std::optional<Pose2>& e = robot(r).end;
+      if (s) points_[start_pt(r)] = {s->x, s->y};
+      if (e) points_[end_pt(r)] = {e->x, e->y};
+    }
+    if (drive != nullptr) SearchRows(*drive);
   }
   int n() const { return n_; }
   int k() const { return k_; }
+  int start_pt(int r) const { return 2 * n_ + r; }
+  int end_pt(int r) const { return 2 * n_ + k_ + r; }
   const End& end(int variant) const { return ends_[variant]; }
   double time(int r, int u) const { return time_[r][u]; }
   double fastest_time(int u) const {
@@ -79,41 +105,54 @@ class BoundInput {
     return best;
   }
   const RobotModel& robot(int r) const { return robots_[r].robot; }
-  // The least time of any move from pose (a, ha) to pose (b, hb): straight
-  // moves from rest to rest take at least one move of their summed length
-  // (StraightTime is concave), plus the least turning (TurnBound).
-  double Move(Point2 a, double ha, Point2 b, double hb) const {
-    return fastest_.StraightTime(std::hypot(b.x - a.x, b.y - a.y)) +
-           fastest_.TurnTime(TurnBound(ha, hb, a, b));
+  double StraightTime(double length) const { return fastest_.StraightTime(length); }
+  // The least length of any drive path between points a and b: the straight
+  // line, or (D - 1) h over the squares of GeodesicHops when longer.
+  double Length(int a, int b) const {
+    const Point2 p = points_[a], q = points_[b];
+    const double line = std::hypot(q.x - p.x, q.y - p.y);
+    if (!geo_) return line;
+    int hops = 0;
+    if (row_[a] >= 0) {
+      hops = hops_[static_cast<size_t>(row_[a]) * points_.size() + b];
+    } else if (row_[b] >= 0) {
+      hops = hops_[static_cast<size_t>(row_[b]) * points_.size() + a];
+    } else if (geo_->source() == a) {
+      hops = geo_->Hops(b);
+    } else if (geo_->source() == b) {
+      hops = geo_->Hops(a);
+    }
+    return std::max(line, geo_->MinLength(hops));
+  }
+  // Points without a row are searched one at a time (CheapestEntries): the
+  // hops from `point` to every other point, until the next Focus.
+  void Focus(int point) {
+    if (geo_ && row_[point] < 0 && geo_->source() != point) geo_->Search(point, max_hops_);
+  }
+  // The least time of any move from point a heading ha to point b heading
+  // hb: straight moves from rest to rest take at least one move of their
+  // summed length (StraightTime is concave), plus the least turning
+  // (TurnBound).
+  double Move(int a, double ha, int b, double hb) const {
+    return fastest_.StraightTime(Length(a, b)) +
+           fastest_.TurnTime(TurnBound(ha, hb, points_[a], points_[b]));
   }
   // The cheapest move into unit u (either direction) from robot r's start
   // (0 when it has none), and out of u to r's end (0 when it has none).
   double FromStart(int r, int u) const {
-    const std::optional<Pose2>& s = robot(r).start;
-    if (!s) return 0.0;
-    return std::min(Move({s->x, s->y}, s->theta, ends_[2 * u].in, ends_[2 * u].h_in),
-                    Move({s->x, s->y}, s->theta, ends_[2 * u + 1].in, ends_[2 * u + 1].h_in));
+    return std::min(FromStartVariant(r, 2 * u), FromStartVariant(r, 2 * u + 1));
   }
   double ToEnd(int r, int u) const {
-    const std::optional<Pose2>& e = robot(r).end;
-    if (!e) return 0.0;
-    double best = INFINITY;
-    for (int v = 0; v < 2; ++v) {
-      const Point2 out = ends_[2 * u + v].out;
-      best = std::min(best, fastest_.StraightTime(std::hypot(e->x - out.x, e->y - out.y)));
-    }
-    return best;
+    return std::min(ToEndVariant(r, 2 * u), ToEndVariant(r, 2 * u + 1));
   }
   // Into variant v (= 2u + direction) from robot r's start; out of variant v
   // to robot r's end (0 without a start or end).
   double FromStartVariant(int r, int v) const {
     const std::optional<Pose2>& s = robot(r).start;
-    return s ? Move({s->x, s->y}, s->theta, ends_[v].in, ends_[v].h_in) : 0.0;
+    return s ? Move(start_pt(r), s->theta, ends_[v].in_pt, ends_[v].h_in) : 0.0;
   }
   double ToEndVariant(int r, int v) const {
-    const std::optional<Pose2>& e = robot(r).end;
-    return e ? fastest_.StraightTime(std::hypot(e->x - ends_[v].out.x, e->y - ends_[v].out.y))
-             : 0.0;
+    return robot(r).end ? fastest_.StraightTime(Length(ends_[v].out_pt, end_pt(r))) : 0.0;
   }
   double Between(int w, int u) const {
     double best = INFINITY;
@@ -121,25 +160,59 @@ class BoundInput {
       for (int b = 0; b < 2; ++b) {
         const End& x = ends_[2 * w + a];
         const End& y = ends_[2 * u + b];
-        best = std::min(best, Move(x.out, x.h_out, y.in, y.h_in));
+        best = std::min(best, Move(x.out_pt, x.h_out, y.in_pt, y.h_in));
       }
     }
     return best;
   }
 
  private:
+  // The hops from every point when the assignment (and the matching) will
+  // want every pair (at most 800 x 800 hop counts), else from the robots'
+  // starts and ends only; the searches stop at a depth that keeps them all
+  // within kSearchBudget.
+  void SearchRows(const Grid& drive) {
+    const int num = static_cast<int>(points_.size());
+    geo_.emplace(drive, points_);
+    const bool dense = n_ + k_ <= kMaxAssignment;
+    // Dense: one search per point; sparse: one per robot pose here and one
+    // per unit entry in CheapestEntries.
+    const double area = static_cast<double>(kSearchBudget) / std::max(1, num);
+    if (area < static_cast<double>(geo_->open_squares()))
+      max_hops_ = std::max(1, static_cast<int>((std::sqrt(area) - 1.0) / 2.0));
+    row_.assign(num, -1);
+    std::vector<int> sources;
+    for (int p = dense ? 0 : 2 * n_; p < num; ++p) {
+      const bool robot_point = p >= 2 * n_;
+      const int r = robot_point ? (p - 2 * n_) % k_ : 0;
+      if (robot_point && !(p < 2 * n_ + k_ ? robot(r).start : robot(r).end)) continue;
+      row_[p] = static_cast<int>(sources.size());
+      sources.push_back(p);
+    }
+    hops_.assign(sources.size() * static_cast<size_t>(num), 0);
+    for (size_t i = 0; i < sources.size(); ++i) {
+      geo_->Search(sources[i], max_hops_);
+      for (int q = 0; q < num; ++q) hops_[i * num + q] = geo_->Hops(q);
+    }
+  }
+
   const std::vector<FleetRobot>& robots_;
   int n_ = 0, k_ = 0;
   RobotModel fastest_;
   std::vector<End> ends_;
   std::vector<std::vector<double>> time_;
+  std::vector<Point2> points_;
+  std::optional<GeodesicHops> geo_;
+  int max_hops_ = -1;
+  std::vector<int> row_;       // per point: its row of hops_, or -1
+  std::vector<int32_t> hops_;  // [row][point]
 };
 
 // Sum of the cheapest way into each unit from another unit's exit or a start,
 // with the k largest savings of a start taken off. Exits are bucketed on a
 // square grid and searched ring by ring until no nearer bucket can beat the
 // best move found.
-double CheapestEntries(const BoundInput& in) {
+double CheapestEntries(BoundInput& in) {
   const int n = in.n(), k = in.k();
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (int w = 0; w < 2 * n; ++w) {
@@ -157,16 +230,18 @@ double CheapestEntries(const BoundInput& in) {
   auto cheapest_in = [&](int u, const End& e) {
     double best = INFINITY;
     const int cx = bx(e.in.x), cy = by(e.in.y);
+    in.Focus(e.in_pt);
     for (int ring = 0; ring <= side; ++ring) {
-      // Every exit in this ring or beyond is at least this far away.
-      if (in.Move({0, 0}, 0, {std::max(0, ring - 1) * bucket, 0}, 0) >= best) break;
+      // Every exit in this ring or beyond is at least this far away (and
+      // Length is at least the straight line).
+      if (in.StraightTime(std::max(0, ring - 1) * bucket) >= best) break;
       for (int gy = cy - ring; gy <= cy + ring; ++gy) {
         for (int gx = cx - ring; gx <= cx + ring; ++gx) {
           if (std::max(std::abs(gx - cx), std::abs(gy - cy)) != ring) continue;
           if (gx < 0 || gy < 0 || gx >= side || gy >= side) continue;
           for (int w : buckets[gy * side + gx]) {
             if (w / 2 == u) continue;
-            best = std::min(best, in.Move(in.end(w).out, in.end(w).h_out, e.in, e.h_in));
+            best = std::min(best, in.Move(in.end(w).out_pt, in.end(w).h_out, e.in_pt, e.h_in));
           }
         }
       }
@@ -230,7 +305,7 @@ std::optional<double> MatchedMoves(const BoundInput& in) {
     for (int b = a + 1; b < 2 * n; ++b) {
       if (a / 2 == b / 2) continue;
       const End& enter = in.end(b);
-      set(a, b, in.Move(leave.out, leave.h_out, enter.in, enter.h_in));
+      set(a, b, in.Move(leave.out_pt, leave.h_out, enter.in_pt, enter.h_in));
     }
   }
   for (int r = 0; r < k; ++r) {
@@ -244,17 +319,13 @@ std::optional<double> MatchedMoves(const BoundInput& in) {
   return PerfectMatchingLowerBound(c, size);
 }
 
-// Sizes up to which the matching (points) and the assignment (units and
-// robots) bounds are computed: both are O(n^3) assignments.
-constexpr int kMaxMatching = 600;
-constexpr int kMaxAssignment = 400;
-
 }  // namespace
 
-MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots) {
+MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots,
+                                 const Grid* drive) {
   MakespanBound bound;
   if (units.units.empty() || robots.empty()) return bound;
-  const BoundInput in(units, robots);
+  BoundInput in(units, robots, drive);
   const int n = in.n(), k = in.k();
   double work = 0.0;
   for (int u = 0; u < n; ++u) work += in.fastest_time(u);
@@ -274,8 +345,8 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
       for (int v = 0; v < 2; ++v) {
         const End& e = in.end(2 * u + v);
         double t = in.time(r, u);
-        if (m.start) t += m.StraightTime(std::hypot(e.in.x - m.start->x, e.in.y - m.start->y));
-        if (m.end) t += m.StraightTime(std::hypot(e.out.x - m.end->x, e.out.y - m.end->y));
+        if (m.start) t += m.StraightTime(in.Length(in.start_pt(r), e.in_pt));
+        if (m.end) t += m.StraightTime(in.Length(e.out_pt, in.end_pt(r)));
         best = std::min(best, t);
       }
     }

@@ -6,17 +6,22 @@
 //   work:  makespan >= (sum over units of [the fastest robot's time to drive
 //          the unit + the cheapest way into it from another unit's exit or a
 //          start]) / k. "The cheapest way in" from pose a to pose b is
-//          StraightTime(|ab|) at the fleet's top speed and acceleration (a
+//          StraightTime(L(a, b)) at the fleet's top speed and acceleration (a
 //          path's straight moves from rest to rest take at least one move of
 //          their summed length, StraightTime being concave) plus TurnBound
 //          at its top turn rate: the least turning of any path from a's
 //          heading to b's, at least the net change and, when the robot moves,
 //          the way through the direction of b - a, capped at half a turn. At
 //          most k units are entered from a start, so the k largest savings of
-//          a start over a unit are taken off;
-//   reach: makespan >= max over units of min over robots of (the straight
-//          move from the robot's start to the unit + the unit + the straight
-//          move to its end pose), for the unit's better direction.
+//          a start over a unit are taken off (with a matching or an
+//          assignment relaxation of the moves when the fleet is small);
+//   reach: makespan >= max over units of min over robots of (the move from
+//          the robot's start to the unit + the unit + the move to its end
+//          pose), for the unit's better direction.
+//
+// L(a, b), the least length of a path from a to b, is the straight line |ab|
+// or, given the drive grid the plans' paths stay on, the longer of |ab| and
+// the geodesic bound of geodesic.h (walls between a and b).
 //
 // Thread-safety: reentrant.
 #ifndef COVPLAN_PLANNER_FLEET_BOUNDS_H_
@@ -26,6 +31,7 @@
 
 #include "planner/fleet/fleet_request.h"
 #include "planner/fleet/units.h"
+#include "planner/grid/grid.h"
 
 namespace covplan {
 
@@ -35,7 +41,11 @@ struct MakespanBound {
   double value() const { return work_s > reach_s ? work_s : reach_s; }
 };
 
-MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots);
+// `drive`: the grid whose free cells every path of the fleet's plans stays on
+// (a start or end pose may stand in a blocked cell beside them); null prices
+// moves by straight lines only.
+MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<FleetRobot>& robots,
+                                 const Grid* drive);
 
 }  // namespace covplan
 

@@ -238,7 +238,8 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
     best.robots[0].id = request.robots[0].id;
     best.robots[0].assigned_cells = one->area->cover_cells;
     best.robots[0].result = *std::move(one);
-    best.lower_bound_s = MakespanLowerBound(units, request.robots).value();
+    best.lower_bound_s =
+        MakespanLowerBound(units, request.robots, best.robots[0].result.area->drive.get()).value();
     best.termination = best.robots[0].result.plan.termination;
     FillFleetFigures(request, best.robots[0].assigned_cells, &best);
     best.planning_ms = Seconds(t0) * 1e3;
@@ -261,7 +262,7 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
   // The bound needs no plan: it is computed beside the search.
   double lower_bound = 0.0;
   std::thread bound_thread(
-      [&] { lower_bound = MakespanLowerBound(units, request.robots).value(); });
+      [&] { lower_bound = MakespanLowerBound(units, request.robots, area->drive.get()).value(); });
 
   FleetSearch search{
       engine, source, request, area, units, std::move(costs), whole->plan.planner == "stc", t0};
