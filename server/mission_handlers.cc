@@ -114,28 +114,65 @@ grpc::ServerUnaryReactor* MissionHandlers::UpdateMission(grpc::CallbackServerCon
 grpc::ServerUnaryReactor* MissionHandlers::GetMission(grpc::CallbackServerContext* context,
                                                       const v1::GetMissionRequest* request,
                                                       v1::GetMissionResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  CallInfo call;
-  if (!gate_->Open(context, "GetMission", reactor, *request, WhileDraining::kServe, &call)) {
-    return reactor;
-  }
+  return ServeSolve(
+      gate_, admission_, context, "GetMission", *request,
+      [this](const CallInfo&) { return admission_->Admit(); },
+      [this, request, response](const CallInfo& call, const StopToken& cancel,
+                                std::string* detail) {
+        absl::Status status = RunGetMission(call, *request, cancel, response);
+        if (status.ok()) {
+          *detail = absl::StrFormat(
+              "%s covered=%d remaining=%d complete=%v", QuotePrefix(request->mission_id(), 20),
+              response->covered_cells(), response->remaining_cells(), response->complete());
+        }
+        return status;
+      });
+}
+
+absl::Status MissionHandlers::RunGetMission(const CallInfo& call,
+                                            const v1::GetMissionRequest& request,
+                                            const StopToken& cancel,
+                                            v1::GetMissionResponse* response) {
   std::optional<FleetMission> mission;
-  if (OwnsPlan(call.tenant_tag, request->mission_id()))
-    mission = missions_->Get(request->mission_id());
-  if (!mission.has_value()) {
-    gate_->Finish(reactor, call, MissionNotFound(request->mission_id()));
-    return reactor;
-  }
+  if (OwnsPlan(call.tenant_tag, request.mission_id()))
+    mission = missions_->Get(request.mission_id());
+  if (!mission.has_value()) return MissionNotFound(request.mission_id());
   response->set_mission_id(mission->mission_id);
   response->set_map_id(mission->map_id);
+  std::vector<MissionRobot> robots;
   for (size_t i = 0; i < mission->robot_ids.size(); ++i) {
     v1::MissionRobotState* r = response->add_robots();
     r->set_robot_id(mission->robot_ids[i]);
     r->set_plan_id(mission->plan_ids[i]);
     r->set_stopped(mission->Stopped(i));
+    MissionRobot& m = robots.emplace_back();
+    m.robot.id = mission->robot_ids[i];
+    m.active = !mission->Stopped(i);
+    v1::PlanRequest origin;
+    m.plan = archive_->Find(mission->plan_ids[i], cancel, &origin);
+    if (m.plan == nullptr) {
+      if (cancel.ShouldStop()) return absl::CancelledError("call cancelled");
+      return absl::FailedPreconditionError(
+          absl::StrFormat("robot %s's plan %s is no longer retained: no account",
+                          QuotePrefix(mission->robot_ids[i]), QuotePrefix(mission->plan_ids[i])));
+    }
+    if (std::optional<v1::RobotProgress> p = progress_->Recorded(mission->plan_ids[i])) {
+      absl::StatusOr<RobotProgress> progress = ProgressFromProto(*p);
+      if (progress.ok()) m.progress = *progress;
+    }
   }
-  gate_->Finish(reactor, call, absl::OkStatus(), QuotePrefix(request->mission_id(), 20));
-  return reactor;
+  ASSIGN_OR_RETURN(MissionAccount account, AccountMission(robots));
+  for (size_t i = 0; i < account.robots.size(); ++i) {
+    v1::MissionRobotState* r = response->mutable_robots(static_cast<int>(i));
+    r->set_covered_cells(account.robots[i].covered_cells);
+    r->set_remaining_cells(account.robots[i].remaining_cells);
+    r->set_cut_off_cells(account.robots[i].cut_off_cells);
+  }
+  response->set_covered_cells(account.covered_cells);
+  response->set_remaining_cells(account.remaining_cells);
+  response->set_cut_off_cells(account.cut_off_cells);
+  response->set_complete(account.complete);
+  return absl::OkStatus();
 }
 
 absl::Status MissionHandlers::RunUpdateMission(const CallInfo& call,
@@ -258,6 +295,10 @@ absl::Status MissionHandlers::BuildRoster(const FleetMission& mission,
                                   p.status().message()));
       }
       r.progress = *p;
+      // Where it is now, for Resume and GetMission's account.
+      if (j >= 0 && request.robots(j).has_progress()) {
+        progress_->Record(mission.plan_ids[i], *progress);
+      }
     }
     if (j >= 0 && request.robots(j).has_pose()) r.pose = PoseFromProto(request.robots(j).pose());
     r.active = !(j >= 0 && request.robots(j).stopped());

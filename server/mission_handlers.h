@@ -11,9 +11,10 @@
 // limit at most); each new plan is retained under a fresh plan_id (and
 // persisted on a stored map) like a PlanFleet robot's, and the mission
 // record gets the new plan ids, the stopped flags and the joined robots.
-// The new plans are the reply: running Drive sessions are not told (a
-// robot opens a new session on its new plan_id). GetMission reads the
-// record. Missions live in memory only.
+// The new plans are the reply and are pushed onto the robots' open Drive
+// sessions (DriveHandler::PushMissionPlan). GetMission reads the record and,
+// on a worker like a Replan, the mission's account (AccountMission over each
+// robot's current plan and recorded progress).
 //
 //   MissionHandlers missions(options, store, metrics, &engine, &gate, &admission, &archive,
 //                            &progress, &fleet_missions);
@@ -71,6 +72,8 @@ class MissionHandlers {
                                        v1::GetMissionResponse* response);
 
  private:
+  absl::Status RunGetMission(const CallInfo& call, const v1::GetMissionRequest& request,
+                             const StopToken& cancel, v1::GetMissionResponse* response);
   // The robots RedivideMission is given, and what UpdateMission keeps of
   // them.
   struct Roster {

@@ -119,6 +119,11 @@ std::shared_ptr<const RetainedPlan> PlanArchive::Find(const std::string& plan_id
   rebuilt->plan_id = plan_id;
   auto plan = std::make_shared<const RetainedPlan>(std::move(*rebuilt));
   plans_.Put(plan);
+  {  // found in memory from now on: its origin with it (its replans are persisted)
+    absl::MutexLock lock(&origins_mu_);
+    origins_.emplace_back(plan_id, std::make_shared<const v1::PlanRequest>(record.request()));
+    while (origins_.size() > 4 * options_.max_retained_plans + 16) origins_.pop_front();
+  }
   return plan;
 }
 

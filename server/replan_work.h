@@ -17,9 +17,9 @@
 #include <memory>
 #include <string>
 
-#include "absl/strings/string_view.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "covplan/v1/covplan.pb.h"
 #include "planner/common/stop_token.h"
 #include "planner/engine/engine.h"

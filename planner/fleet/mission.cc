@@ -29,7 +29,65 @@ absl::StatusOr<Pose2> PoseOf(size_t i, const MissionRobot& r) {
                                                "reported position"));
 }
 
+// What is left of a robot's current plan.
+struct Remainder {
+  std::vector<uint8_t> left;   // per cover-grid cell: still to sweep, reachable
+  int64_t cells = 0;           // of them
+  int64_t covered_before = 0;  // swept before the robot's position
+  int64_t cut_off = 0;         // cut off (unreachable from where it is)
+};
+
+// Robot i's remainder from its progress; none reported: it has not started
+// and its plan's every cell is left.
+absl::StatusOr<Remainder> RemainderOf(size_t i, const MissionRobot& r) {
+  Remainder out;
+  if (r.plan->area == nullptr) return out;  // an idle robot's plan: given nothing
+  if (r.progress.waypoint < 0 && !r.progress.distance_m.has_value()) {
+    const Grid& cover = *r.plan->area->cover;
+    out.left.assign(static_cast<size_t>(cover.size()), 0);
+    for (const CoverageSweep& s : r.plan->plan.sweeps) {
+      for (const CellIndex& c : s.cells) {
+        uint8_t& f = out.left[static_cast<size_t>(cover.Index(c.row, c.col))];
+        out.cells += f == 0;
+        f = 1;
+      }
+    }
+    return out;
+  }
+  absl::StatusOr<ReplanResult> rest = Remaining(*r.plan, r.progress, Observations{});
+  if (!rest.ok()) return RobotError(i, r.robot.id, rest.status());
+  const std::vector<uint8_t>& cover = rest->area->cover->free_flags();
+  out.left.assign(cover.begin(), cover.end());
+  for (uint8_t f : out.left) out.cells += f != 0;
+  out.covered_before = rest->stats.covered_cells_before;
+  out.cut_off = static_cast<int64_t>(rest->unreachable.size());
+  return out;
+}
+
 }  // namespace
+
+absl::StatusOr<MissionAccount> AccountMission(const std::vector<MissionRobot>& robots) {
+  MissionAccount out;
+  std::vector<uint8_t> left;
+  for (size_t i = 0; i < robots.size(); ++i) {
+    const MissionRobot& r = robots[i];
+    RobotAccount& a = out.robots.emplace_back();
+    if (r.plan == nullptr || r.plan->area == nullptr) continue;  // given nothing
+    ASSIGN_OR_RETURN(Remainder rest, RemainderOf(i, r));
+    const PlanStats& s = r.plan->plan.stats;
+    a.covered_cells = s.mission_covered_cells + rest.covered_before;
+    a.cut_off_cells = s.mission_cut_off_cells + rest.cut_off;
+    out.covered_cells += a.covered_cells;
+    out.cut_off_cells += a.cut_off_cells;
+    if (!r.active) continue;  // its remainder was handed over
+    a.remaining_cells = rest.cells;
+    if (left.size() < rest.left.size()) left.resize(rest.left.size(), 0);
+    for (size_t c = 0; c < rest.left.size(); ++c) left[c] |= rest.left[c];
+  }
+  for (uint8_t f : left) out.remaining_cells += f != 0;
+  out.complete = out.remaining_cells == 0;
+  return out;
+}
 
 absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
                                                   const MapSource& source, const PlanRequest& base,
@@ -37,21 +95,23 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
                                                   const MissionOptions& options) {
   MissionRedivision out;
   std::vector<uint8_t> left;
+  std::vector<PlanStats> accounts;  // per active robot
   FleetRequest fleet;
   fleet.base = base;
   fleet.division = options.division;
   fleet.clearance_m = options.clearance_m;
   for (size_t i = 0; i < robots.size(); ++i) {
     const MissionRobot& r = robots[i];
+    PlanStats carried;  // the robot's account so far, for its new plan
     if (r.plan != nullptr) {
-      // No progress reported: it has not started, everything is left.
-      RobotProgress progress = r.progress;
-      if (progress.waypoint < 0 && !progress.distance_m.has_value()) progress.distance_m = 0.0;
-      absl::StatusOr<ReplanResult> rest = Remaining(*r.plan, progress, Observations{});
-      if (!rest.ok()) return RobotError(i, r.robot.id, rest.status());
-      const std::vector<uint8_t>& cover = rest->area->cover->free_flags();
+      ASSIGN_OR_RETURN(Remainder rest, RemainderOf(i, r));
+      const PlanStats& s = r.plan->plan.stats;
+      carried.mission_covered_cells = s.mission_covered_cells + rest.covered_before;
+      carried.mission_cut_off_cells = s.mission_cut_off_cells + rest.cut_off;
+      carried.mission_obstructed_cells = s.mission_obstructed_cells;
+      const std::vector<uint8_t>& cover = rest.left;  // empty: given nothing
       if (left.empty()) left.assign(cover.size(), 0);
-      if (left.size() != cover.size()) {
+      if (!cover.empty() && left.size() != cover.size()) {
         return RobotError(i, r.robot.id,
                           absl::InvalidArgumentError("its plan is on another grid than the "
                                                      "mission's"));
@@ -62,9 +122,10 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
         ++out.remaining_cells;
         out.handed_over_cells += !r.active;
       }
-      out.cut_off_cells += static_cast<int64_t>(rest->unreachable.size());
+      out.cut_off_cells += rest.cut_off;
     }
     if (!r.active) continue;
+    accounts.push_back(carried);
     ASSIGN_OR_RETURN(Pose2 pose, PoseOf(i, r));
     FleetRobot robot = r.robot;
     robot.robot.start = pose;
@@ -78,6 +139,12 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
   }
   fleet.cover_mask = std::move(left);
   ASSIGN_OR_RETURN(out.plan, PlanFleet(engine, source, fleet));
+  for (size_t k = 0; k < out.plan.robots.size() && k < accounts.size(); ++k) {
+    PlanStats& s = out.plan.robots[k].result.plan.stats;
+    s.mission_covered_cells = accounts[k].mission_covered_cells;
+    s.mission_cut_off_cells = accounts[k].mission_cut_off_cells;
+    s.mission_obstructed_cells = accounts[k].mission_obstructed_cells;
+  }
   return out;
 }
 

@@ -50,6 +50,9 @@ struct MissionRedivision {
   int64_t cut_off_cells = 0;           // cells of plans no robot can reach any more
 };
 
+// Each new plan continues its robot's account: its stats' mission_covered,
+// mission_cut_off and mission_obstructed cells carry what the robot's
+// earlier plans swept, lost and found blocked (0 for a joining robot).
 // InvalidArgument naming the robot ("robots[2] ('c'): ...") for malformed
 // progress, a robot without plan or pose, or no active robot while cells are
 // left.
@@ -57,6 +60,24 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
                                                   const MapSource& source, const PlanRequest& base,
                                                   const std::vector<MissionRobot>& robots,
                                                   const MissionOptions& options);
+
+// A mission's account, from each robot's current plan and progress (robots
+// as for RedivideMission; a stopped robot handed its remainder over).
+struct RobotAccount {
+  int64_t covered_cells = 0;    // swept by it over all its plans so far
+  int64_t remaining_cells = 0;  // left on its current plan, reachable (0 once stopped)
+  int64_t cut_off_cells = 0;    // of its plans' cells, cut off by obstacles
+};
+struct MissionAccount {
+  std::vector<RobotAccount> robots;  // as given
+  int64_t covered_cells = 0;         // sum over the robots
+  int64_t remaining_cells = 0;       // distinct cells left on the active robots' plans
+  int64_t cut_off_cells = 0;         // sum over the robots
+  bool complete = false;             // no reachable cell left on any active robot's plan
+};
+
+// InvalidArgument naming the robot for malformed progress.
+absl::StatusOr<MissionAccount> AccountMission(const std::vector<MissionRobot>& robots);
 
 }  // namespace covplan
 

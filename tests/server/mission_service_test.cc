@@ -272,6 +272,59 @@ TEST_F(MissionServiceTest, AMissionAndItsUpdatesSurviveARestart) {
   EXPECT_EQ(GetPlan(fleet_.mission_id(), &plan).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
+TEST_F(MissionServiceTest, TheAccountAddsUpAndIsCompleteOnlyWhenNothingIsLeft) {
+  PlanThree();
+  v1::GetMissionResponse mission;
+  grpc::Status status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(mission.covered_cells(), 0);
+  EXPECT_EQ(mission.remaining_cells(), fleet_.covered_cells());
+  EXPECT_FALSE(mission.complete());
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(mission.robots(i).remaining_cells(),
+              static_cast<int64_t>(SweptCells(fleet_.robots(i).plan()).size()));
+  }
+  // b stops a third of the way along: what it swept stays its own.
+  const v1::PlanResponse& b = fleet_.robots(1).plan();
+  const int k = std::max(1, b.path_size() / 3);
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* stop = update.add_robots();
+  stop->set_robot_id("b");
+  stop->set_stopped(true);
+  stop->mutable_progress()->set_waypoint(k);
+  stop->mutable_progress()->mutable_position()->set_x(b.path(k - 1).x());
+  stop->mutable_progress()->mutable_position()->set_y(b.path(k - 1).y());
+  v1::UpdateMissionResponse updated;
+  status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_GT(mission.robots(1).covered_cells(), 0);
+  EXPECT_EQ(mission.robots(1).remaining_cells(), 0);
+  EXPECT_EQ(mission.remaining_cells(), updated.remaining_cells());
+  EXPECT_EQ(mission.covered_cells() + mission.remaining_cells() + mission.cut_off_cells(),
+            fleet_.cover_cells());
+  EXPECT_FALSE(mission.complete());
+  // a and c report that they reached the ends of their new plans.
+  for (const v1::FleetRobotPlan& robot : updated.robots()) {
+    Session s = OpenDrive(robot.plan().plan_id());
+    const int n = robot.plan().path_size();
+    v1::DriveRequest at_end;
+    at_end.set_sequence(2);
+    at_end.mutable_progress()->set_waypoint(n - 1);
+    at_end.mutable_progress()->mutable_position()->set_x(robot.plan().path(n - 1).x());
+    at_end.mutable_progress()->mutable_position()->set_y(robot.plan().path(n - 1).y());
+    ASSERT_TRUE(s.stream->Write(at_end));
+    Close(s);  // the server has read (and recorded) it once the call ends
+  }
+  status = GetMission(fleet_.mission_id(), &mission);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(mission.remaining_cells(), 0);
+  EXPECT_TRUE(mission.complete());
+  EXPECT_EQ(mission.covered_cells() + mission.cut_off_cells(), fleet_.cover_cells());
+}
+
 TEST_F(MissionServiceTest, AnObstacleOneRobotSeesIsReplannedIntoTheOthersStreams) {
   PlanThree();
   const v1::PlanResponse& a = fleet_.robots(0).plan();
