@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include "planner/fleet/assignment.h"
+#include "planner/fleet/detour_turn.h"
 #include "planner/fleet/geodesic.h"
+#include "planner/fleet/one_tree.h"
 
 namespace covplan {
 namespace {
@@ -27,16 +30,26 @@ double UnitTime(const TourUnits& units, const TourUnit& u, const RobotModel& rob
 
 double Reversed(double heading) { return heading + M_PI; }
 
-// The least total turning (radians) of any path of straight segments and
-// turns in place from `a` heading `ha` to `b` heading `hb`
-// (docs/fleet.md): at least the net change, and, when the robot moves, the
-// way through the displacement's direction d, capped at half a turn (the
-// headings a path takes span an arc; under half a turn that arc holds d).
+// The least total turning (radians, up to a full turn) of any path of
+// straight segments and turns in place from `a` heading `ha` to `b` heading
+// `hb` (docs/fleet.md): the headings the path takes span an arc. Under half
+// a turn that arc holds the displacement's direction d (it is a positive sum
+// of the segments' headings) and the turning walks from ha through d to hb;
+// otherwise the walk covers an arc of half a turn or more from ha to hb,
+// which takes at least a full turn less the net change. Never less than the
+// net change.
 double TurnBound(double ha, double hb, Point2 a, Point2 b) {
   const double net = HeadingChange(ha, hb);
   if (std::hypot(b.x - a.x, b.y - a.y) <= 1e-9) return net;
   const double d = std::atan2(b.y - a.y, b.x - a.x);
-  return std::max(net, std::min(M_PI, HeadingChange(ha, d) + HeadingChange(d, hb)));
+  return std::max(net, std::min(2.0 * M_PI - net, HeadingChange(ha, d) + HeadingChange(d, hb)));
+}
+
+// Seconds to turn in place by `angle` radians in all (up to a full turn;
+// RobotModel::TurnTime takes a heading change, at most half a turn).
+double TurningTime(const RobotModel& robot, double angle) {
+  const double half = std::min(angle, M_PI);
+  return robot.TurnTime(half) + robot.TurnTime(std::max(0.0, angle - half));
 }
 
 }  // namespace
@@ -54,9 +67,16 @@ struct End {
 };
 
 // Sizes up to which the matching (points) and the assignment (units and
-// robots) bounds are computed: both are O(n^3) assignments.
+// robots) bounds are computed: both are O(n^3) assignments over the moves
+// between points, priced once.
 constexpr int kMaxMatching = 600;
 constexpr int kMaxAssignment = 400;
+// Points up to which the Held-Karp bound runs, and the vertex pairs its
+// subgradient steps may visit (about 0.1 s).
+constexpr int kMaxOneTree = 1200;
+constexpr int64_t kOneTreeWork = 100'000'000;
+// Moves up to this many cells long are checked for a detour's turning.
+constexpr double kDetourReach = 12.0;
 // Square visits all geodesic searches of one bound may take (about 0.1 s):
 // above it the searches stop at a depth (their bounds stay valid).
 constexpr int64_t kSearchBudget = 10'000'000;
@@ -92,6 +112,7 @@ class BoundInput {
       if (e) points_[end_pt(r)] = {e->x, e->y};
     }
     if (drive != nullptr) SearchRows(*drive);
+    drive_ = drive;
   }
   int n() const { return n_; }
   int k() const { return k_; }
@@ -132,18 +153,25 @@ class BoundInput {
   // The least time of any move from point a heading ha to point b heading
   // hb: straight moves from rest to rest take at least one move of their
   // summed length (StraightTime is concave), plus the least turning
-  // (TurnBound).
+  // (TurnBound, or the detour's when larger). QuickMove leaves the detour
+  // out: it is never more than Move, so a search can skip the detour of a
+  // move whose quick cost cannot beat the best found.
   double Move(int a, double ha, int b, double hb) const {
+    double turn = TurnBound(ha, hb, points_[a], points_[b]);
+    if (drive_ != nullptr && turn < 2.0 * M_PI) {
+      turn = std::max(turn, DetourTurnBound(*drive_, points_[a], ha, points_[b], hb,
+                                            kDetourReach * drive_->cell_size()));
+    }
+    return fastest_.StraightTime(Length(a, b)) + TurningTime(fastest_, turn);
+  }
+  double QuickMove(int a, double ha, int b, double hb) const {
     return fastest_.StraightTime(Length(a, b)) +
-           fastest_.TurnTime(TurnBound(ha, hb, points_[a], points_[b]));
+           TurningTime(fastest_, TurnBound(ha, hb, points_[a], points_[b]));
   }
   // The cheapest move into unit u (either direction) from robot r's start
-  // (0 when it has none), and out of u to r's end (0 when it has none).
+  // (0 when it has none).
   double FromStart(int r, int u) const {
     return std::min(FromStartVariant(r, 2 * u), FromStartVariant(r, 2 * u + 1));
-  }
-  double ToEnd(int r, int u) const {
-    return std::min(ToEndVariant(r, 2 * u), ToEndVariant(r, 2 * u + 1));
   }
   // Into variant v (= 2u + direction) from robot r's start; out of variant v
   // to robot r's end (0 without a start or end).
@@ -153,17 +181,6 @@ class BoundInput {
   }
   double ToEndVariant(int r, int v) const {
     return robot(r).end ? fastest_.StraightTime(Length(ends_[v].out_pt, end_pt(r))) : 0.0;
-  }
-  double Between(int w, int u) const {
-    double best = INFINITY;
-    for (int a = 0; a < 2; ++a) {
-      for (int b = 0; b < 2; ++b) {
-        const End& x = ends_[2 * w + a];
-        const End& y = ends_[2 * u + b];
-        best = std::min(best, Move(x.out_pt, x.h_out, y.in_pt, y.h_in));
-      }
-    }
-    return best;
   }
 
  private:
@@ -197,6 +214,7 @@ class BoundInput {
   }
 
   const std::vector<FleetRobot>& robots_;
+  const Grid* drive_ = nullptr;
   int n_ = 0, k_ = 0;
   RobotModel fastest_;
   std::vector<End> ends_;
@@ -241,7 +259,9 @@ double CheapestEntries(BoundInput& in) {
           if (gx < 0 || gy < 0 || gx >= side || gy >= side) continue;
           for (int w : buckets[gy * side + gx]) {
             if (w / 2 == u) continue;
-            best = std::min(best, in.Move(in.end(w).out_pt, in.end(w).h_out, e.in_pt, e.h_in));
+            const End& x = in.end(w);
+            if (in.QuickMove(x.out_pt, x.h_out, e.in_pt, e.h_in) < best)
+              best = std::min(best, in.Move(x.out_pt, x.h_out, e.in_pt, e.h_in));
           }
         }
       }
@@ -263,45 +283,23 @@ double CheapestEntries(BoundInput& in) {
   return sum;
 }
 
-// The least total cost of the moves of any k paths, start_r -> units ->
-// end_r, that enter every unit once: the assignment relaxation over the
-// predecessors (unit exits, starts) and successors (unit entries, ends).
-std::optional<double> AssignedMoves(const BoundInput& in) {
-  const int n = in.n(), k = in.k(), size = n + k;
-  std::vector<double> c(static_cast<size_t>(size) * size, INFINITY);
-  auto at = [&](int row, int col) -> double& { return c[static_cast<size_t>(row) * size + col]; };
-  for (int w = 0; w < n; ++w) {
-    for (int u = 0; u < n; ++u) {
-      if (u != w) at(w, u) = in.Between(w, u);
-    }
-    for (int r = 0; r < k; ++r) at(w, n + r) = in.ToEnd(r, w);
-  }
-  for (int r = 0; r < k; ++r) {
-    for (int u = 0; u < n; ++u) at(n + r, u) = in.FromStart(r, u);
-    at(n + r, n + r) = 0.0;  // a robot given nothing
-  }
-  return MinAssignmentCost(c, size);
-}
-
-// The least total cost of the moves of any k paths start_r -> units ->
-// end_r: the moves pair up the units' two ends, the starts and the ends, so
-// they form a perfect matching of those 2n + 2k points (a unit's own two ends
-// never; a start only with a unit or its own robot's end, an idle robot).
-// A lower bound of the minimum-cost perfect matching (half the assignment
-// over the points, PerfectMatchingLowerBound) keeps, unlike the assignment
-// over the units, each unit driven in one direction; the larger of the two is
-// taken.
-std::optional<double> MatchedMoves(const BoundInput& in) {
+// The moves between the 2n + 2k points (point 2u + v is unit u's end where
+// variant v enters it and variant 1 - v leaves it; then the starts, then the
+// ends): symmetric, +inf where no move of a fleet plan goes (a unit's own
+// two ends; a start with a start, an end or another robot's end). A start
+// with its own robot's end costs 0 (a robot given nothing).
+std::vector<double> MoveMatrix(const BoundInput& in) {
   const int n = in.n(), k = in.k(), size = 2 * n + 2 * k;
   std::vector<double> c(static_cast<size_t>(size) * size, INFINITY);
   auto set = [&](int a, int b, double v) {
     c[static_cast<size_t>(a) * size + b] = v;
     c[static_cast<size_t>(b) * size + a] = v;
   };
-  // Point 2u + v is unit u's end where variant v enters it (and variant 1 - v
-  // leaves it): leaving there heads along variant 1 - v's exit heading.
+  // Leaving point a heads along the exit heading of the variant that ends
+  // there (a ^ 1). The move back from b to a costs the same: its headings
+  // and direction are those of a -> b reversed.
   for (int a = 0; a < 2 * n; ++a) {
-    const End& leave = in.end(a ^ 1);  // the variant that ends at point a
+    const End& leave = in.end(a ^ 1);
     for (int b = a + 1; b < 2 * n; ++b) {
       if (a / 2 == b / 2) continue;
       const End& enter = in.end(b);
@@ -314,9 +312,67 @@ std::optional<double> MatchedMoves(const BoundInput& in) {
       set(start, a, in.FromStartVariant(r, a));
       set(end, a, in.ToEndVariant(r, a ^ 1));
     }
-    set(start, end, 0.0);  // a robot given nothing
+    set(start, end, 0.0);
   }
-  return PerfectMatchingLowerBound(c, size);
+  return c;
+}
+
+// The least total cost of the moves of any k paths start_r -> units ->
+// end_r: the moves pair up the units' two ends, the starts and the ends, so
+// they form a perfect matching of those 2n + 2k points. A lower bound of
+// the minimum-cost perfect matching (half the assignment over the points,
+// PerfectMatchingLowerBound) keeps, unlike the assignment over the units,
+// each unit driven in one direction.
+std::optional<double> MatchedMoves(const std::vector<double>& m, int n, int k) {
+  return PerfectMatchingLowerBound(m, 2 * (n + k));
+}
+
+// The least total cost of the moves of any k paths, start_r -> units ->
+// end_r, that enter every unit once: the assignment relaxation over the
+// predecessors (unit exits, starts) and successors (unit entries, ends),
+// each arc the cheapest of its directions in the point matrix `m`.
+std::optional<double> AssignedMoves(const std::vector<double>& m, int n, int k) {
+  const int points = 2 * n + 2 * k, size = n + k;
+  auto move = [&](int a, int b) { return m[static_cast<size_t>(a) * points + b]; };
+  // The cheapest move leaving one of the points a0, a0 + 1 (or a0 alone)
+  // into one of b0, b0 + 1 (or b0 alone).
+  auto cheapest = [&](int a0, int a_count, int b0, int b_count) {
+    double best = INFINITY;
+    for (int a = a0; a < a0 + a_count; ++a) {
+      for (int b = b0; b < b0 + b_count; ++b) best = std::min(best, move(a, b));
+    }
+    return best;
+  };
+  std::vector<double> c(static_cast<size_t>(size) * size, INFINITY);
+  auto at = [&](int row, int col) -> double& { return c[static_cast<size_t>(row) * size + col]; };
+  for (int w = 0; w < n; ++w) {
+    for (int u = 0; u < n; ++u) {
+      if (u != w) at(w, u) = cheapest(2 * w, 2, 2 * u, 2);
+    }
+    for (int r = 0; r < k; ++r) at(w, n + r) = cheapest(2 * w, 2, 2 * n + k + r, 1);
+  }
+  for (int r = 0; r < k; ++r) {
+    for (int u = 0; u < n; ++u) at(n + r, u) = cheapest(2 * n + r, 1, 2 * u, 2);
+    at(n + r, n + r) = 0.0;  // a robot given nothing
+  }
+  return MinAssignmentCost(c, size);
+}
+
+// The same moves with the subtours the matching allows eliminated: join
+// each unit's two ends (the unit, its time counted apart) and robot r's end
+// to robot r + 1's start (a free link), and the k paths chained in turn are
+// one cycle through all the points holding those forced edges. Its least
+// cost is at least the Held-Karp bound (one_tree.h).
+std::optional<double> OneTreeMoves(std::vector<double> c, int n, int k) {
+  const int size = 2 * n + 2 * k;
+  std::vector<int> partner(size);
+  auto force = [&](int a, int b) {
+    partner[a] = b, partner[b] = a;
+    c[static_cast<size_t>(a) * size + b] = c[static_cast<size_t>(b) * size + a] = 0.0;
+  };
+  for (int u = 0; u < n; ++u) force(2 * u, 2 * u + 1);
+  for (int r = 0; r < k; ++r) force(2 * n + k + r, 2 * n + (r + 1) % k);
+  return HeldKarpBound(c, partner, kOneTreeWork);
 }
 
 }  // namespace
@@ -330,10 +386,14 @@ MakespanBound MakespanLowerBound(const TourUnits& units, const std::vector<Fleet
   double work = 0.0;
   for (int u = 0; u < n; ++u) work += in.fastest_time(u);
   std::optional<double> moves;
-  if (2 * (n + k) <= kMaxMatching) moves = MatchedMoves(in);
-  if (n + k <= kMaxAssignment) {
-    const std::optional<double> assigned = AssignedMoves(in);
-    if (assigned && (!moves || *assigned > *moves)) moves = assigned;
+  auto keep = [&](const std::optional<double>& v) {
+    if (v && (!moves || *v > *moves)) moves = v;
+  };
+  if (2 * (n + k) <= kMaxOneTree) {  // every size cap below is within it
+    std::vector<double> matrix = MoveMatrix(in);
+    if (2 * (n + k) <= kMaxMatching) keep(MatchedMoves(matrix, n, k));
+    if (n + k <= kMaxAssignment) keep(AssignedMoves(matrix, n, k));
+    keep(OneTreeMoves(std::move(matrix), n, k));
   }
   work += moves.has_value() ? *moves : CheapestEntries(in);
   bound.work_s = std::max(0.0, work) / k;

@@ -11,10 +11,13 @@
 //          their summed length, StraightTime being concave) plus TurnBound
 //          at its top turn rate: the least turning of any path from a's
 //          heading to b's, at least the net change and, when the robot moves,
-//          the way through the direction of b - a, capped at half a turn. At
-//          most k units are entered from a start, so the k largest savings of
-//          a start over a unit are taken off (with a matching or an
-//          assignment relaxation of the moves when the fleet is small);
+//          the way through the direction of b - a or else a full turn less
+//          the net change; raised by the detour a blocked cell or a wall on
+//          the segment ab forces (detour_turn.h). At most k units are entered
+//          from a start, so the k largest savings of a start over a unit are
+//          taken off; when the fleet is small, the largest of a matching, an
+//          assignment and a Held-Karp 1-tree relaxation of the moves
+//          (one_tree.h) is used instead;
 //   reach: makespan >= max over units of min over robots of (the move from
 //          the robot's start to the unit + the unit + the move to its end
 //          pose), for the unit's better direction.
