@@ -41,10 +41,11 @@ bool FreeWithin(const Grid& g, Point2 p, double radius) {
 double ClearStretch(const Grid& g, Point2 x0, Point2 dir, double limit) {
   const double step = g.cell_size() / 4.0;
   const double w = g.cols() * g.cell_size(), hgt = g.rows() * g.cell_size();
-  for (double t = step;; t += step) {
+  // Samples step apart from t = 0: every point within step / 2 of a clear
+  // sample is clear, so all of [0, t - step / 2) is when sample t is not.
+  for (double t = 0.0;; t += step) {
     const Point2 p{x0.x + t * dir.x, x0.y + t * dir.y};
-    // Samples step apart: every point within step / 2 of a clear sample is clear.
-    if (FreeWithin(g, p, step / 2.0 + 1e-9)) return t - step / 2.0;
+    if (FreeWithin(g, p, step / 2.0 + 1e-9)) return std::max(0.0, t - step / 2.0);
     if (t >= limit) return t;
     const double px = p.x - g.origin().x, py = p.y - g.origin().y;
     if (px < -g.cell_size() || py < -g.cell_size() || px > w + g.cell_size() ||

@@ -123,7 +123,10 @@ std::optional<double> HeldKarpBound(const std::vector<double>& costs,
   std::vector<double>& p = graph.penalties();
   for (int64_t work = 0; work + per_step <= work_budget || work == 0; work += per_step) {
     const OneTree t = graph.Solve();
-    if (!t.connected) return std::nullopt;
+    // Connectivity does not depend on the penalties: only the first step
+    // can find the graph disconnected (a later one would be a numerical
+    // failure, and the best bound so far stands).
+    if (!t.connected) return best == -kInf ? std::nullopt : std::optional<double>(best);
     if (best == -kInf || t.value > best + 1e-9 * std::abs(best)) {
       best = t.value;
       stall = 0;
@@ -135,8 +138,11 @@ std::optional<double> HeldKarpBound(const std::vector<double>& costs,
     double norm2 = 0.0;
     for (int v = 0; v < n; ++v) norm2 += (t.degree[v] - 2.0) * (t.degree[v] - 2.0);
     if (norm2 == 0.0) break;  // the 1-tree is a cycle: the bound is exact
-    // Polyak's step towards a target above the best bound so far.
-    const double target = std::max(upper, best + 1e-3 * std::abs(best) + 1e-9);
+    // Polyak's step towards a target above the best bound so far (the
+    // nearest-neighbour cycle, or 5 % above the bound when it found none).
+    const double floor = best + 1e-3 * std::abs(best) + 1e-9;
+    const double target =
+        std::isfinite(upper) ? std::max(upper, floor) : best + 0.05 * std::abs(best) + 1e-6;
     const double step = lambda * (target - t.value) / norm2;
     for (int v = 0; v < n; ++v) p[v] += step * (t.degree[v] - 2.0);
   }

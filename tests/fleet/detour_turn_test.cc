@@ -97,6 +97,26 @@ TEST(DetourTurnBound, NeverAboveTheTurningOfARealPath) {
   EXPECT_GT(positive, 20);  // the bound does find detours
 }
 
+// A move that clips the corner of a blocked cell with free cells beside it:
+// the blocked stretch of the crossing line is almost nothing, and the bound
+// stays below a legal path that slips past the corner.
+TEST(DetourTurnBound, ClippingACornerCostsAlmostNothing) {
+  const Grid g = Grid::FromAscii({"...", ".#."}, 1.0);  // blocked: row 0, column 1
+  for (double y : {0.999, 0.95}) {
+    const Point2 a{0.5, y}, b{2.5, y};
+    // a -> the blocked cell's two top corners -> b, all on free squares.
+    const std::vector<Point2> path = {a, {1.0, 1.0}, {2.0, 1.0}, b};
+    double turning = 0.0, heading = 0.0;
+    for (size_t i = 1; i < path.size(); ++i) {
+      const double h = std::atan2(path[i].y - path[i - 1].y, path[i].x - path[i - 1].x);
+      turning += HeadingChange(heading, h);
+      heading = h;
+    }
+    turning += HeadingChange(heading, 0.0);
+    EXPECT_LE(DetourTurnBound(g, a, 0.0, b, 0.0, 12.0), turning + 1e-9) << "y = " << y;
+  }
+}
+
 TEST(DetourTurnBound, PricesTheWayRoundAWallOpenAtOneEnd) {
   // 5 x 5 free cells; a barrier above row 2 from column 2 to the east edge.
   // From (2, 2) heading east to (3, 2) heading west the robot must go round
