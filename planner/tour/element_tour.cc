@@ -117,12 +117,30 @@ absl::Status ElementTourModel::RoutePoses(const StopToken& stop, const char* sta
   return absl::OkStatus();
 }
 
-void ElementTourModel::TransitionPoints(int u, int v, std::vector<Point2>* pts) const {
+double ElementTourModel::TransitionPoints(int u, int v, std::vector<Point2>* pts) const {
   thread_local std::vector<CellIndex> cells;
+  thread_local std::vector<Point2> back;
+  const double heading_out = variants_[u].heading_out, heading_in = variants_[v].heading_in;
   cells.clear();
   table_->AppendPath(u ^ 1, v, &cells);
   pts->clear();
   for (const CellIndex& c : cells) pts->push_back(grid_->CellCenter(c));
+  double time = motion_->Polyline(*pts, heading_out, heading_in);
+  // The search from v's entry found its own shortest path back: driven in
+  // reverse it is as short (up to the search's tolerance) and may pass an
+  // obstacle on the other side, turning less for these headings.
+  if (table_->Reachable(v, u ^ 1)) {
+    cells.clear();
+    table_->AppendPath(v, u ^ 1, &cells);
+    back.clear();
+    for (auto c = cells.rbegin(); c != cells.rend(); ++c) back.push_back(grid_->CellCenter(*c));
+    const double back_time = motion_->Polyline(back, heading_out, heading_in);
+    if (back_time < time) {
+      time = back_time;
+      pts->swap(back);
+    }
+  }
+  return time;
 }
 
 double ElementTourModel::Between(int u, int v) const {
@@ -130,9 +148,7 @@ double ElementTourModel::Between(int u, int v) const {
     return std::numeric_limits<double>::infinity();
   }
   thread_local std::vector<Point2> pts;
-  TransitionPoints(u, v, &pts);
-  return motion_->Polyline(pts, variants_[u].heading_out, variants_[v].heading_in) +
-         variants_[v].traverse;
+  return TransitionPoints(u, v, &pts) + variants_[v].traverse;
 }
 
 void ElementTourModel::BuildPath(const std::vector<int>& vertices, std::vector<Waypoint>* path,

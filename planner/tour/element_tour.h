@@ -116,8 +116,10 @@ class ElementTourModel : public TourModel {
   absl::Status RoutePoses(const StopToken& stop, const char* start_name, const char* end_name);
 
  private:
-  // The cell centres of the table's path from the exit of u to the entry of v.
-  void TransitionPoints(int u, int v, std::vector<Point2>* pts) const;
+  // The cell centres of the path from the exit of u to the entry of v, and
+  // its time: the table's path, or the reverse of the table's path from v's
+  // entry to u's exit when that one takes less time with the two headings.
+  double TransitionPoints(int u, int v, std::vector<Point2>* pts) const;
 
   const Grid* grid_ = nullptr;
   const TransitionTable* table_ = nullptr;
