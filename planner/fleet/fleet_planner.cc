@@ -119,14 +119,17 @@ struct FleetSearch {
     time_left = Seconds(t0) + last_round_s < budget() && !request.base.common.stop.ShouldStop();
     return time_left;
   }
-  // Plans a division's shares; `share` of what is left of the budget goes to
-  // the tour searches of this round.
-  absl::Status PlanDivision(std::vector<std::vector<int64_t>> cells, double share, FleetPlan* out) {
-    if (connected) MakeRegionsConnected(*area->drive, &cells);
+  // The tour search limit of each share when `share` of what is left of
+  // the budget goes to the tour searches of a round.
+  double ShareLimit(double share) const {
     const size_t k = request.robots.size();
     const int threads = std::clamp<int>(request.base.common.num_threads, 1, static_cast<int>(k));
     const double batches = std::ceil(static_cast<double>(k) / threads);
-    const double limit = std::max(0.05, (budget() - Seconds(t0)) * share / batches);
+    return std::max(0.05, (budget() - Seconds(t0)) * share / batches);
+  }
+  // Plans a division's shares, each share's tour search within `limit`.
+  absl::Status PlanDivision(std::vector<std::vector<int64_t>> cells, double limit, FleetPlan* out) {
+    if (connected) MakeRegionsConnected(*area->drive, &cells);
     const absl::Time start = absl::Now();
     out->division = request.division;
     RETURN_IF_ERROR(PlanShares(engine, source, request, *area, cells, limit, out));
@@ -141,17 +144,21 @@ struct FleetSearch {
   }
 
   absl::Status Run(FleetPlan* best) {
-    if (request.division == FleetDivision::kEqualArea) return PlanDivision(Regions(), 0.5, best);
+    // The first round's limit; the equal-area candidate below gets the same,
+    // as the equal-area division planned alone does.
+    const double first_limit = ShareLimit(0.5);
+    if (request.division == FleetDivision::kEqualArea)
+      return PlanDivision(Regions(), first_limit, best);
     TourSplit split = SplitTour(costs);
-    RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), 0.5, best));
+    RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), first_limit, best));
     FleetPlan last = *best;  // the plans of `split`
     // The equal-area regions are one more candidate: the makespan division is
     // never worse than the baseline where the tour's pieces are.
-    // It may overrun the budget by a quarter (never the caller's deadline),
-    // so that on small sites the baseline never wins.
-    if (!request.base.common.stop.ShouldStop() && Seconds(t0) + last_round_s <= 1.25 * budget()) {
+    // It may overrun the budget by 15 % (never the caller's deadline), so
+    // that on small sites, where rounds are quick, the baseline never wins.
+    if (!request.base.common.stop.ShouldStop() && Seconds(t0) + last_round_s <= 1.15 * budget()) {
       FleetPlan candidate;
-      RETURN_IF_ERROR(PlanDivision(Regions(), 0.5, &candidate));
+      RETURN_IF_ERROR(PlanDivision(Regions(), first_limit, &candidate));
       if (candidate.makespan_s < best->makespan_s) {
         candidate.from_regions = true;
         *best = std::move(candidate);
@@ -173,7 +180,7 @@ struct FleetSearch {
       if (next.pieces == split.pieces) break;
       split = std::move(next);
       FleetPlan candidate;
-      RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), 0.25, &candidate));
+      RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), ShareLimit(0.25), &candidate));
       ++rounds;
       last = candidate;
       if (candidate.makespan_s < best->makespan_s) *best = std::move(candidate);
