@@ -24,6 +24,7 @@
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
 #include "tests/testing/test_maps.h"
+#include "tests/testing/timing.h"
 
 namespace covplan {
 namespace {
@@ -280,11 +281,8 @@ TEST_F(ServerProcessTest, CorruptedMapFileIsReportedNotServed) {
 
 // The short deadline: sanitizers slow the server about threefold, so the
 // same property is checked there at a proportionally longer deadline.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr absl::Duration kShortDeadline = absl::Milliseconds(450);
-#else
-constexpr absl::Duration kShortDeadline = absl::Milliseconds(150);
-#endif
+constexpr absl::Duration kShortDeadline =
+    absl::Milliseconds(static_cast<int64_t>(150 * testing::kTimingSlowdown));
 
 TEST_F(ServerProcessTest, ShortDeadlineGetsAValidPlanInTime) {
   // The repeated request must search under its deadline, not be remembered.
