@@ -265,7 +265,8 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
   const std::shared_ptr<const CoverageArea> area = whole->area;
   const TourUnits units = UnitsOfPlan(whole->plan, *area->cover);
   ASSIGN_OR_RETURN(UnitCosts costs,
-                   UnitCosts::Build(units, *area->drive, request.robots, request.base.common.stop));
+                   UnitCosts::Build(units, *area->drive, request.robots, request.base.common.stop,
+                                    request.base.common.num_threads));
   // The bound needs no plan: it is computed beside the search.
   double lower_bound = 0.0;
   std::thread bound_thread(

@@ -1,6 +1,9 @@
 #include "planner/fleet/units.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
 #include <utility>
 
 #include "absl/strings/str_format.h"
@@ -46,16 +49,6 @@ TourUnits UnitsOfPlan(const CoveragePlan& plan, const Grid& grid) {
 
 namespace {
 
-// Seconds from a pose to every cell of `drive` (any-angle distance driven at
-// the robot's speed, one turn onto the straight line): +inf where unreachable.
-absl::StatusOr<AnyAngleSearch*> SearchFrom(AnyAngleSearch* search, const Grid& drive,
-                                           const Pose2& pose, const std::string& what,
-                                           const StopToken& stop) {
-  ASSIGN_OR_RETURN(CellIndex cell, JoinCell(drive, pose, what.c_str()));
-  if (!search->Run(cell, stop)) return absl::DeadlineExceededError("fleet: cancelled");
-  return search;
-}
-
 double TripTime(const RobotModel& robot, Point2 a, std::optional<double> heading_a, Point2 b,
                 std::optional<double> heading_b, double path_m) {
   const double straight = std::hypot(b.x - a.x, b.y - a.y);
@@ -72,7 +65,7 @@ double TripTime(const RobotModel& robot, Point2 a, std::optional<double> heading
 
 absl::StatusOr<UnitCosts> UnitCosts::Build(const TourUnits& units, const Grid& drive,
                                            const std::vector<FleetRobot>& robots,
-                                           const StopToken& stop) {
+                                           const StopToken& stop, int num_threads) {
   UnitCosts c;
   const int n = static_cast<int>(units.units.size());
   const int k = static_cast<int>(robots.size());
@@ -109,51 +102,79 @@ absl::StatusOr<UnitCosts> UnitCosts::Build(const TourUnits& units, const Grid& d
   }
   // Distances (metres) from each distinct pose to every unit's entry and
   // exit: one any-angle search per pose (a robot that ends where it starts,
-  // or robots sharing a dock, share one).
-  AnyAngleSearch search(drive);
-  const double cell = drive.cell_size();
+  // or robots sharing a dock, share one), up to `num_threads` at a time.
   struct Field {
-    double x, y;
+    Pose2 pose;
+    CellIndex cell;
     std::vector<double> entry, exit;
   };
   std::vector<Field> fields;
-  auto field = [&](const Pose2& pose, const std::string& what) -> absl::StatusOr<const Field*> {
-    for (const Field& f : fields) {
-      if (f.x == pose.x && f.y == pose.y) return &f;
+  std::vector<int> start_field(k, -1), end_field(k, -1);
+  auto field_of = [&](const Pose2& pose, const std::string& what) -> absl::StatusOr<int> {
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (fields[i].pose.x == pose.x && fields[i].pose.y == pose.y) return static_cast<int>(i);
     }
-    ASSIGN_OR_RETURN(AnyAngleSearch * s, SearchFrom(&search, drive, pose, what, stop));
-    Field f{pose.x, pose.y, std::vector<double>(n), std::vector<double>(n)};
-    auto at = [&](Point2 p) {
-      const CellIndex c = drive.CellAt(p);
-      return drive.IsFree(c) && s->Reached(c) ? s->DistanceCells(c) * cell : INFINITY;
-    };
-    for (int u = 0; u < n; ++u) {
-      f.entry[u] = at(units.units[u].entry);
-      f.exit[u] = at(units.units[u].exit);
-    }
-    fields.push_back(std::move(f));
-    return &fields.back();
+    ASSIGN_OR_RETURN(CellIndex cell, JoinCell(drive, pose, what.c_str()));
+    fields.push_back({pose, cell, {}, {}});
+    return static_cast<int>(fields.size()) - 1;
   };
-  fields.reserve(2 * k);
   for (int r = 0; r < k; ++r) {
     const RobotModel& robot = robots[r].robot;
     if (robot.start.has_value()) {
-      ASSIGN_OR_RETURN(const Field* f,
-                       field(*robot.start, absl::StrFormat("robots[%d].robot.start", r)));
+      ASSIGN_OR_RETURN(start_field[r],
+                       field_of(*robot.start, absl::StrFormat("robots[%d].robot.start", r)));
+    }
+    if (robot.end.has_value()) {
+      ASSIGN_OR_RETURN(end_field[r],
+                       field_of(*robot.end, absl::StrFormat("robots[%d].robot.end", r)));
+    }
+  }
+  const double cell = drive.cell_size();
+  std::atomic<size_t> next{0};
+  std::atomic<bool> cancelled{false};
+  auto work = [&] {
+    AnyAngleSearch search(drive);
+    for (size_t i; (i = next.fetch_add(1)) < fields.size() && !cancelled;) {
+      Field& f = fields[i];
+      if (!search.Run(f.cell, stop)) {
+        cancelled = true;
+        return;
+      }
+      auto at = [&](Point2 p) {
+        const CellIndex c = drive.CellAt(p);
+        return drive.IsFree(c) && search.Reached(c) ? search.DistanceCells(c) * cell : INFINITY;
+      };
+      f.entry.resize(n);
+      f.exit.resize(n);
+      for (int u = 0; u < n; ++u) {
+        f.entry[u] = at(units.units[u].entry);
+        f.exit[u] = at(units.units[u].exit);
+      }
+    }
+  };
+  const int threads = std::clamp<int>(num_threads, 1, std::max<int>(1, fields.size()));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  if (cancelled) return absl::DeadlineExceededError("fleet: cancelled");
+  for (int r = 0; r < k; ++r) {
+    const RobotModel& robot = robots[r].robot;
+    if (start_field[r] >= 0) {
+      const Field& f = fields[start_field[r]];
       const Point2 from{robot.start->x, robot.start->y};
       for (int u = 0; u < n; ++u) {
-        const double d = f->entry[u];
+        const double d = f.entry[u];
         c.reach_[r][u] = std::isfinite(d) ? TripTime(robot, from, robot.start->theta,
                                                      units.units[u].entry, std::nullopt, d)
                                           : INFINITY;
       }
     }
-    if (robot.end.has_value()) {
-      ASSIGN_OR_RETURN(const Field* f,
-                       field(*robot.end, absl::StrFormat("robots[%d].robot.end", r)));
+    if (end_field[r] >= 0) {
+      const Field& f = fields[end_field[r]];
       const Point2 to{robot.end->x, robot.end->y};
       for (int u = 0; u < n; ++u) {
-        const double d = f->exit[u];
+        const double d = f.exit[u];
         c.ret_[r][u] = std::isfinite(d) ? TripTime(robot, units.units[u].exit,
                                                    units.units[u].exit_heading, to, std::nullopt, d)
                                         : INFINITY;

@@ -8,7 +8,7 @@
 // own model) and the trip to its end pose.
 //
 //   ASSIGN_OR_RETURN(TourUnits units, UnitsOfPlan(reference, *area.drive));
-//   ASSIGN_OR_RETURN(UnitCosts costs, UnitCosts::Build(units, *area.drive, robots, stop));
+//   ASSIGN_OR_RETURN(UnitCosts costs, UnitCosts::Build(units, *area.drive, robots, stop, 2));
 //   double t = costs.Piece(r, first, last);
 //
 // Thread-safety: immutable after construction.
@@ -47,11 +47,12 @@ TourUnits UnitsOfPlan(const CoveragePlan& plan, const Grid& grid);
 class UnitCosts {
  public:
   // Any-angle distance fields on `drive` from each robot's start and end
-  // pose (InvalidArgument naming robots[i].robot.start/end when a pose lies
-  // outside the drive grid or where it cannot join it).
+  // pose, up to `num_threads` searches at a time (InvalidArgument naming
+  // robots[i].robot.start/end when a pose lies outside the drive grid or
+  // where it cannot join it).
   static absl::StatusOr<UnitCosts> Build(const TourUnits& units, const Grid& drive,
                                          const std::vector<FleetRobot>& robots,
-                                         const StopToken& stop);
+                                         const StopToken& stop, int num_threads = 1);
 
   int num_robots() const { return static_cast<int>(reach_.size()); }
   int num_units() const { return num_units_; }
