@@ -17,6 +17,6 @@ if [ "${WAREHOUSE:-1}" = 1 ]; then
   out=$(mktemp -d)
   /usr/bin/python3 scripts/maps/gen_warehouse.py warehouse "$out"
   /usr/bin/time -f "warehouse peak RSS %M KiB, %e s" build/bin/fleet_bench --tool 0.3 \
-    --budget "${WAREHOUSE_BUDGET:-6}" --threads 2 --robots 8 "$out/warehouse.yaml"
+    --budget "${WAREHOUSE_BUDGET:-3}" --threads 2 --robots 8 "$out/warehouse.yaml"
   rm -rf "$out"
 fi
