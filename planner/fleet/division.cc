@@ -224,21 +224,22 @@ bool KeepsRegionConnected(const Grid& drive, const std::vector<int>& owner, int6
   return all || runs <= 1;
 }
 
-// Evens out the cell counts of regions grown unevenly (a robot boxed in by
-// the others): the largest region hands the cells along its border with its
-// smallest neighbour over to it, half the difference at a time, while that
-// narrows the spread.
-void BalanceRegions(const Grid& drive, int k, std::vector<int>* owner_ptr) {
+// Evens out the loads (the summed cell costs) of regions grown unevenly (a
+// robot boxed in by the others): the most loaded region hands the cells
+// along its border with its least loaded neighbour over to it, up to half
+// the difference at a time, while that narrows the spread.
+void BalanceRegions(const Grid& drive, int k, const std::vector<double>& cost,
+                    std::vector<int>* owner_ptr) {
   std::vector<int>& owner = *owner_ptr;
-  std::vector<int64_t> count(k, 0);
-  for (int o : owner) {
-    if (o >= 0) ++count[o];
+  std::vector<double> load(k, 0.0);
+  for (int64_t i = 0; i < drive.size(); ++i) {
+    if (owner[i] >= 0) load[owner[i]] += cost[i];
   }
   std::vector<uint8_t> stuck(k, 0);
   for (int round = 0; round < 64 * k; ++round) {
     int big = -1;
     for (int r = 0; r < k; ++r) {
-      if (!stuck[r] && (big < 0 || count[r] > count[big])) big = r;
+      if (!stuck[r] && (big < 0 || load[r] > load[big])) big = r;
     }
     if (big < 0) break;
     // Its border cells, by neighbour.
@@ -256,25 +257,26 @@ void BalanceRegions(const Grid& drive, int k, std::vector<int>* owner_ptr) {
     }
     int small = -1;
     for (int r = 0; r < k; ++r) {
-      if (!border[r].empty() && count[r] + 1 < count[big] && (small < 0 || count[r] < count[small]))
+      if (!border[r].empty() && load[r] < load[big] && (small < 0 || load[r] < load[small]))
         small = r;
     }
     if (small < 0) {
       stuck[big] = 1;
       continue;
     }
-    // Hand over border cells whose loss leaves `big` connected around them.
-    const int64_t want = (count[big] - count[small]) / 2;
-    int64_t given = 0;
+    // Hand over border cells whose loss leaves `big` connected around them,
+    // up to half the difference (no further: the two would swap places).
+    const double want = (load[big] - load[small]) / 2.0;
+    double given = 0.0;
     for (int64_t i : border[small]) {
-      if (given >= want) break;
+      if (given + cost[i] > want) break;
       if (!KeepsRegionConnected(drive, owner, i)) continue;
       owner[i] = small;
-      ++given;
+      given += cost[i];
     }
-    count[big] -= given;
-    count[small] += given;
-    if (given == 0) {
+    load[big] -= given;
+    load[small] += given;
+    if (given == 0.0) {
       stuck[big] = 1;
       continue;
     }
@@ -286,11 +288,21 @@ void BalanceRegions(const Grid& drive, int k, std::vector<int>* owner_ptr) {
 
 std::vector<std::vector<int64_t>> EqualAreaRegions(
     const Grid& drive, const Grid& cover, const std::vector<std::optional<Pose2>>& starts) {
+  return BalancedRegions(drive, cover, starts, std::vector<double>(drive.size(), 1.0));
+}
+
+std::vector<std::vector<int64_t>> BalancedRegions(const Grid& drive, const Grid& cover,
+                                                  const std::vector<std::optional<Pose2>>& starts,
+                                                  const std::vector<double>& cost) {
   const int k = static_cast<int>(starts.size());
   std::vector<std::vector<int64_t>> regions(k);
   if (k == 0) return regions;
   const int64_t total = cover.CountFree();
-  const int64_t quota = (total + k - 1) / k;
+  double total_cost = 0.0;
+  for (int64_t i = 0; i < drive.size(); ++i) {
+    if (cover.free_flags()[i]) total_cost += cost[i];
+  }
+  const double quota = total_cost / k;
   int unseeded = 0;
   for (const auto& s : starts) unseeded += !s.has_value();
   const std::vector<int64_t> spread = SpreadSeeds(cover, unseeded);
@@ -314,7 +326,7 @@ std::vector<std::vector<int64_t>> EqualAreaRegions(
   }
   // In turns, each robot under its quota claims its nearest unclaimed cover
   // cell; it grows through free cells no other robot has claimed.
-  std::vector<int64_t> claimed(k, 0);
+  std::vector<double> claimed(k, 0.0);
   int64_t left = total;
   for (bool progress = true; left > 0 && progress;) {
     progress = false;
@@ -333,7 +345,7 @@ std::vector<std::vector<int64_t>> EqualAreaRegions(
         }
         if (owner[i] < 0 && cover.free_flags()[i]) {
           owner[i] = r;
-          ++claimed[r];
+          claimed[r] += cost[i];
           --left;
           progress = true;
           break;
@@ -362,7 +374,7 @@ std::vector<std::vector<int64_t>> EqualAreaRegions(
   for (int64_t i = 0; i < drive.size(); ++i) {
     if (owner[i] >= 0 && !cover.free_flags()[i]) owner[i] = -1;
   }
-  BalanceRegions(drive, k, &owner);
+  BalanceRegions(drive, k, cost, &owner);
   for (int64_t i = 0; i < drive.size(); ++i) {
     if (owner[i] >= 0) regions[owner[i]].push_back(i);
   }

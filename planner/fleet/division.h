@@ -12,15 +12,20 @@
 // the robots sorted by where along the tour their start is nearest, improved
 // by swapping neighbours at the best cut. Of splits within 1 % of the best
 // makespan, the one with the least summed robot time (trips from the starts
-// included) is kept: robots stay nearer home. Pieces
-// of one tour are compact (the tour sweeps a room before the next), so the
-// robots do not criss-cross the site.
+// included) is kept: robots stay nearer home. Pieces of a tour that sweeps a
+// room before the next are runs of rooms; where the tour comes back (long
+// aisles across a warehouse) they scatter, and BalancedRegions is the
+// compact alternative.
 //
 // EqualAreaRegions (the DARP-style baseline): regions of equal cell count,
 // grown in turns from each robot's start over the drive grid, each region
 // connected; cells no region reached go to the nearest region, and regions
 // left uneven (a robot boxed in by the others) trade border cells, largest
 // to its smallest neighbour, until the spread stops narrowing.
+//
+// BalancedRegions: the same with a cost per cell (the makespan division's
+// candidate: the seconds the reference tour spends per cell), regions of
+// equal summed cost.
 //
 // MakeRegionsConnected: the cells of each robot that lie outside its
 // largest connected part are handed to the neighbouring region that touches
@@ -56,6 +61,13 @@ std::vector<std::vector<int64_t>> CellsOfSplit(const TourUnits& units, const Tou
 // robot's start pose (nullopt: seeds spread over the site, farthest first).
 std::vector<std::vector<int64_t>> EqualAreaRegions(const Grid& drive, const Grid& cover,
                                                    const std::vector<std::optional<Pose2>>& starts);
+
+// Per robot, the cover cells of a region whose cells cost about 1/k of
+// all; `cost` is indexed like the grids (Grid::Index), each entry positive
+// and finite.
+std::vector<std::vector<int64_t>> BalancedRegions(const Grid& drive, const Grid& cover,
+                                                  const std::vector<std::optional<Pose2>>& starts,
+                                                  const std::vector<double>& cost);
 
 // Rewrites `cells` (per robot) so that each robot's cells are connected on
 // `drive` (4-neighbours, barriers respected); returns the cells moved.

@@ -137,10 +137,34 @@ struct FleetSearch {
     last_round_s = Seconds(start);
     return absl::OkStatus();
   }
-  std::vector<std::vector<int64_t>> Regions() const {
+  std::vector<std::optional<Pose2>> Starts() const {
     std::vector<std::optional<Pose2>> starts;
     for (const FleetRobot& r : request.robots) starts.push_back(r.robot.start);
-    return EqualAreaRegions(*area->drive, *area->cover, starts);
+    return starts;
+  }
+  // Regions grown from the starts that take the reference tour equal time:
+  // each cell costs its unit's seconds in the tour (the move on to the next
+  // unit included) over the unit's cells.
+  std::vector<std::vector<int64_t>> TimeRegions() const {
+    const Grid& drive = *area->drive;
+    std::vector<double> cost(static_cast<size_t>(drive.size()), 0.0);
+    double sum = 0.0;
+    int64_t cells = 0;
+    for (int u = 0; u < costs.num_units(); ++u) {
+      const TourUnit& unit = units.units[u];
+      if (unit.cells.empty()) continue;
+      const double each = costs.Step(0, u) / static_cast<double>(unit.cells.size());
+      for (int64_t c : unit.cells) cost[c] = each;
+      sum += costs.Step(0, u);
+      cells += static_cast<int64_t>(unit.cells.size());
+    }
+    // Cells no unit swept (none in a complete tour) and zero-time units:
+    // the mean.
+    const double mean = cells > 0 && sum > 0.0 ? sum / static_cast<double>(cells) : 1.0;
+    for (double& c : cost) {
+      if (!(c > 0.0)) c = mean;
+    }
+    return BalancedRegions(drive, *area->cover, Starts(), cost);
   }
 
   absl::Status Run(FleetPlan* best) {
@@ -148,17 +172,18 @@ struct FleetSearch {
     // as the equal-area division planned alone does.
     const double first_limit = ShareLimit(0.5);
     if (request.division == FleetDivision::kEqualArea)
-      return PlanDivision(Regions(), first_limit, best);
+      return PlanDivision(EqualAreaRegions(*area->drive, *area->cover, Starts()), first_limit,
+                          best);
     TourSplit split = SplitTour(costs);
     RETURN_IF_ERROR(PlanDivision(CellsOfSplit(units, split), first_limit, best));
     FleetPlan last = *best;  // the plans of `split`
-    // The equal-area regions are one more candidate: the makespan division is
-    // never worse than the baseline where the tour's pieces are.
+    // Compact regions of equal tour time are one more candidate, where the
+    // tour's pieces lie scattered or a robot's trip from its start weighs.
     // It may overrun the budget by 15 % (never the caller's deadline), so
-    // that on small sites, where rounds are quick, the baseline never wins.
+    // that on small sites, where rounds are quick, it is always tried.
     if (!request.base.common.stop.ShouldStop() && Seconds(t0) + last_round_s <= 1.15 * budget()) {
       FleetPlan candidate;
-      RETURN_IF_ERROR(PlanDivision(Regions(), first_limit, &candidate));
+      RETURN_IF_ERROR(PlanDivision(TimeRegions(), first_limit, &candidate));
       if (candidate.makespan_s < best->makespan_s) {
         candidate.from_regions = true;
         *best = std::move(candidate);

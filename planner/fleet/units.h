@@ -71,6 +71,9 @@ class UnitCosts {
   double Along(int r, int first, int last) const {
     return prefix_[r][last + 1] - prefix_[r][first] - move_[r][last % num_units_];
   }
+  // Robot r's seconds on unit m of the tour and the move on to the next
+  // (unscaled).
+  double Step(int r, int m) const { return prefix_[r][m + 1] - prefix_[r][m]; }
   // Multiplies robot r's piece costs, to learn from its real plans.
   void SetScale(int r, double s) { scale_[r] = s; }
   double scale(int r) const { return scale_[r]; }

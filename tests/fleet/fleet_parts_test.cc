@@ -1,5 +1,5 @@
 // The fleet's parts alone: the assignment solver against brute force, and
-// the equal-area regions on an open grid.
+// the equal-area and equal-cost regions on an open grid.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -102,6 +102,39 @@ TEST(EqualArea, RegionsOfAnOpenGridAreEqualConnectedAndCoverEverything) {
     EXPECT_LE(hi - lo, 2) << "k=" << k;
     std::vector<std::vector<int64_t>> copy = regions;
     EXPECT_EQ(MakeRegionsConnected(g, &copy), 0) << "k=" << k << ": a region was not connected";
+  }
+}
+
+TEST(BalancedRegions, RegionsOfEqualCostAreConnectedAndCoverEverything) {
+  // Cells of the left half cost three times those of the right half: a
+  // robot starting on the left gets fewer cells than one on the right.
+  std::vector<uint8_t> free(30 * 40, 1);
+  const Grid g(30, 40, 1.0, {0.0, 0.0}, free);
+  std::vector<double> cost(static_cast<size_t>(g.size()));
+  for (int64_t i = 0; i < g.size(); ++i) cost[i] = g.FromIndex(i).col < 20 ? 3.0 : 1.0;
+  double total_cost = 0.0;
+  for (double c : cost) total_cost += c;  // 30 * (20 * 3 + 20) = 2400
+  for (int k : {2, 3, 4}) {
+    SCOPED_TRACE(k);
+    std::vector<std::optional<Pose2>> starts;
+    for (int r = 0; r < k; ++r) starts.push_back(Pose2{0.5 + 39.0 * r / (k - 1), 15.5, 0.0});
+    std::vector<std::vector<int64_t>> regions = BalancedRegions(g, g, starts, cost);
+    ASSERT_EQ(regions.size(), static_cast<size_t>(k));
+    int64_t cells = 0;
+    std::vector<double> load(k, 0.0);
+    for (int r = 0; r < k; ++r) {
+      cells += static_cast<int64_t>(regions[r].size());
+      for (int64_t i : regions[r]) load[r] += cost[i];
+    }
+    EXPECT_EQ(cells, g.size());
+    for (int r = 0; r < k; ++r) {
+      // Within three of the costliest cells of an equal share.
+      EXPECT_NEAR(load[r], total_cost / k, 9.0) << "robot " << r;
+    }
+    // The robot on the costly side sweeps fewer cells than the one on the cheap side.
+    EXPECT_LT(regions[0].size(), regions[k - 1].size());
+    std::vector<std::vector<int64_t>> copy = regions;
+    EXPECT_EQ(MakeRegionsConnected(g, &copy), 0) << "a region was not connected";
   }
 }
 
