@@ -17,6 +17,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "tests/testing/timing.h"
 
 namespace covplan {
 namespace {
@@ -223,25 +224,33 @@ TEST_F(ReplanServiceTest, MalformedRequestsAreInvalidArgumentOrNotFound) {
 TEST_F(ReplanServiceTest, AShortDeadlineIsAnsweredInTimeWithAPlan) {
   v1::PlanResponse plan;
   ASSERT_TRUE(Plan(PlanRequestForOffice(), &plan).ok());
+  // 150 ms, proportionally longer under sanitizers (testing::kTimingSlowdown).
+  const std::chrono::milliseconds deadline(static_cast<int64_t>(150 * testing::kTimingSlowdown));
   for (v1::ReplanMethod method : {v1::AUTO, v1::ILP1, v1::FULL}) {
     v1::ReplanRequest request = RequestFor(plan);
     request.set_method(method);
     v1::ReplanResponse out;
     const auto start = std::chrono::steady_clock::now();
-    const grpc::Status status = Replan(request, &out, std::chrono::milliseconds(150));
+    const grpc::Status status = Replan(request, &out, deadline);
     const auto elapsed = std::chrono::steady_clock::now() - start;
     ASSERT_TRUE(status.ok()) << v1::ReplanMethod_Name(method) << ": " << status.error_message();
-    EXPECT_LT(elapsed, std::chrono::milliseconds(150));
+    EXPECT_LT(elapsed, deadline);
     EXPECT_EQ(Swept(out.plan()), out.replan().remaining_cells()) << v1::ReplanMethod_Name(method);
   }
 }
 
 TEST_F(ReplanServiceTest, TheEstimatorIsKeptAcrossRestarts) {
+  // The greedy tour does not depend on how far a timed search got, so the
+  // box meets the same uncovered ranks in every build and the replan that
+  // repartitions them teaches the estimator a sample.
+  v1::PlanRequest request = PlanRequestForOffice();
+  request.set_tour_solver(v1::GREEDY);
   v1::PlanResponse plan;
-  ASSERT_TRUE(Plan(PlanRequestForOffice(), &plan).ok());
+  ASSERT_TRUE(Plan(request, &plan).ok());
   v1::ReplanResponse out;
   ASSERT_TRUE(Replan(RequestFor(plan), &out).ok());
   ASSERT_GE(out.replan().replanned_encounter(), 0) << out.replan().method();
+  ASSERT_GT(out.replan().new_ranks(), 0) << out.replan().method();
   const int64_t samples = server_->service().estimator().num_samples();
   EXPECT_GE(samples, 1);
   server_.reset();

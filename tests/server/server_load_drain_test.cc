@@ -24,6 +24,7 @@
 #include "tests/server/server_process.h"
 #include "tests/testing/png_writer.h"
 #include "tests/testing/test_maps.h"
+#include "tests/testing/timing.h"
 
 namespace covplan {
 namespace {
@@ -75,15 +76,19 @@ TEST_F(ServerHardeningTest, TimeLostInTheQueueIsResourceExhaustedNotDeadlineExce
     EXPECT_TRUE(stub_->Plan(&context, request, &response).ok());
   });
   absl::SleepFor(absl::Milliseconds(100));
-  // Waits ~1.9 s for the worker, then has ~0.6 s for a map whose artifacts
-  // take longer than that to build.
+  // Waits ~1.9 s for the worker, then has ~0.6 s (under sanitizers, which
+  // slow the busy solve's overrun and the reply, ~2 s) for a map whose
+  // artifacts take longer than that to build.
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(2500));
+  context.set_deadline(
+      std::chrono::system_clock::now() +
+      std::chrono::milliseconds(2000 + static_cast<int64_t>(500 * testing::kTimingSlowdown)));
   v1::PlanRequest request = testing::PlanRequestFor(fresh_map, 0.2);
   v1::PlanResponse response;
   const grpc::Status status = stub_->Plan(&context, request, &response);
   busy.join();
-  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED)
+      << status.error_message() << server_->log();
   EXPECT_THAT(status.error_message(), HasSubstr("server busy"));
 }
 
