@@ -144,18 +144,21 @@ struct FleetSearch {
   }
   // Regions grown from the starts that take the reference tour equal time:
   // each cell costs its unit's seconds in the tour (the move on to the next
-  // unit included) over the unit's cells.
+  // unit included; not the move from the last unit back to the first, which
+  // no robot drives) over the unit's cells.
   std::vector<std::vector<int64_t>> TimeRegions() const {
     const Grid& drive = *area->drive;
     std::vector<double> cost(static_cast<size_t>(drive.size()), 0.0);
     double sum = 0.0;
     int64_t cells = 0;
-    for (int u = 0; u < costs.num_units(); ++u) {
+    const int n = costs.num_units();
+    for (int u = 0; u < n; ++u) {
       const TourUnit& unit = units.units[u];
       if (unit.cells.empty()) continue;
-      const double each = costs.Step(0, u) / static_cast<double>(unit.cells.size());
+      const double seconds = u + 1 < n ? costs.Step(0, u) : costs.Along(0, u, u);
+      const double each = seconds / static_cast<double>(unit.cells.size());
       for (int64_t c : unit.cells) cost[c] = each;
-      sum += costs.Step(0, u);
+      sum += seconds;
       cells += static_cast<int64_t>(unit.cells.size());
     }
     // Cells no unit swept (none in a complete tour) and zero-time units:
