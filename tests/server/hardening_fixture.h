@@ -32,7 +32,6 @@
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
 #include "tests/testing/test_maps.h"
-#include "tests/testing/timing.h"
 
 namespace covplan::testing {
 
@@ -121,8 +120,7 @@ class ServerHardeningTest : public ::testing::Test {
 
   void StartServer(const std::vector<std::string>& args = {}) {
     server_ = std::make_unique<ServerProcess>();
-    std::vector<std::string> all = {"--metrics_port=-1", "--drain_notice_s=0",
-                                    testing::ReplyMarginFlag()};
+    std::vector<std::string> all = testing::QuietServerFlags();
     all.insert(all.end(), args.begin(), args.end());
     const absl::Status started = server_->Start(store_, all);
     ASSERT_TRUE(started.ok()) << started;

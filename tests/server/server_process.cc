@@ -12,6 +12,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "server/service_options.h"
+#include "tests/testing/timing.h"
 
 namespace covplan::testing {
 namespace {
@@ -135,6 +137,12 @@ std::string ServerProcess::log() const {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+std::vector<std::string> QuietServerFlags() {
+  const double margin_ms = absl::ToDoubleMilliseconds(ServiceOptions().deadline_margin);
+  return {"--metrics_port=-1", "--drain_notice_s=0",
+          absl::StrCat("--deadline_margin_ms=", static_cast<int>(margin_ms * kTimingSlowdown))};
 }
 
 }  // namespace covplan::testing

@@ -58,6 +58,13 @@ class ServerProcess {
   std::string log_path_;
 };
 
+// The flags the process-level test fixtures start a server with (flags
+// given after them win): no /metrics (its HTTP server takes ~2 s to stop),
+// no drain notice, and the reply margin (--deadline_margin_ms, the service's
+// default) scaled by kTimingSlowdown: a sanitized server needs longer to
+// notice its stop and send, so a reply due at the deadline arrives in time.
+std::vector<std::string> QuietServerFlags();
+
 }  // namespace covplan::testing
 
 #endif  // COVPLAN_TESTS_SERVER_SERVER_PROCESS_H_

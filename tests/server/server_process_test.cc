@@ -62,13 +62,10 @@ class ServerProcessTest : public ::testing::Test {
     std::filesystem::remove_all(root_, ec);
   }
 
-  // Without /metrics (its HTTP server takes ~2 s to stop) and without the
-  // drain notice, and with the reply margin scaled for sanitizers
-  // (testing::ReplyMarginFlag), unless `args` ask otherwise (the last flag wins).
+  // testing::QuietServerFlags, then `args` (the last flag wins).
   void StartServer(const std::vector<std::string>& args = {}) {
     server_ = std::make_unique<ServerProcess>();
-    std::vector<std::string> all = {"--metrics_port=-1", "--drain_notice_s=0",
-                                    testing::ReplyMarginFlag()};
+    std::vector<std::string> all = testing::QuietServerFlags();
     all.insert(all.end(), args.begin(), args.end());
     const absl::Status started = server_->Start(store_, all);
     ASSERT_TRUE(started.ok()) << started;
@@ -281,9 +278,9 @@ TEST_F(ServerProcessTest, CorruptedMapFileIsReportedNotServed) {
   EXPECT_TRUE(Plan(Request(map_id, 0.4, 0.5), &plan).ok());
 }
 
-// The short deadline: sanitizers slow the server about threefold (more with
-// the suite's other tests beside it), so the same property is checked there
-// at a proportionally longer deadline (testing::kTimingSlowdown).
+// The short deadline: sanitizers slow the server down, so the same property
+// is checked there at a proportionally longer deadline
+// (testing::kTimingSlowdown).
 constexpr absl::Duration kShortDeadline =
     absl::Milliseconds(static_cast<int64_t>(150 * testing::kTimingSlowdown));
 
