@@ -410,8 +410,8 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
 }
 
 absl::StatusOr<EngineResult> PlanningEngine::PlanPart(
-    const MapSource& source, const PlanRequest& original,
-    const std::vector<uint8_t>& cover_mask) const {
+    const MapSource& source, const PlanRequest& original, const std::vector<uint8_t>& cover_mask,
+    const std::vector<uint8_t>& drive_mask) const {
   ASSIGN_OR_RETURN(Resolved resolved, Resolve(original));
   const PlanRequest request = WithStationPoses(original);
   PlanContext ctx;
@@ -425,21 +425,44 @@ absl::StatusOr<EngineResult> PlanningEngine::PlanPart(
     return absl::InvalidArgumentError(absl::StrFormat(
         "cover mask has %d entries, the grid %d cells", cover_mask.size(), whole.cover->size()));
   }
+  if (!drive_mask.empty() && drive_mask.size() != cover_mask.size()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "drive mask has %d entries, the grid %d cells", drive_mask.size(), whole.cover->size()));
+  }
+  // FNV-1a over the selected cell indices, then over the closed ones.
+  uint64_t digest = 1469598103934665603ull;
+  auto hash = [&digest](size_t i) {
+    for (uint64_t v = i + 1; v != 0; v >>= 8) digest = (digest ^ (v & 0xff)) * 1099511628211ull;
+  };
+  std::vector<uint8_t> drive = whole.drive->free_flags();
+  int64_t closed = 0;
+  for (size_t i = 0; i < drive.size() && !drive_mask.empty(); ++i) {
+    if (drive[i] == 0 || drive_mask[i] != 0) continue;
+    drive[i] = 0;
+    ++closed;
+  }
   std::vector<uint8_t> flags = whole.cover->free_flags();
   int64_t cells = 0;
-  uint64_t digest = 1469598103934665603ull;  // FNV-1a over the selected cell indices
   for (size_t i = 0; i < flags.size(); ++i) {
-    flags[i] = flags[i] != 0 && cover_mask[i] != 0;
+    flags[i] = flags[i] != 0 && cover_mask[i] != 0 && drive[i] != 0;
     if (flags[i] == 0) continue;
     ++cells;
-    for (uint64_t v = i + 1; v != 0; v >>= 8) digest = (digest ^ (v & 0xff)) * 1099511628211ull;
+    hash(i);
   }
   if (cells == 0) return absl::InvalidArgumentError("cover mask selects no cell to cover");
   auto part = std::make_shared<CoverageArea>(whole);
   part->cover = std::make_shared<const Grid>(whole.cover->WithFreeFlags(std::move(flags)));
   part->cover_cells = cells;
+  std::string key = absl::StrFormat("%d", cells);
+  if (closed > 0) {
+    for (size_t i = 0; i < drive.size(); ++i) {
+      if (whole.drive->free_flags()[i] != 0 && drive[i] == 0) hash(i);
+    }
+    part->drive = std::make_shared<const Grid>(whole.drive->WithFreeFlags(std::move(drive)));
+    key = absl::StrFormat("%d-%d", cells, closed);
+  }
   ctx.area_key =
-      ctx.area_key.Derive<CoverageArea>("part", absl::StrFormat("%d:%016x", cells, digest));
+      ctx.area_key.Derive<CoverageArea>("part", absl::StrFormat("%s:%016x", key, digest));
   ctx.area = part;
   ASSIGN_OR_RETURN(CoveragePlan plan, resolved.planner->Plan(ctx));
   plan.planner = std::string(resolved.planner->name());

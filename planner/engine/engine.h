@@ -134,9 +134,12 @@ class PlanningEngine {
   // part's per-planner artifacts are keyed by the mask's content. Plan memory
   // is neither read nor written. InvalidArgument when the mask has the wrong
   // size or selects no cell to cover. For fleets (planner/fleet): one robot's
-  // share of the site.
+  // share of the site. A non-empty `drive_mask` (same indexing) also closes
+  // every drive cell whose entry is zero (obstacles robots reported while
+  // driving): the robot neither drives nor sweeps there.
   absl::StatusOr<EngineResult> PlanPart(const MapSource& source, const PlanRequest& request,
-                                        const std::vector<uint8_t>& cover_mask) const;
+                                        const std::vector<uint8_t>& cover_mask,
+                                        const std::vector<uint8_t>& drive_mask = {}) const;
   // Builds every per-map artifact `request` needs, without planning.
   absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
   // The coverage area `request` plans on (validated like Plan), e.g. to

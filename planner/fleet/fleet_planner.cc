@@ -80,7 +80,7 @@ absl::Status PlanShares(const PlanningEngine& engine, const MapSource& source,
       PlanRequest r = request.RobotRequest(i);
       r.common.time_limit_s = limit_s;
       r.common.num_threads = 1;
-      absl::StatusOr<EngineResult> result = engine.PlanPart(source, r, mask);
+      absl::StatusOr<EngineResult> result = engine.PlanPart(source, r, mask, request.drive_mask);
       if (!result.ok()) {
         status[i] = RobotError(request, i, result.status());
         continue;
@@ -264,9 +264,9 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
   if (k == 1) {
     // A fleet of one is the single-robot plan, exactly.
     absl::StatusOr<EngineResult> one =
-        request.cover_mask.empty()
-            ? engine.Plan(source, request.RobotRequest(0))
-            : engine.PlanPart(source, request.RobotRequest(0), request.cover_mask);
+        request.cover_mask.empty() ? engine.Plan(source, request.RobotRequest(0))
+                                   : engine.PlanPart(source, request.RobotRequest(0),
+                                                     request.cover_mask, request.drive_mask);
     if (!one.ok()) return RobotError(request, 0, one.status());
     const TourUnits units = UnitsOfPlan(one->plan, *one->area->cover);
     best.robots.resize(1);
@@ -286,9 +286,10 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
   ref.common.robot.end.reset();
   ref.battery.reset();
   ref.common.time_limit_s = budget * kReferenceShare;
-  absl::StatusOr<EngineResult> whole = request.cover_mask.empty()
-                                           ? engine.Plan(source, ref)
-                                           : engine.PlanPart(source, ref, request.cover_mask);
+  absl::StatusOr<EngineResult> whole =
+      request.cover_mask.empty()
+          ? engine.Plan(source, ref)
+          : engine.PlanPart(source, ref, request.cover_mask, request.drive_mask);
   if (!whole.ok()) return whole.status();
   const std::shared_ptr<const CoverageArea> area = whole->area;
   const TourUnits units = UnitsOfPlan(whole->plan, *area->cover);

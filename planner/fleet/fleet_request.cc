@@ -35,6 +35,9 @@ absl::Status FleetRequest::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrFormat("robots: at most %d robots per fleet, got %d", kMaxRobots, robots.size()));
   }
+  if (!drive_mask.empty() && cover_mask.empty()) {
+    return absl::InvalidArgumentError("drive_mask: given without a cover mask");
+  }
   std::map<std::string, size_t> seen;
   for (size_t i = 0; i < robots.size(); ++i) {
     const FleetRobot& r = robots[i];

@@ -60,6 +60,10 @@ struct FleetRequest {
   // cells whose entry is non-zero (Grid::Index on the site's grid): a fleet
   // redividing what is left of a mission.
   std::vector<uint8_t> cover_mask;
+  // Empty: the robots drive anywhere on the site's drive grid. Else (with a
+  // cover mask) only on the cells whose entry is non-zero: a redivision
+  // closes the obstacles the robots reported.
+  std::vector<uint8_t> drive_mask;
 
   static constexpr int kMaxRobots = 64;
   // InvalidArgument naming the field ("robots[2].id", "robots[1].robot.tool_width_m").

@@ -1,10 +1,12 @@
 #include "planner/fleet/mission.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "absl/strings/str_format.h"
 #include "planner/common/status_macros.h"
 #include "planner/fleet/fleet_planner.h"
+#include "planner/tour/grid_paths.h"
 
 namespace covplan {
 namespace {
@@ -64,6 +66,51 @@ absl::StatusOr<Remainder> RemainderOf(size_t i, const MissionRobot& r) {
   return out;
 }
 
+// The cells the active robots may drive on: those free in every robot's
+// current plan (a plan replanned around a reported obstacle has closed the
+// obstacle's cells, and those it cut off from that robot: an obstacle one
+// robot met is closed for all), kept to the component that holds the most
+// active robots (ties: the larger component). Empty when no robot has a
+// plan yet (the site's own grid).
+absl::StatusOr<std::vector<uint8_t>> MissionDrive(const std::vector<MissionRobot>& robots) {
+  std::vector<uint8_t> free;
+  const Grid* shape = nullptr;
+  for (size_t i = 0; i < robots.size(); ++i) {
+    const MissionRobot& r = robots[i];
+    if (r.plan == nullptr || r.plan->area == nullptr) continue;
+    const Grid& d = *r.plan->area->drive;
+    if (shape == nullptr) {
+      shape = &d;
+      free = d.free_flags();
+      continue;
+    }
+    if (d.size() != shape->size()) {
+      return RobotError(i, r.robot.id,
+                        absl::InvalidArgumentError("its plan is on another grid than the "
+                                                   "mission's"));
+    }
+    for (size_t c = 0; c < free.size(); ++c) free[c] = free[c] && d.free_flags()[c];
+  }
+  if (shape == nullptr) return free;
+  const Grid grid = shape->WithFreeFlags(free);
+  int32_t n = 0;
+  const std::vector<int32_t> comp = FreeComponents(grid, &n);
+  std::vector<std::pair<int64_t, int64_t>> weight(static_cast<size_t>(n), {0, 0});
+  for (int32_t id : comp) {
+    if (id >= 0) ++weight[static_cast<size_t>(id)].second;
+  }
+  for (size_t i = 0; i < robots.size(); ++i) {
+    if (!robots[i].active) continue;
+    ASSIGN_OR_RETURN(Pose2 pose, PoseOf(i, robots[i]));
+    absl::StatusOr<CellIndex> cell = JoinCell(grid, pose, "robot");
+    if (cell.ok()) ++weight[static_cast<size_t>(comp[grid.Index(cell->row, cell->col)])].first;
+  }
+  const int32_t keep =
+      static_cast<int32_t>(std::max_element(weight.begin(), weight.end()) - weight.begin());
+  for (size_t c = 0; c < free.size(); ++c) free[c] = comp[c] == keep;
+  return free;
+}
+
 }  // namespace
 
 absl::StatusOr<MissionAccount> AccountMission(const std::vector<MissionRobot>& robots) {
@@ -94,7 +141,8 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
                                                   const std::vector<MissionRobot>& robots,
                                                   const MissionOptions& options) {
   MissionRedivision out;
-  std::vector<uint8_t> left;
+  ASSIGN_OR_RETURN(std::vector<uint8_t> drive, MissionDrive(robots));
+  std::vector<uint8_t> left;        // per cell: 1 to cover, 2 closed (counted cut off)
   std::vector<PlanStats> accounts;  // per active robot
   FleetRequest fleet;
   fleet.base = base;
@@ -118,6 +166,11 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
       }
       for (size_t c = 0; c < cover.size(); ++c) {
         if (!cover[c] || left[c]) continue;
+        if (!drive.empty() && !drive[c]) {  // closed by an obstacle another robot met
+          left[c] = 2;
+          ++out.cut_off_cells;
+          continue;
+        }
         left[c] = 1;
         ++out.remaining_cells;
         out.handed_over_cells += !r.active;
@@ -137,7 +190,9 @@ absl::StatusOr<MissionRedivision> RedivideMission(const PlanningEngine& engine,
     return absl::InvalidArgumentError(absl::StrFormat(
         "robots: %d cells are left to cover and no robot is active", out.remaining_cells));
   }
+  for (uint8_t& f : left) f = f == 1;
   fleet.cover_mask = std::move(left);
+  fleet.drive_mask = std::move(drive);
   ASSIGN_OR_RETURN(out.plan, PlanFleet(engine, source, fleet));
   for (size_t k = 0; k < out.plan.robots.size() && k < accounts.size(); ++k) {
     PlanStats& s = out.plan.robots[k].result.plan.stats;

@@ -4,7 +4,10 @@
 // remainder (planner/replan's Remaining: the cells of its current plan still
 // to sweep, from its progress); the active robots are planned over it as a
 // fleet (PlanFleet with a cover mask), each from where it stands now to its
-// own end pose.
+// own end pose. An obstacle one robot reported (its plan, replanned around
+// it, has closed its cells) is closed for every robot: the new plans drive
+// only on the cells free in every robot's current plan (a drive mask), and
+// the cells left there are counted cut off.
 //
 //   std::vector<MissionRobot> robots = ...;  // current plans, progress, poses
 //   robots[1].active = false;                // robot 1 broke down

@@ -183,6 +183,27 @@ TEST(Fleet, AFailedRobotsCellsReappearInTheOthersPlans) {
   EXPECT_EQ(two->cover_cells, left);
 }
 
+TEST(Fleet, MasksOfTheWrongShapeAreRefused) {
+  const OccupancyMap map = testing::LoadShippedMap("small_rooms.yaml");
+  const PlannerRegistry registry = BuiltinPlanners();
+  LocalArtifactCache cache;
+  PlanningEngine engine(&registry, &cache, EngineLimits{});
+  const MapSource source = testing::SourceOfMap(map, "rooms");
+  FleetRequest f = Fleet("oarp", 0.2);
+  f.robots = {Robot("a", 0.8, 1.2, 1.2), Robot("b", 0.8, 4.0, 1.2)};
+  f.drive_mask = {1, 1, 1};
+  absl::StatusOr<FleetPlan> fleet = PlanFleet(engine, source, f);
+  EXPECT_EQ(fleet.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(fleet.status().message()), HasSubstr("drive_mask: given without"));
+  absl::StatusOr<std::shared_ptr<const CoverageArea>> area =
+      engine.AreaFor(source, f.RobotRequest(0));
+  ASSERT_TRUE(area.ok()) << area.status();
+  f.cover_mask.assign(static_cast<size_t>((*area)->cover->size()), 1);
+  fleet = PlanFleet(engine, source, f);
+  EXPECT_EQ(fleet.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(fleet.status().message()), HasSubstr("drive mask has 3 entries"));
+}
+
 TEST(Fleet, SafetyReportFindsRobotsThatStartTogether) {
   const OccupancyMap map = testing::LoadShippedMap("small_rooms.yaml");
   const PlannerRegistry registry = BuiltinPlanners();

@@ -123,6 +123,61 @@ TEST(Mission, AJoiningRobotTakesAShare) {
   EXPECT_EQ(r->plan.covered_cells, r->remaining_cells);
 }
 
+// Robot a meets an obstacle on cells robot c has still to sweep (its plan is
+// replanned around it; c's is not); c then stops. The obstacle is closed for
+// the robot that takes over c's cells: no new plan sweeps or drives there.
+TEST(Mission, AnObstacleOneRobotMetIsClosedForTheOthers) {
+  Mission m;
+  const size_t cells = static_cast<size_t>(m.retained[0]->plan.grid->size());
+  std::vector<MissionRobot> robots = {m.Driving(0, 0.3), m.Driving(1, 0.3), m.Driving(2, 0.3)};
+  // Three cells of a rank in the middle of what robot c has left.
+  std::vector<const CoverageSweep*> ahead;
+  for (const CoverageSweep& s : m.retained[2]->plan.sweeps) {
+    if (s.waypoint > robots[2].progress.waypoint && s.cells.size() >= 5) ahead.push_back(&s);
+  }
+  ASSERT_FALSE(ahead.empty());
+  const CoverageSweep& rank = *ahead[ahead.size() / 2];
+  Observations seen;
+  seen.cells.assign(rank.cells.begin() + 1, rank.cells.begin() + 4);
+  ReplanOptions options;
+  options.tour_time_limit_s = 0.2;
+  absl::StatusOr<ReplanResult> met =
+      Replan(*m.retained[0], robots[0].progress, seen, options, /*estimator=*/nullptr);
+  ASSERT_TRUE(met.ok()) << met.status();
+  auto replanned = std::make_shared<RetainedPlan>(*m.retained[0]);
+  replanned->plan = met->plan;
+  replanned->area = met->area;
+  robots[0].plan = replanned;
+  robots[0].progress = RobotProgress{};
+  robots[2].active = false;
+
+  absl::StatusOr<MissionRedivision> r =
+      RedivideMission(m.engine, m.source, m.request.base, robots, MissionOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  ASSERT_EQ(r->plan.robots.size(), 2u);
+  EXPECT_GE(r->cut_off_cells, 3);
+  std::vector<uint8_t> swept(cells, 0);
+  for (size_t i = 0; i < 2; ++i) {
+    const FleetRobotPlan& rp = r->plan.robots[i];
+    const RobotModel& model = m.request.robots[i == 0 ? 0 : 1].robot;
+    EXPECT_EQ(testing::CheckPlanConformance(rp.result.plan, *rp.result.area, model), "");
+    EXPECT_EQ(testing::CheckPathStaysFree(*met->area->drive, rp.result.plan.path, true), "")
+        << "robot " << rp.id << " drives into the obstacle robot a met";
+    for (const CoverageSweep& s : rp.result.plan.sweeps)
+      for (const CellIndex& c : s.cells) swept[rp.result.plan.grid->Index(c.row, c.col)] = 1;
+  }
+  for (const CellIndex& c : seen.cells) {
+    EXPECT_FALSE(swept[m.retained[0]->plan.grid->Index(c.row, c.col)])
+        << "cell (" << c.row << ", " << c.col << ") of the obstacle is swept";
+  }
+  // Everything else robot c left is still swept by someone.
+  const std::vector<uint8_t> left =
+      SweptAfter(m.retained[2]->plan, robots[2].progress.waypoint, cells);
+  int64_t lost = 0;
+  for (size_t c = 0; c < cells; ++c) lost += left[c] && !swept[c];
+  EXPECT_LE(lost, static_cast<int64_t>(seen.cells.size()) + 2);
+}
+
 TEST(Mission, NoActiveRobotWhileCellsAreLeftIsRefused) {
   Mission m;
   std::vector<MissionRobot> robots = {m.Driving(0, 0.2)};

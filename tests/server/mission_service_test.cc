@@ -7,11 +7,13 @@
 // unknown missions are NOT_FOUND, unknown robots INVALID_ARGUMENT naming
 // the field. A mission and its updates survive a server restart. With
 // Drive sessions open, an obstacle one robot reports reaches the others'
-// streams as a new plan, and a redivision is pushed onto them.
+// streams as a new plan, and a redivision is pushed onto them. An obstacle
+// one robot reported is kept out of every plan a redivision makes.
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -23,6 +25,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "tests/server/mission_fixture.h"
 #include "tests/testing/test_maps.h"
 
 namespace covplan {
@@ -30,124 +33,8 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::set<int> SweptCells(const v1::PlanResponse& plan) {
-  std::set<int> cells;
-  for (const v1::CoverageSweep& s : plan.sweeps()) cells.insert(s.cells().begin(), s.cells().end());
-  return cells;
-}
-
-class MissionServiceTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = (std::filesystem::temp_directory_path() / absl::StrCat("covplan_mission_", ::getpid()))
-               .string();
-    ServerConfig config;
-    config.port = 0;
-    config.metrics_port = -1;
-    config.store_dir = dir_ + "/maps";
-    ASSERT_NO_FATAL_FAILURE(StartServer(config));
-    absl::StatusOr<v1::Map> map =
-        MapProtoFromFile(absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_office.yaml"),
-                         MapFileOverrides(), EngineLimits());
-    ASSERT_TRUE(map.ok()) << map.status();
-    grpc::ClientContext context;
-    v1::PutMapRequest put;
-    *put.mutable_map() = *map;
-    v1::PutMapResponse stored;
-    ASSERT_TRUE(stub_->PutMap(&context, put, &stored).ok());
-    map_id_ = stored.map_id();
-  }
-  void StartServer(const ServerConfig& config) {
-    config_ = config;
-    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = std::move(*server);
-    stub_ = v1::CoveragePlanner::NewStub(grpc::CreateChannel(
-        absl::StrCat("127.0.0.1:", server_->port()), grpc::InsecureChannelCredentials()));
-  }
-  // Stops the server (its I/O pool finishes its writes) and starts another on
-  // the same store.
-  void Restart() {
-    server_.reset();
-    StartServer(config_);
-  }
-  void TearDown() override {
-    server_.reset();
-    std::filesystem::remove_all(dir_);
-  }
-
-  // Robots a (west end), b (placed by the planner) and c (east end).
-  void PlanThree() {
-    v1::PlanFleetRequest r;
-    r.mutable_plan()->set_map_id(map_id_);
-    r.mutable_plan()->mutable_robot()->set_tool_width_m(0.8);
-    r.mutable_plan()->set_time_limit_s(1.0);
-    const double x[] = {1.5, 0.0, 20.0};
-    const char* ids[] = {"a", "b", "c"};
-    for (int i = 0; i < 3; ++i) {
-      v1::FleetRobot* robot = r.add_robots();
-      robot->set_id(ids[i]);
-      robot->mutable_robot()->set_tool_width_m(0.8);
-      if (i == 1) continue;
-      robot->mutable_robot()->mutable_start()->set_x(x[i]);
-      robot->mutable_robot()->mutable_start()->set_y(1.5);
-    }
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
-    grpc::Status status = stub_->PlanFleet(&context, r, &fleet_);
-    ASSERT_TRUE(status.ok()) << status.error_message();
-    ASSERT_EQ(fleet_.robots_size(), 3);
-    for (const v1::FleetRobotPlan& robot : fleet_.robots()) ASSERT_FALSE(robot.idle());
-  }
-  grpc::Status Update(const v1::UpdateMissionRequest& request, v1::UpdateMissionResponse* out) {
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
-    return stub_->UpdateMission(&context, request, out);
-  }
-  grpc::Status GetMission(const std::string& mission_id, v1::GetMissionResponse* out) {
-    grpc::ClientContext context;
-    v1::GetMissionRequest get;
-    get.set_mission_id(mission_id);
-    return stub_->GetMission(&context, get, out);
-  }
-  grpc::Status GetPlan(const std::string& plan_id, v1::PlanResponse* out) {
-    grpc::ClientContext context;
-    v1::GetPlanRequest get;
-    get.set_plan_id(plan_id);
-    return stub_->GetPlan(&context, get, out);
-  }
-
-  // A robot's Drive session on `plan_id`, its ready event read.
-  struct Session {
-    std::unique_ptr<grpc::ClientContext> context;
-    std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> stream;
-  };
-  Session OpenDrive(const std::string& plan_id) {
-    Session s;
-    s.context = std::make_unique<grpc::ClientContext>();
-    s.context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-    s.stream = stub_->Drive(s.context.get());
-    v1::DriveRequest first;
-    first.set_plan_id(plan_id);
-    first.set_sequence(1);
-    EXPECT_TRUE(s.stream->Write(first));
-    v1::DriveEvent ready;
-    EXPECT_TRUE(s.stream->Read(&ready));
-    EXPECT_TRUE(ready.has_ready()) << ready.DebugString();
-    return s;
-  }
-  static void Close(Session& s) {
-    s.stream->WritesDone();
-    EXPECT_TRUE(s.stream->Finish().ok());
-  }
-
-  ServerConfig config_;
-  std::string dir_;
-  std::string map_id_;
-  std::unique_ptr<CovplanServer> server_;
-  std::unique_ptr<v1::CoveragePlanner::Stub> stub_;
-  v1::PlanFleetResponse fleet_;
-};
+using testing::MissionServiceTest;
+using testing::SweptCells;
 
 TEST_F(MissionServiceTest, AStoppedRobotsRemainderGoesToTheOthers) {
   PlanThree();
@@ -367,6 +254,73 @@ TEST_F(MissionServiceTest, AnObstacleOneRobotSeesIsReplannedIntoTheOthersStreams
   EXPECT_EQ(mission.robots(2).plan_id(), c2.plan_id());
   Close(sa);
   Close(sc);
+}
+
+// Robot a reports (Replan) an obstacle on cells robot c sweeps near the end
+// of its plan; c's plan never learns of it, and c then stops for good. The
+// robots that take over c's cells neither sweep nor drive there.
+TEST_F(MissionServiceTest, ARedivisionKeepsOutOfTheObstaclesTheRobotsReported) {
+  PlanThree();
+  const v1::PlanResponse& a = fleet_.robots(0).plan();
+  const v1::PlanResponse& c = fleet_.robots(2).plan();
+  const v1::CoverageSweep& late = c.sweeps(c.sweeps_size() - 2);
+  ASSERT_GE(late.cells_size(), 1);
+  std::set<int> blocked(late.cells().begin(),
+                        late.cells().begin() + std::min(3, late.cells_size()));
+  v1::ReplanRequest seen;
+  seen.set_plan_id(a.plan_id());
+  seen.mutable_progress()->set_waypoint(1);
+  seen.mutable_progress()->mutable_position()->set_x(a.path(0).x());
+  seen.mutable_progress()->mutable_position()->set_y(a.path(0).y());
+  for (int cell : blocked) {
+    v1::CellRef* ref = seen.mutable_obstacles()->add_cells();
+    ref->set_row(cell / c.grid().cols());
+    ref->set_col(cell % c.grid().cols());
+  }
+  v1::ReplanResponse a2;
+  {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    grpc::Status status = stub_->Replan(&context, seen, &a2);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+  }
+  v1::UpdateMissionRequest update;
+  update.set_mission_id(fleet_.mission_id());
+  v1::MissionRobotUpdate* stop = update.add_robots();
+  stop->set_robot_id("c");
+  stop->set_stopped(true);
+  const int k = std::max(1, c.path_size() / 3);
+  stop->mutable_progress()->set_waypoint(k);
+  stop->mutable_progress()->mutable_position()->set_x(c.path(k - 1).x());
+  stop->mutable_progress()->mutable_position()->set_y(c.path(k - 1).y());
+  v1::UpdateMissionResponse updated;
+  grpc::Status status = Update(update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(updated.robots_size(), 2);
+  EXPECT_GE(updated.cut_off_cells(), static_cast<int>(blocked.size()));
+  for (const v1::FleetRobotPlan& robot : updated.robots()) {
+    const v1::PlanResponse& p = robot.plan();
+    for (int cell : SweptCells(p)) {
+      EXPECT_EQ(blocked.count(cell), 0u) << robot.id() << " sweeps blocked cell " << cell;
+    }
+    // Every point of the path (sampled at 1/20 of a cell) lies outside the
+    // blocked cells.
+    const v1::Grid& g = p.grid();
+    for (int i = 1; i < p.path_size(); ++i) {
+      const v1::Waypoint &u = p.path(i - 1), &v = p.path(i);
+      const double len = std::hypot(v.x() - u.x(), v.y() - u.y());
+      const int steps = 1 + static_cast<int>(20.0 * len / g.cell_size_m());
+      for (int s = 0; s <= steps; ++s) {
+        const double t = static_cast<double>(s) / steps;
+        const int col = static_cast<int>(
+            std::floor((u.x() + t * (v.x() - u.x()) - g.origin_x_m()) / g.cell_size_m()));
+        const int row = static_cast<int>(
+            std::floor((u.y() + t * (v.y() - u.y()) - g.origin_y_m()) / g.cell_size_m()));
+        ASSERT_EQ(blocked.count(row * g.cols() + col), 0u)
+            << robot.id() << " drives through blocked cell (" << row << ", " << col << ")";
+      }
+    }
+  }
 }
 
 TEST_F(MissionServiceTest, ARedivisionIsPushedOntoTheRobotsStreams) {
