@@ -1,7 +1,15 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package covplan needs to build, test and run.
 # Idempotent: skips apt entirely when everything is already present.
+#   scripts/install-deps.sh                      # the build's packages
+#   scripts/install-deps.sh haproxy prometheus   # those and these
+#   scripts/install-deps.sh --only buildah       # only these (scripts/deploy/*)
 set -euo pipefail
+ONLY=0
+if [ "${1:-}" = --only ]; then
+  ONLY=1
+  shift
+fi
 
 PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates
@@ -28,7 +36,13 @@ fi
 # first command must not do.
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 DEPLOY_TOOLS=()
-if [ "${CI:-}" = true ] || [ "${COVPLAN_DEPLOY_TOOLS:-0}" = 1 ]; then
+if [ "$ONLY" = 1 ]; then
+  PKGS=("$@")
+  OPTIONAL=()
+else
+  PKGS+=("$@")
+fi
+if [ "$ONLY" = 0 ] && { [ "${CI:-}" = true ] || [ "${COVPLAN_DEPLOY_TOOLS:-0}" = 1 ]; }; then
   DEPLOY_TOOLS=(prometheus haproxy)
   if command -v npm >/dev/null && [ ! -d "$ROOT/deploy/kubernetes/validator/node_modules" ]; then
     (cd "$ROOT/deploy/kubernetes/validator" && npm ci --no-audit --no-fund --silent) ||

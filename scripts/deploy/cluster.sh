@@ -18,8 +18,9 @@
 # postgres when initdb is installed; disk: one store dir per replica, so a
 # map registered on one replica is unknown to the others),
 # CLUSTER_CACHE_MB (per replica, default 256), CLUSTER_THREADS (default 1).
-# Needs: haproxy, prometheus, postgresql (apt-get install haproxy prometheus
-# postgresql). Nothing here is used by the test suite or run_sample.sh.
+# Needs haproxy, prometheus and postgresql: `up` installs them with apt-get
+# (scripts/install-deps.sh --only) and builds covplan when build/bin has no
+# server. Nothing here is used by the test suite or run_sample.sh.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 ROOT=$(pwd)
@@ -27,6 +28,22 @@ DIR=${COVPLAN_CLUSTER_DIR:-/tmp/covplan-cluster}
 BASE=${COVPLAN_CLUSTER_PORT:-56100}
 BIN=${COVPLAN_BIN:-$ROOT/build/bin}
 PG_BIN=${PG_BIN:-/usr/lib/postgresql/15/bin}
+if [ "${1:-}" = up ]; then
+  # On a fresh clone: the packages the cluster runs on, and the build.
+  extra=(haproxy prometheus)
+  [ "${CLUSTER_STORE:-}" = disk ] || extra+=(postgresql)
+  bash "$ROOT/scripts/install-deps.sh" --only "${extra[@]}"
+  if [ ! -x "$BIN/covplan-server" ]; then
+    if [ -n "${COVPLAN_BIN:-}" ]; then
+      echo "cluster: no covplan-server in COVPLAN_BIN=$BIN"
+      exit 1
+    fi
+    echo "cluster: building covplan into build/ (scripts/build.sh; minutes on a fresh clone)"
+    mkdir -p "$DIR"
+    bash "$ROOT/scripts/build.sh" >"$DIR/build.log" 2>&1 ||
+      { tail -20 "$DIR/build.log"; exit 1; }
+  fi
+fi
 if [ -z "${CLUSTER_STORE:-}" ]; then
   if [ -x "$PG_BIN/initdb" ]; then CLUSTER_STORE=postgres; else CLUSTER_STORE=disk; fi
 fi

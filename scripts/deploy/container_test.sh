@@ -15,13 +15,17 @@
 #   4. prints the image size, user and health check.
 #
 #   sudo bash scripts/deploy/container_test.sh        # root, or rootless buildah
-# Exit 0 pass, 1 fail, 77 skipped (no buildah / debootstrap: apt-get install
-# buildah debootstrap). Not part of scripts/test.sh: it compiles the whole
-# project inside the build stage (tens of minutes on 2 cores), see docs/deploy.md.
+# Installs buildah and debootstrap with apt-get when they are missing.
+# Exit 0 pass, 1 fail, 77 skipped (buildah / debootstrap could not be
+# installed). Not part of scripts/test.sh: it compiles the whole project
+# inside the build stage (tens of minutes on 2 cores), see docs/deploy.md.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+if ! command -v buildah >/dev/null || ! command -v debootstrap >/dev/null; then
+  bash scripts/install-deps.sh --only buildah debootstrap || true
+fi
 for tool in buildah debootstrap; do
-  command -v "$tool" >/dev/null || { echo "SKIPPED: $tool not installed (apt-get install buildah debootstrap)"; exit 77; }
+  command -v "$tool" >/dev/null || { echo "SKIPPED: $tool could not be installed (apt-get install buildah debootstrap)"; exit 77; }
 done
 BASE_IMAGE=${BASE_IMAGE:-localhost/covplan-debian:bookworm-slim}
 IMAGE=${IMAGE:-localhost/covplan-server:test}
