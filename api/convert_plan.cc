@@ -244,6 +244,10 @@ PlanStats PlanStatsFromProto(const v1::PlanStats& s) {
   o.grid_rows = s.grid_rows();
   o.grid_cols = s.grid_cols();
   o.map_free_area_m2 = s.map_free_area_m2();
+  o.reachable_area_m2 = s.reachable_area_m2();
+  o.swept_reachable_ratio = s.swept_reachable_ratio();
+  o.missed_reachable_m2 = s.missed_reachable_m2();
+  o.floor_ms = s.floor_ms();
   o.tour_cut_short = s.tour_cut_short();
   o.decomposition_cached = s.decomposition_cached();
   o.plan_source = PlanOriginFromProto(s.plan_source());
@@ -435,6 +439,10 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_grid_rows(static_cast<int32_t>(s.grid_rows));
   o->set_grid_cols(static_cast<int32_t>(s.grid_cols));
   o->set_map_free_area_m2(s.map_free_area_m2);
+  o->set_reachable_area_m2(s.reachable_area_m2);
+  o->set_swept_reachable_ratio(s.swept_reachable_ratio);
+  o->set_missed_reachable_m2(s.missed_reachable_m2);
+  o->set_floor_ms(s.floor_ms);
   o->set_tour_cut_short(s.tour_cut_short);
   o->set_decomposition_cached(s.decomposition_cached);
   o->set_plan_source(PlanOriginToProto(s.plan_source));

@@ -498,7 +498,7 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
              "ranks      %d (partition %s)\n"
              "tour       %s, %d turns, %s\n"
              "length     coverage %.1f m, transitions %.1f m\n"
-             "coverage   %.1f %% of the free area\n"
+             "coverage   %.1f %% of the free area%s\n"
              "duration   %.1f s estimated (turning %.1f s)\n"
              "timings    planning %.1f ms: grid %.1f, partition %.1f, transitions %.1f, tour %.1f "
              "ms%s\n",
@@ -509,6 +509,11 @@ std::string FormatPlanSummary(const v1::PlanResponse& r) {
              s.num_ranks(), s.partition_solver(), s.tour_solver(), s.num_turns(),
              r.termination().detail().empty() ? "converged" : r.termination().detail(),
              s.coverage_length_m(), s.transition_length_m(), 100.0 * s.covered_free_area_ratio(),
+             s.reachable_area_m2() > 0.0
+                 ? absl::StrFormat("; %.1f %% of the %.1f m2 the tool can reach (%.1f m2 missed)",
+                                   100.0 * s.swept_reachable_ratio(), s.reachable_area_m2(),
+                                   s.missed_reachable_m2())
+                 : "",
              s.estimated_duration_s(), s.turning_time_s(), s.planning_ms(), s.grid_ms(),
              s.partition_ms(), s.transitions_ms(), s.tour_ms(),
              absl::StrCat(s.decomposition_cached() ? " (decomposition cached)" : "",

@@ -9,6 +9,7 @@
 #include "absl/time/clock.h"
 #include "planner/common/status_macros.h"
 #include "planner/energy/charge_cycles.h"
+#include "planner/engine/floor_artifact.h"
 #include "planner/engine/plan_memory.h"
 #include "planner/tour/path_timing.h"
 #include "planner/tour/tour_model.h"
@@ -180,6 +181,7 @@ absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest&
   bool all_cached = true;
   RETURN_IF_ERROR(
       Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
+  RETURN_IF_ERROR(FloorFor(ctx).status());
   return resolved.planner->Prepare(ctx);
 }
 
@@ -366,6 +368,8 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
         absl::ToDoubleMilliseconds(absl::Now() - t);  // the split is part of the tour
   }
   RETURN_IF_ERROR(Finish(request, resolved, area, all_cached, &plan));
+  RETURN_IF_ERROR(MeasurePlanFloor(ctx, &plan));
+  plan.stats.planning_ms += plan.stats.floor_ms;
   plan.stats.plan_source = plan_source;
 
   if (keys.has_value()) {

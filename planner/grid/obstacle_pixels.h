@@ -45,6 +45,14 @@ class ObstaclePixels {
     return (diag_[static_cast<size_t>(r) * cols_ + c] >> (dc > 0 ? 0 : 1)) & 1u;
   }
 
+  // The map's pixels: width() x height(), px_per_cell() to a cell's side;
+  // pixel (col, row) is [col, col+1] x [row, row+1] in pixel units from the
+  // grid's origin. Off the map every pixel counts as not free.
+  int64_t width() const { return width_; }
+  int64_t height() const { return height_; }
+  double px_per_cell() const { return px_per_cell_; }
+  bool Blocked(int64_t col, int64_t row) const { return PixelBlocked(col, row); }
+
   size_t MemoryBytes() const {
     return sizeof(*this) + bits_.capacity() * sizeof(uint64_t) + box_.capacity() * sizeof(Box) +
            diag_.capacity();

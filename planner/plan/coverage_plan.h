@@ -104,14 +104,23 @@ struct PlanStats {
   int64_t mission_cut_off_cells = 0;
   int64_t mission_obstructed_cells = 0;
   double map_free_area_m2 = 0.0;
+  // The floor measured on the map's pixels, not on the grid
+  // (planner/plan/floor_measure.h): the free area a tool disc can touch in
+  // the robot's part of the map (in the regions, when given), the share of
+  // it the path sweeps, and what it misses. 0: not measured (a fleet
+  // robot's share, a replanned plan, a map without pixels).
+  double reachable_area_m2 = 0.0;
+  double swept_reachable_ratio = 0.0;
+  double missed_reachable_m2 = 0.0;
   // Timing (wall clock, milliseconds).
   double planning_ms = 0.0;
   double grid_ms = 0.0;
   double partition_ms = 0.0;
   double transitions_ms = 0.0;
   double tour_ms = 0.0;
-  bool tour_cut_short = false;                 // kept for old callers: termination.limit_reached()
-  bool decomposition_cached = false;           // every per-map artifact came from the cache
+  double floor_ms = 0.0;              // the floor measure (its per-area part when not cached)
+  bool tour_cut_short = false;        // kept for old callers: termination.limit_reached()
+  bool decomposition_cached = false;  // every per-map artifact came from the cache
   PlanOrigin plan_source = PlanOrigin::kCold;  // set by the engine
   std::string partition_solver;
   std::string tour_solver;

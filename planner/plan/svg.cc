@@ -2,17 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "planner/plan/floor_measure.h"
 #include "planner/plan/svg_layers.h"
 
 namespace covplan {
 namespace {
 
 using svg_internal::AppendEnds;
+using svg_internal::AppendRuns;
 using svg_internal::AppendSegments;
 using svg_internal::AppendSite;
 using svg_internal::AppendSvgClose;
@@ -20,6 +23,9 @@ using svg_internal::AppendSvgOpen;
 using svg_internal::LegendFontSize;
 using svg_internal::SvgFrame;
 using svg_internal::SvgFrameOf;
+
+// The reachable floor the path misses.
+constexpr const char* kMissedFill = "#ff2d95";
 
 // Charge cycle colours, in cycle order (repeating after ten).
 constexpr const char* kCycleColours[] = {"#e6194b", "#3cb44b", "#4363d8", "#f58231", "#911eb4",
@@ -77,19 +83,47 @@ void AppendStationLegs(std::string* out, const CoveragePlan& plan, const std::ve
   absl::StrAppend(out, "</g>\n");
 }
 
+// The reachable floor the path misses (floor_measure.h), in the map's
+// pixels, drawn over the site; its area in m2 (0: nothing missed, or no map).
+double AppendMissedFloor(std::string* out, const CoveragePlan& plan, const OccupancyMap* map,
+                         const SvgZones& zones) {
+  if (map == nullptr || plan.grid == nullptr) return 0.0;
+  auto area = [](const std::vector<PolygonInput>& p, const char* field) -> std::optional<Area> {
+    if (p.empty()) return std::nullopt;
+    absl::StatusOr<Area> a = Area::Create(p, field);
+    return a.ok() ? std::optional<Area>(*std::move(a)) : std::nullopt;
+  };
+  const std::optional<Area> no_go = area(zones.no_go, "no_go");
+  const std::optional<Area> regions = area(zones.regions, "regions");
+  const FloorReach reach =
+      ComputeFloorReach(*map, *plan.grid, no_go ? &*no_go : nullptr, regions ? &*regions : nullptr);
+  const FloorMeasure m = MeasureFloor(reach, plan.path, /*keep_missed=*/true);
+  if (m.missed.empty()) return 0.0;
+  const int64_t w = reach.width;
+  AppendRuns(out, static_cast<int>(reach.height), static_cast<int>(w), reach.origin.x,
+             reach.origin.y, reach.pixel_m, kMissedFill,
+             [&](int r, int c) { return m.missed[static_cast<size_t>(r * w + c)] != 0; });
+  return m.missed_reachable_m2;
+}
+
 // Legend above the map (not flipped), sized to fit the map's width
 // (sans-serif glyphs average about 0.56 em).
 void AppendLegend(std::string* out, const CoveragePlan& plan, const SvgZones& zones,
-                  const SvgFrame& f) {
+                  double missed_m2, const SvgFrame& f) {
   const std::string summary =
       absl::StrFormat(" · %d ranks, %d turns, %.0f s", static_cast<int>(plan.stats.num_ranks),
                       static_cast<int>(plan.stats.num_turns), plan.stats.estimated_duration_s);
   std::string zone_legend;
   if (!zones.regions.empty()) zone_legend += " · <tspan fill=\"#1f5fa8\">regions</tspan>";
   if (!zones.no_go.empty()) zone_legend += " · <tspan fill=\"#a61e1e\">no-go zones</tspan>";
+  if (missed_m2 > 0.0) {
+    zone_legend += absl::StrFormat(" · <tspan fill=\"%s\">missed floor %.1f m²</tspan>",
+                                   kMissedFill, missed_m2);
+  }
   constexpr int kLegendChars = 54;  // "horizontal ranks · vertical ranks · transitions"
   const double chars = kLegendChars + static_cast<double>(summary.size()) +
-                       (zones.regions.empty() ? 0 : 10) + (zones.no_go.empty() ? 0 : 14);
+                       (zones.regions.empty() ? 0 : 10) + (zones.no_go.empty() ? 0 : 14) +
+                       (missed_m2 > 0.0 ? 24 : 0);
   const double fs = LegendFontSize(f, chars);
   const std::string sweeps_legend =
       plan.cycles.empty()
@@ -116,6 +150,7 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map,
   std::string out;
   AppendSvgOpen(&out, f);
   AppendSite(&out, grid, map, zones);
+  const double missed_m2 = AppendMissedFloor(&out, plan, map, zones);
   const std::vector<int> cycle_of = CycleOfWaypoint(plan);
   AppendCoverage(&out, plan, cycle_of, s);
   AppendSegments(&out, plan.path, {SegmentKind::kTransition},
@@ -125,7 +160,7 @@ std::string RenderPlanSvg(const CoveragePlan& plan, const OccupancyMap* map,
   if (!plan.cycles.empty()) AppendStationLegs(&out, plan, cycle_of, s);
   AppendEnds(&out, plan.path, s, "#1aa33a", "", "#d62728");
   std::string legend;
-  AppendLegend(&legend, plan, zones, f);
+  AppendLegend(&legend, plan, zones, missed_m2, f);
   AppendSvgClose(&out, legend);
   return out;
 }

@@ -29,6 +29,7 @@ void Normalise(v1::PlanResponse* r) {
   s->clear_transitions_ms();
   s->clear_tour_ms();
   s->clear_decomposition_cached();
+  s->clear_floor_ms();
 }
 
 void AddBox(google::protobuf::RepeatedPtrField<v1::Polygon>* out, double x0, double y0, double x1,

@@ -149,7 +149,7 @@ TEST(Artifacts, AreBuiltOnceAndPrepareWarmsThem) {
   r.common.time_limit_s = 60;  // converges long before: the same seed gives the same plan
   ASSERT_TRUE(engine.Prepare(source, r).ok());
   EXPECT_EQ(loads, 1);
-  EXPECT_EQ(cache.size(), 4u);
+  EXPECT_EQ(cache.size(), 5u);  // grid, area, floor, partition, transitions
   absl::StatusOr<EngineResult> a = engine.Plan(source, r);
   absl::StatusOr<EngineResult> b = engine.Plan(source, r);
   ASSERT_TRUE(a.ok() && b.ok());
@@ -167,7 +167,7 @@ TEST(Artifacts, AreBuiltOnceAndPrepareWarmsThem) {
   missing.map_id = "gone";
   missing.load = []() -> absl::StatusOr<SiteMap> { return absl::NotFoundError("map gone"); };
   EXPECT_EQ(engine.Plan(missing, r).status().code(), absl::StatusCode::kNotFound);
-  EXPECT_EQ(cache.size(), 6u);  // the 4 artifacts + the remembered tour and plan
+  EXPECT_EQ(cache.size(), 7u);  // the 5 artifacts + the remembered tour and plan
 }
 
 // The site checks are the engine's, so every entry point (the server,

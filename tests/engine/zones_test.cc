@@ -165,17 +165,17 @@ TEST(Zones, ShareTheMapsGridAndAZonelessRequestStillHitsTheCache) {
   LocalArtifactCache cache;
   PlanOptions plain = Options();
   ASSERT_TRUE(PlanCoverage(map, plain, &cache, "office").ok());
-  // grid, area, partition, transitions, and the remembered plan (a greedy
-  // tour: no remembered tour to warm-start from).
+  // grid, area, floor, partition, transitions, and the remembered plan (a
+  // greedy tour: no remembered tour to warm-start from).
   const size_t after_plain = cache.size();
-  EXPECT_EQ(after_plain, 5u);
+  EXPECT_EQ(after_plain, 6u);
   PlanOptions zoned = Options();
   zoned.no_go = {Box(3.3, 3.3, 5.1, 5.05)};
   absl::StatusOr<CoveragePlan> z = PlanCoverage(map, zoned, &cache, "office");
   ASSERT_TRUE(z.ok()) << z.status();
   EXPECT_FALSE(z->stats.decomposition_cached);
-  EXPECT_EQ(cache.size(),
-            after_plain + 4);  // the grid is shared; area, partition, transitions, plan are new
+  // The grid is shared; area, floor, partition, transitions, plan are new.
+  EXPECT_EQ(cache.size(), after_plain + 5);
   absl::StatusOr<CoveragePlan> again = PlanCoverage(map, plain, &cache, "office");
   ASSERT_TRUE(again.ok());
   EXPECT_TRUE(again->stats.decomposition_cached);
@@ -189,7 +189,7 @@ TEST(Zones, ShareTheMapsGridAndAZonelessRequestStillHitsTheCache) {
   ASSERT_TRUE(r.ok());
   EXPECT_TRUE(r->stats.decomposition_cached);
   EXPECT_EQ(r->stats.plan_source, PlanOrigin::kCacheHit);  // the zones' plan, too
-  EXPECT_EQ(cache.size(), after_plain + 4);
+  EXPECT_EQ(cache.size(), after_plain + 5);
 }
 
 TEST(Zones, BadAreasAreInvalidArgumentNamingTheRingOrVertex) {

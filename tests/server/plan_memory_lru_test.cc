@@ -80,7 +80,7 @@ TEST(PlanMemoryBudgetTest, RememberedPlansAreAccountedAndEvicted) {
   absl::StatusOr<EngineResult> first = probe.Plan(source, Request(1));
   ASSERT_TRUE(first.ok()) << first.status();
   const size_t with_plan = roomy.stats().bytes;
-  EXPECT_EQ(roomy.stats().entries, 6u);  // 4 artifacts + remembered tour + plan
+  EXPECT_EQ(roomy.stats().entries, 7u);  // 5 artifacts + remembered tour + plan
   // The remembered copy (its vectors without the returned plan's slack).
   const CoveragePlan copy = first->plan;
   EXPECT_GE(with_plan - artifacts, copy.MemoryBytes());

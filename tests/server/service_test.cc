@@ -732,7 +732,7 @@ TEST_F(MetricsServiceTest, MetricsEndpointExposesTheFamilies) {
         "covplan_request_duration_seconds_bucket{method=\"Plan\"",
         "covplan_plan_solve_duration_seconds_count 1", "covplan_plans_cut_short_total",
         "covplan_worker_queue_depth", "covplan_solves_in_flight",
-        "covplan_artifact_cache_misses_total 4",  // grid, area, partition, transitions
+        "covplan_artifact_cache_misses_total 5",  // grid, area, floor, partition, transitions
         "covplan_plan_source_total{source=\"cold\"} 1",
         "covplan_plan_source_total{source=\"cache_hit\"} 0", "covplan_artifact_cache_hits_total",
         "covplan_artifact_cache_evictions_total", "covplan_artifact_cache_bytes",
