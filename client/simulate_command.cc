@@ -52,7 +52,9 @@ constexpr char kUsage[] =
     "random rotated rectangles over PCT % of its free area, placed with --seed) with a\n"
     "radial line-of-sight sensor (default 5.6 m), replans with --method (default auto)\n"
     "whenever new obstacles cut the path, and prints one JSON object: total_time_s =\n"
-    "drive_time_s + stoppage_s, replans, coverage of the true map's free area, and\n"
+    "drive_time_s + stoppage_s, replans, coverage of the true map's free area, the\n"
+    "floor the tool can reach on the true map and the share of it the driven path swept\n"
+    "(reachable_area_m2, swept_reachable_ratio, missed_reachable_m2), and\n"
     "offline_lower_bound_s (OARP planned on the true map) and offline_cell_bound_s (OARP\n"
     "on the known map with the cells the true map blocks filled: the bound of the cell\n"
     "model the replanner and the simulated robot work in, which ignores new obstacles\n"
@@ -392,6 +394,9 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
   json.Field("num_turns", absl::StrCat(r.num_turns));
   json.Field("path_length_m", JsonNumber(r.path_length_m));
   json.Field("covered_free_area_ratio", JsonNumber(r.covered_free_area_ratio));
+  json.Field("reachable_area_m2", JsonNumber(r.floor.reachable_area_m2));
+  json.Field("swept_reachable_ratio", JsonNumber(r.floor.swept_reachable_ratio));
+  json.Field("missed_reachable_m2", JsonNumber(r.floor.missed_reachable_m2));
   json.Field("mean_replan_ms",
              JsonNumber(r.replan_ms.empty() ? 0.0 : total_ms / r.replan_ms.size()));
   json.Field("max_replan_ms", JsonNumber(max_ms));
@@ -401,6 +406,7 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
   json.Field("planned_duration_s", JsonNumber(r.planned_duration_s));
   json.Field("offline_lower_bound_s", JsonNumber(bound.duration_s));
   json.Field("offline_covered_free_area_ratio", JsonNumber(bound.covered_free_area_ratio));
+  json.Field("offline_swept_reachable_ratio", JsonNumber(bound.swept_reachable_ratio));
   json.Field("offline_cell_bound_s", JsonNumber(cell_bound.duration_s));
   json.Field("length_in_obstacles_m", JsonNumber(r.length_in_obstacles_m));
   json.Field("completed", r.completed ? "true" : "false");
@@ -471,7 +477,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   // the start and end poses: see SimulationResult::truth_cleared_px).
   if (r.truth_used != nullptr) truth = *r.truth_used;
   OfflineBound bound, cell_bound;
-  bound.duration_s = bound.covered_free_area_ratio = cell_bound.duration_s = std::nan("");
+  bound.duration_s = bound.covered_free_area_ratio = bound.swept_reachable_ratio =
+      cell_bound.duration_s = std::nan("");
   if (!a.Has("no-offline-bound")) {
     ASSIGN_OR_RETURN(bound, OfflineLowerBound(truth, o.plan));
     ASSIGN_OR_RETURN(OccupancyMap cells, CellLevelTruth(known, truth, o.plan));

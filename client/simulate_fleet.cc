@@ -111,16 +111,19 @@ std::string ResultJson(const FleetSimulationResult& r, const ParsedArgs& a,
       "  \"planned_makespan_s\": %s,\n  \"makespan_s\": %s,\n  \"mission_cells\": %d,\n"
       "  \"swept_cells\": %d,\n  \"reachable_cells\": %d,\n  \"unswept_reachable_cells\": %d,\n"
       "  \"unswept_reachable\": [%s],\n"
-      "  \"covered_free_area_ratio\": %s,\n  \"length_in_obstacles_m\": %s,\n"
+      "  \"covered_free_area_ratio\": %s,\n  \"reachable_area_m2\": %s,\n"
+      "  \"swept_reachable_ratio\": %s,\n  \"missed_reachable_m2\": %s,\n"
+      "  \"length_in_obstacles_m\": %s,\n"
       "  \"completed\": %s,\n  \"problems\": [%s],\n  \"redivisions\": [\n%s\n  ],\n"
       "  \"robots\": [\n%s\n  ]\n}\n",
       JsonString(a.Get("map").value_or("")), JsonString(truth_name), JsonString(o.plan.planner),
       JsonString(ReplanMethodName(o.method)), Number(r.initial.makespan_s), Number(r.makespan_s),
       r.mission_cells, r.swept_cells, r.reachable_cells, r.unswept_reachable_cells,
       absl::StrJoin(unswept, ", "), Number(r.covered_free_area_ratio),
-      Number(r.length_in_obstacles_m), r.completed ? "true" : "false",
-      absl::StrJoin(problems, ", "), absl::StrJoin(redivisions, ",\n"),
-      absl::StrJoin(robots, ",\n"));
+      Number(r.floor.reachable_area_m2), Number(r.floor.swept_reachable_ratio),
+      Number(r.floor.missed_reachable_m2), Number(r.length_in_obstacles_m),
+      r.completed ? "true" : "false", absl::StrJoin(problems, ", "),
+      absl::StrJoin(redivisions, ",\n"), absl::StrJoin(robots, ",\n"));
 }
 
 // The driven paths on the true map, each robot's swept cells tinted.
@@ -239,12 +242,15 @@ std::string FormatFleetSimulation(const FleetSimulationResult& r) {
         d.failed_robot, d.time_s, d.left_cells, absl::StrJoin(d.robots, ", "), d.plan.makespan_s,
         d.plan.lower_bound_s, d.achieved_s, Ratio(d));
   }
-  absl::StrAppendFormat(&out,
-                        "unswept    %d reachable cells of %d (swept %d cells, %.4f of the true "
-                        "map's free area)\n"
-                        "obstacles  %.2f m driven inside obstacles smaller than half a cell\n",
-                        r.unswept_reachable_cells, r.reachable_cells, r.swept_cells,
-                        r.covered_free_area_ratio, r.length_in_obstacles_m);
+  absl::StrAppendFormat(
+      &out,
+      "unswept    %d reachable cells of %d (swept %d cells, %.4f of the true "
+      "map's free area)\n"
+      "floor      %.2f %% of the %.1f m2 the tool can reach swept (%.1f m2 missed)\n"
+      "obstacles  %.2f m driven inside obstacles smaller than half a cell\n",
+      r.unswept_reachable_cells, r.reachable_cells, r.swept_cells, r.covered_free_area_ratio,
+      100.0 * r.floor.swept_reachable_ratio, r.floor.reachable_area_m2, r.floor.missed_reachable_m2,
+      r.length_in_obstacles_m);
   if (!r.completed) absl::StrAppend(&out, "incomplete a bound of the simulation stopped a robot\n");
   for (const std::string& p : r.problems) absl::StrAppend(&out, "problem    ", p, "\n");
   return out;

@@ -200,10 +200,18 @@ FloorReach ComputeFloorReach(const OccupancyMap& map, const Grid& drive, const A
 
 FloorMeasure MeasureFloor(const FloorReach& reach, const std::vector<Waypoint>& path,
                           bool keep_missed) {
+  return MeasureFloor(reach, std::vector<const std::vector<Waypoint>*>{&path}, keep_missed);
+}
+
+FloorMeasure MeasureFloor(const FloorReach& reach,
+                          const std::vector<const std::vector<Waypoint>*>& paths,
+                          bool keep_missed) {
   FloorMeasure m;
   if (reach.width <= 0 || reach.height <= 0) return m;
   std::vector<uint8_t> swept(reach.reachable.size(), 0);
-  StampPath(reach, path, reach.tool_radius_px, &swept);
+  for (const std::vector<Waypoint>* path : paths) {
+    if (path != nullptr) StampPath(reach, *path, reach.tool_radius_px, &swept);
+  }
   int64_t hit = 0;
   for (size_t p = 0; p < swept.size(); ++p) hit += swept[p] && reach.reachable[p];
   const double px_m2 = reach.pixel_m * reach.pixel_m;

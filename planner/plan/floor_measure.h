@@ -68,6 +68,10 @@ struct FloorMeasure {
 
 FloorMeasure MeasureFloor(const FloorReach& reach, const std::vector<Waypoint>& path,
                           bool keep_missed);
+// The floor swept by any of `paths` (several robots, or legs driven one
+// after the other: no segment joins one path's end to the next's start).
+FloorMeasure MeasureFloor(const FloorReach& reach,
+                          const std::vector<const std::vector<Waypoint>*>& paths, bool keep_missed);
 
 // Per pixel of a width x height image: 1 when some pixel where `site` is
 // non-zero has its centre within sqrt(radius2) pixels of this pixel's centre

@@ -325,27 +325,23 @@ void FleetRun::Measure() {
   // that holds a robot's start, as the robots' cell model moves: the true
   // grid's free cells with the known map's walls (new obstacles are blocked
   // cells to it, whatever they touch).
-  std::vector<uint8_t> free(mission_->drive->free_flags().begin(),
-                            mission_->drive->free_flags().end());
-  for (size_t c = 0; c < free.size(); ++c) free[c] = free[c] && site_.grid.free_flags()[c];
-  const Grid model = mission_->drive->WithFreeFlags(std::move(free));
-  int32_t num = 0;
-  const std::vector<int32_t> comp = FreeComponents(model, &num);
-  std::vector<uint8_t> start_comp(static_cast<size_t>(num), 0);
+  std::vector<Point2> starts;
   for (const FleetRobotPlan& rp : r.initial.robots) {
     if (rp.result.plan.path.empty()) continue;
-    const Waypoint& w = rp.result.plan.path.front();
-    const CellIndex c = site_.grid.CellAt({w.x, w.y});
-    if (site_.grid.InBounds(c.row, c.col) && comp[site_.grid.Index(c.row, c.col)] >= 0)
-      start_comp[comp[site_.grid.Index(c.row, c.col)]] = 1;
+    starts.push_back({rp.result.plan.path.front().x, rp.result.plan.path.front().y});
   }
-  for (size_t c = 0; c < comp.size(); ++c) {
-    if (!mission_->cover->free_flags()[c] || comp[c] < 0 || !start_comp[comp[c]]) continue;
+  const Grid model = sim_internal::ReachableModel(site_, *mission_->drive, starts);
+  for (size_t c = 0; c < model.free_flags().size(); ++c) {
+    if (!mission_->cover->free_flags()[c] || !model.free_flags()[c]) continue;
     ++r.reachable_cells;
     if (r.swept[c]) continue;
     ++r.unswept_reachable_cells;
     r.unswept_reachable.push_back(site_.grid.FromIndex(static_cast<int64_t>(c)));
   }
+  std::vector<const std::vector<Waypoint>*> paths;
+  for (const auto& s : robots_) paths.push_back(&s->run.driven);
+  r.floor = sim_internal::DrivenFloor(site_, model, mission_->zones.no_go.get(),
+                                      mission_->zones.regions.get(), paths);
   for (const auto& s : robots_) r.robots.push_back(std::move(s->run));
 }
 

@@ -35,6 +35,7 @@
 #include "absl/status/statusor.h"
 #include "planner/fleet/fleet_request.h"
 #include "planner/grid/occupancy_map.h"
+#include "planner/plan/floor_measure.h"
 #include "planner/sim/simulator.h"
 
 namespace covplan {
@@ -115,8 +116,12 @@ struct FleetSimulationResult {
   std::vector<uint8_t> swept;                // per cell: swept by some robot
   double covered_free_area_ratio = 0.0;      // of the true map's free area
   double length_in_obstacles_m = 0.0;        // summed over the robots
-  std::vector<std::string> problems;         // every leg's, prefixed with the robot's id
-  bool completed = true;                     // false: a bound of the options stopped a leg
+  // The floor the tool can reach on the true map from those cells (the
+  // robots' connected part, outside the no-go zones, inside the regions;
+  // floor_measure.h) and how much of it all driven paths swept.
+  FloorMeasure floor;
+  std::vector<std::string> problems;  // every leg's, prefixed with the robot's id
+  bool completed = true;              // false: a bound of the options stopped a leg
   // The true map the robots drove when clearing their start and end poses
   // changed it (see SimulationResult::truth_used), else null.
   std::shared_ptr<const OccupancyMap> truth_used;

@@ -14,6 +14,7 @@ absl::StatusOr<OfflineBound> OfflineLowerBound(const OccupancyMap& truth,
   OfflineBound b;
   b.duration_s = plan.stats.estimated_duration_s;
   b.covered_free_area_ratio = plan.stats.covered_free_area_ratio;
+  b.swept_reachable_ratio = plan.stats.swept_reachable_ratio;
   b.num_ranks = plan.stats.num_ranks;
   b.charge_cycles = static_cast<int>(plan.cycles.size());
   return b;

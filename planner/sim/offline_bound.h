@@ -26,6 +26,7 @@ namespace covplan {
 struct OfflineBound {
   double duration_s = 0.0;  // the plan's estimated duration
   double covered_free_area_ratio = 0.0;
+  double swept_reachable_ratio = 0.0;  // the plan's own, on the true map
   int64_t num_ranks = 0;
   // Battery plans: the offline plan's charge cycles (duration_s has no
   // recharge time in it; add recharge_s for each).

@@ -1,10 +1,13 @@
 #include "planner/sim/run_setup.h"
 
+#include <cstdint>
 #include <utility>
+#include <vector>
 
 #include "planner/common/status_macros.h"
 #include "planner/sim/clutter.h"
 #include "planner/sim/map_frame.h"
+#include "planner/tour/grid_paths.h"
 
 namespace covplan::sim_internal {
 
@@ -47,6 +50,32 @@ double CoveredFreeAreaRatio(const TrueSite& site, const std::vector<uint8_t>& sw
     if (swept[i]) swept_free_px += site.fractions[i] * px_per_cell * px_per_cell;
   }
   return true_free > 0 ? swept_free_px / true_free : 0.0;
+}
+
+Grid ReachableModel(const TrueSite& site, const Grid& drive, const std::vector<Point2>& starts) {
+  std::vector<uint8_t> free(drive.free_flags().begin(), drive.free_flags().end());
+  for (size_t c = 0; c < free.size() && c < site.grid.free_flags().size(); ++c) {
+    free[c] = free[c] && site.grid.free_flags()[c];
+  }
+  const Grid both = drive.WithFreeFlags(free);
+  int32_t num = 0;
+  const std::vector<int32_t> comp = FreeComponents(both, &num);
+  std::vector<uint8_t> held(static_cast<size_t>(num), 0);
+  for (const Point2& p : starts) {
+    const CellIndex c = both.CellAt(p);
+    if (both.InBounds(c.row, c.col) && comp[both.Index(c.row, c.col)] >= 0) {
+      held[comp[both.Index(c.row, c.col)]] = 1;
+    }
+  }
+  for (size_t c = 0; c < free.size(); ++c) free[c] = comp[c] >= 0 && held[comp[c]];
+  return drive.WithFreeFlags(std::move(free));
+}
+
+FloorMeasure DrivenFloor(const TrueSite& site, const Grid& model, const Area* no_go,
+                         const Area* regions,
+                         const std::vector<const std::vector<Waypoint>*>& paths) {
+  const FloorReach reach = ComputeFloorReach(site.map(), model, no_go, regions);
+  return MeasureFloor(reach, paths, /*keep_missed=*/false);
 }
 
 absl::StatusOr<RetainedPlan> LocalPlanSource::InitialPlan(const OccupancyMap& known,

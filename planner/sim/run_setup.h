@@ -1,8 +1,8 @@
 // What every simulated run sets up (internal to planner/sim), for one robot
 // (simulator.cc) and for a fleet (fleet_simulator.cc): the true map with
 // nothing standing where robots start and end, its grid in the plans' frame,
-// the cells a sensor can find, the coverage measured against the true map,
-// and the in-process plan source.
+// the cells a sensor can find, the coverage and the floor measured against
+// the true map, and the in-process plan source.
 //
 //   ASSIGN_OR_RETURN(TrueSite site, MakeTrueSite(known, truth, {start, end}, options.plan));
 //   SimulatedDrive drive(site.map(), site.grid, options, plan,
@@ -21,6 +21,7 @@
 #include "planner/assembly/plan_coverage.h"
 #include "planner/grid/grid.h"
 #include "planner/grid/occupancy_map.h"
+#include "planner/plan/floor_measure.h"
 #include "planner/sim/simulator.h"
 
 namespace covplan::sim_internal {
@@ -49,6 +50,19 @@ absl::StatusOr<std::vector<uint8_t>> Candidates(const Grid& drive, const Grid& t
 
 // The true map's free area inside the cells flagged in `swept`, over its free area.
 double CoveredFreeAreaRatio(const TrueSite& site, const std::vector<uint8_t>& swept);
+
+// The robots' cell model of the true site: the cells free on both `drive`
+// (the robots' part of the known map, with its walls) and the true grid that
+// lie in a component holding one of `starts`. What a robot can get to as
+// the replanner moves it (new obstacles are blocked cells to it).
+Grid ReachableModel(const TrueSite& site, const Grid& drive, const std::vector<Point2>& starts);
+
+// The floor a tool disc can reach on the true map from the free cells of
+// `model` (a ReachableModel; floor_measure.h), outside `no_go` and inside
+// `regions` (either may be null), and how much of it `paths` swept.
+FloorMeasure DrivenFloor(const TrueSite& site, const Grid& model, const Area* no_go,
+                         const Area* regions,
+                         const std::vector<const std::vector<Waypoint>*>& paths);
 
 // Plans (PlanCoverageWithArea) and replans (Replan, with an estimator of its
 // own) in process.

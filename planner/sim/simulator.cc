@@ -8,6 +8,7 @@
 #include "absl/strings/str_format.h"
 #include "planner/common/status_macros.h"
 #include "planner/engine/engine.h"
+#include "planner/geometry/area.h"
 #include "planner/grid/grid.h"
 #include "planner/sim/clutter.h"
 #include "planner/sim/drive.h"
@@ -71,8 +72,10 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
           "battery.station (%.3f, %.3f) is not in a free cell of the true map", st.x, st.y));
     }
   }
-  const Grid& drive = retained.area != nullptr ? *retained.area->drive : *retained.plan.grid;
-  ASSIGN_OR_RETURN(std::vector<uint8_t> candidate, sim_internal::Candidates(drive, true_grid));
+  // Held here: the run replaces its plan (and with it the area) on replans.
+  const std::shared_ptr<const Grid> drive =
+      retained.area != nullptr ? retained.area->drive : retained.plan.grid;
+  ASSIGN_OR_RETURN(std::vector<uint8_t> candidate, sim_internal::Candidates(*drive, true_grid));
   sim_internal::SimulatedDrive sim(site.map(), true_grid, options, std::move(retained),
                                    std::move(candidate), source);
   ASSIGN_OR_RETURN(SimulationResult result, sim.Run());
@@ -81,6 +84,13 @@ absl::StatusOr<SimulationResult> Simulate(const OccupancyMap& known, const Occup
   // Coverage against the true map: its free area inside the swept cells.
   result.covered_free_area_ratio = sim_internal::CoveredFreeAreaRatio(site, sim.swept());
   result.length_in_obstacles_m = sim_internal::LengthInObstacles(site.map(), result.driven);
+  // The floor against the true map (the zones were checked by the plan).
+  ASSIGN_OR_RETURN(const Area no_go, Area::Create(options.plan.no_go, "no_go"));
+  ASSIGN_OR_RETURN(const Area regions, Area::Create(options.plan.regions, "regions"));
+  const Point2 start{result.driven.front().x, result.driven.front().y};
+  result.floor =
+      sim_internal::DrivenFloor(site, sim_internal::ReachableModel(site, *drive, {start}), &no_go,
+                                &regions, {&result.driven});
   return result;
 }
 

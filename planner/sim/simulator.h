@@ -11,7 +11,7 @@
 //   o.method = ReplanMethod::kAuto;
 //   o.plan.robot.tool_width_m = 0.8;
 //   ASSIGN_OR_RETURN(SimulationResult r, Simulate(known, truth, o));
-//   r.total_time_s, r.stoppage_s, r.covered_free_area_ratio, r.driven ...
+//   r.total_time_s, r.stoppage_s, r.covered_free_area_ratio, r.floor, r.driven ...
 //   ASSIGN_OR_RETURN(OfflineBound lb, OfflineLowerBound(truth, o.plan));  // OARP knowing
 //   everything (offline_bound.h, included here)
 //
@@ -54,6 +54,7 @@
 #include "planner/assembly/plan_coverage.h"
 #include "planner/grid/occupancy_map.h"
 #include "planner/plan/coverage_plan.h"
+#include "planner/plan/floor_measure.h"
 #include "planner/replan/replanner.h"
 #include "planner/sim/battery_run.h"
 #include "planner/sim/offline_bound.h"
@@ -121,6 +122,12 @@ struct SimulationResult {
   // Replanner errors and paths that entered a cell reported blocked, with
   // the input that caused them; each was worked around by a greedy detour.
   std::vector<std::string> problems;
+  // The floor the tool can reach on the true map and how much of it the
+  // driven path swept (floor_measure.h): seeded from the cells free on both
+  // the plan's drive grid and the true grid, in the robot's component as its
+  // cell model moves; outside the no-go zones, inside the regions. The
+  // plan's own figure (stats.swept_reachable_ratio) is the known map's.
+  FloorMeasure floor;
   // Per cell of the plan's grid (Grid::Index): swept by the driven path.
   std::vector<uint8_t> swept;
   bool completed = true;  // false: a bound of SimulationOptions stopped the run

@@ -79,9 +79,17 @@ std::vector<uint8_t> Reachable(const Grid& known, const Grid& truth,
   return reachable;
 }
 
-// What every fleet run must show: no driving into furniture, and every cell
-// a single simulated robot sweeps swept by the fleet.
-void CheckRun(const FleetSimulationResult& r, const std::vector<uint8_t>& single_swept) {
+// What every fleet run must show: no driving into furniture, every cell a
+// single simulated robot sweeps swept by the fleet, and about as much of the
+// floor the tool can reach (the paths differ within the cells).
+void CheckRun(const FleetSimulationResult& r, const SimulationResult& single) {
+  const std::vector<uint8_t>& single_swept = single.swept;
+  std::printf("floor: fleet %.4f of %.1f m2, one robot %.4f of %.1f m2\n",
+              r.floor.swept_reachable_ratio, r.floor.reachable_area_m2,
+              single.floor.swept_reachable_ratio, single.floor.reachable_area_m2);
+  EXPECT_GE(r.floor.reachable_area_m2, single.floor.reachable_area_m2 - 1e-9);
+  EXPECT_GE(r.floor.swept_reachable_ratio, single.floor.swept_reachable_ratio - 0.01);
+  EXPECT_LE(r.floor.swept_reachable_ratio, 1.0);
   const Grid true_grid = TrueGrid(testing::LoadShippedMap("sample_office_furnished.yaml"));
   EXPECT_TRUE(r.completed);
   EXPECT_THAT(r.problems, ::testing::IsEmpty());
@@ -118,7 +126,7 @@ TEST(FleetSimulation, ThreeRobotsOneFailingAtAThirdOfTheMakespanLeaveNoReachable
   absl::StatusOr<FleetSimulationResult> all = SimulateFleet(known, truth, o);
   ASSERT_TRUE(all.ok()) << all.status();
   Print(*all);
-  CheckRun(*all, one->swept);
+  CheckRun(*all, *one);
   EXPECT_TRUE(all->redivisions.empty());
 
   const double t_f = all->initial.makespan_s / 3.0;
@@ -126,7 +134,7 @@ TEST(FleetSimulation, ThreeRobotsOneFailingAtAThirdOfTheMakespanLeaveNoReachable
   absl::StatusOr<FleetSimulationResult> r = SimulateFleet(known, truth, o);
   ASSERT_TRUE(r.ok()) << r.status();
   Print(*r);
-  CheckRun(*r, one->swept);
+  CheckRun(*r, *one);
   ASSERT_EQ(r->redivisions.size(), 1u);
   const FleetRedivision& d = r->redivisions[0];
   EXPECT_EQ(d.failed_robot, "b");

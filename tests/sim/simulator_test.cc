@@ -109,6 +109,20 @@ TEST_P(EveryReplanMethod,
   // close; on maps with chair legs the true map's bound is far higher (barriers).
   EXPECT_GT(r->total_time_s, 0.9 * cell_bound->duration_s);
   EXPECT_LT(r->length_in_obstacles_m, 0.01 * r->path_length_m);
+  // The floor of the furnished office: less than the plain office's (the
+  // furniture takes some), and the driven path sweeps about as much of it as
+  // the offline plan of the true map does.
+  std::printf("floor: %.1f m2 reachable, %.4f swept (offline %.4f), %.1f m2 missed\n",
+              r->floor.reachable_area_m2, r->floor.swept_reachable_ratio,
+              offline->swept_reachable_ratio, r->floor.missed_reachable_m2);
+  absl::StatusOr<CoveragePlan> plain = PlanCoverage(known, o.plan);
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_GT(r->floor.reachable_area_m2, 0.5 * plain->stats.reachable_area_m2);
+  EXPECT_LT(r->floor.reachable_area_m2, plain->stats.reachable_area_m2);
+  EXPECT_GE(r->floor.swept_reachable_ratio, 0.97 * offline->swept_reachable_ratio);
+  EXPECT_LE(r->floor.swept_reachable_ratio, 1.0);
+  EXPECT_NEAR(r->floor.missed_reachable_m2,
+              r->floor.reachable_area_m2 * (1.0 - r->floor.swept_reachable_ratio), 1e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, EveryReplanMethod,
@@ -136,6 +150,11 @@ TEST(Simulate, WithAPerfectMapNothingIsReplannedAndTheRunIsThePlan) {
   EXPECT_EQ(r->driven.size(), plan->plan.path.size());
   EXPECT_DOUBLE_EQ(r->planned_duration_s, plan->plan.stats.estimated_duration_s);
   EXPECT_NEAR(r->covered_free_area_ratio, plan->plan.stats.covered_free_area_ratio, 1e-9);
+  // The floor: the plan's own figures (the same map, the same path).
+  EXPECT_GT(r->floor.reachable_area_m2, 0.0);
+  EXPECT_NEAR(r->floor.reachable_area_m2, plan->plan.stats.reachable_area_m2, 1e-9);
+  EXPECT_NEAR(r->floor.swept_reachable_ratio, plan->plan.stats.swept_reachable_ratio, 1e-9);
+  EXPECT_NEAR(r->floor.missed_reachable_m2, plan->plan.stats.missed_reachable_m2, 1e-9);
 }
 
 TEST(CellLevelTruth, FillsExactlyTheCellsTheTrueMapBlocks) {
@@ -350,6 +369,13 @@ TEST(SimulateCommand, PrintsEveryFigureAsOneJsonObject) {
   EXPECT_GT(coverage, 0.5);
   EXPECT_LE(coverage, 1.0);
   EXPECT_GT(JsonField(*json, "offline_lower_bound_s"), 0.5 * total);
+  const double floor = JsonField(*json, "swept_reachable_ratio");
+  EXPECT_GT(floor, 0.5);
+  EXPECT_LE(floor, 1.0);
+  EXPECT_GT(JsonField(*json, "reachable_area_m2"), 0.0);
+  EXPECT_NEAR(JsonField(*json, "missed_reachable_m2"),
+              JsonField(*json, "reachable_area_m2") * (1.0 - floor), 0.01);
+  EXPECT_GT(JsonField(*json, "offline_swept_reachable_ratio"), 0.5);
 }
 
 TEST(SimulateCommand, BadFlagsAreInvalidArgument) {
