@@ -76,29 +76,41 @@ std::vector<uint8_t> NearSites(const std::vector<uint8_t>& site, int64_t width, 
     int32_t* row = g.data() + j * width;
     for (int64_t i = 0; i < width; ++i) row[i] = std::min(row[i], down[i] + 1);
   }
-  // Along each row: the nearest site is within the radius when some column
-  // dx away (|dx| <= R) has one within radius2 - dx^2 of this row.
-  const int64_t big_r = static_cast<int64_t>(std::floor(std::sqrt(radius2)));
-  const int64_t limit = static_cast<int64_t>(std::floor(radius2));  // integer squares
-  // Squares in int32: a column distance is capped at R + 1 first.
-  const int32_t cap = static_cast<int32_t>(big_r) + 1;
-  std::vector<int32_t> sq(static_cast<size_t>(width)), best(static_cast<size_t>(width));
+  // Along each row, the squared distance to the nearest site is the lower
+  // envelope of the parabolas (x - q)^2 + g_q^2 over the columns q that have
+  // a site (Felzenszwalb and Huttenlocher's distance transform), O(width).
+  // The envelope's breakpoints are doubles; the distance at each pixel is
+  // then taken exactly in integers from the parabola that owns it (where two
+  // parabolas are within rounding of each other they are equal there).
+  std::vector<int64_t> v(static_cast<size_t>(width));
+  std::vector<double> z(static_cast<size_t>(width) + 1);
   for (int64_t j = 0; j < height; ++j) {
     const int32_t* row = g.data() + j * width;
-    for (int64_t i = 0; i < width; ++i) {
-      const int32_t gy = std::min(row[i], cap);
-      sq[i] = gy * gy;
-    }
-    std::fill(best.begin(), best.end(), std::numeric_limits<int32_t>::max());
-    for (int64_t dx = -big_r; dx <= big_r; ++dx) {
-      const int64_t lo = std::max<int64_t>(0, -dx), hi = std::min<int64_t>(width, width - dx);
-      const int32_t dx2 = static_cast<int32_t>(dx * dx);
-      const int32_t* shifted = sq.data() + dx;
-      int32_t* b = best.data();
-      for (int64_t i = lo; i < hi; ++i) b[i] = std::min(b[i], shifted[i] + dx2);
+    auto f = [row](int64_t q) {
+      return static_cast<double>(row[q]) * row[q] + static_cast<double>(q) * q;
+    };
+    int64_t k = -1;
+    for (int64_t q = 0; q < width; ++q) {
+      if (row[q] >= kNone) continue;
+      double at = -std::numeric_limits<double>::infinity();
+      while (k >= 0) {
+        at = (f(q) - f(v[k])) / (2.0 * static_cast<double>(q - v[k]));
+        if (at > z[k]) break;
+        --k;
+      }
+      ++k;
+      v[k] = q;
+      z[k] = k == 0 ? -std::numeric_limits<double>::infinity() : at;
+      z[k + 1] = std::numeric_limits<double>::infinity();
     }
     uint8_t* o = out.data() + j * width;
-    for (int64_t i = 0; i < width; ++i) o[i] = best[i] <= limit;
+    if (k < 0) continue;  // no site in this row's reach: all 0
+    int64_t owner = 0;
+    for (int64_t i = 0; i < width; ++i) {
+      while (z[owner + 1] < static_cast<double>(i)) ++owner;
+      const int64_t dx = i - v[owner], gy = row[v[owner]];
+      o[i] = static_cast<double>(dx * dx + gy * gy) <= radius2;
+    }
   }
   return out;
 }

@@ -75,7 +75,7 @@ FloorMeasure MeasureFloor(const FloorReach& reach,
 
 // Per pixel of a width x height image: 1 when some pixel where `site` is
 // non-zero has its centre within sqrt(radius2) pixels of this pixel's centre
-// (squared distance <= radius2), else 0. Exact; O(pixels x radius).
+// (squared distance <= radius2), else 0. Exact; O(pixels).
 std::vector<uint8_t> NearSites(const std::vector<uint8_t>& site, int64_t width, int64_t height,
                                double radius2);
 

@@ -165,17 +165,19 @@ double ReachableM2(const FloorReach& r) { return r.reachable_px * r.pixel_m * r.
 TEST(FloorMeasure, NearSitesIsExact) {
   std::mt19937 rng(7);
   const int64_t w = 37, h = 23;
-  for (double radius2 : {0.0, 2.0, 8.5, 30.0, 72.25}) {
-    std::vector<uint8_t> site(w * h, 0);
-    for (uint8_t& s : site) s = rng() % 29 == 0;
-    const std::vector<uint8_t> near = NearSites(site, w, h, radius2);
-    for (int64_t p = 0; p < w * h; ++p) {
-      bool want = false;
-      for (int64_t q = 0; q < w * h && !want; ++q) {
-        const double dx = p % w - q % w, dy = p / w - q / w;
-        want = site[q] && dx * dx + dy * dy <= radius2;
+  for (double radius2 : {0.0, 2.0, 8.5, 30.0, 72.25, 5000.0}) {
+    for (unsigned one_in : {2u, 29u, 400u}) {
+      std::vector<uint8_t> site(w * h, 0);
+      for (uint8_t& s : site) s = rng() % one_in == 0;
+      const std::vector<uint8_t> near = NearSites(site, w, h, radius2);
+      for (int64_t p = 0; p < w * h; ++p) {
+        bool want = false;
+        for (int64_t q = 0; q < w * h && !want; ++q) {
+          const double dx = p % w - q % w, dy = p / w - q / w;
+          want = site[q] && dx * dx + dy * dy <= radius2;
+        }
+        ASSERT_EQ(near[p], want) << "pixel " << p << " radius2 " << radius2 << " 1/" << one_in;
       }
-      ASSERT_EQ(near[p], want) << "pixel " << p << " radius2 " << radius2;
     }
   }
 }
