@@ -196,6 +196,9 @@ void FleetPlanToProto(const FleetPlan& plan, v1::PlanFleetResponse* out) {
   out->set_division(FleetDivisionToProto(plan.division));
   out->set_planning_ms(plan.planning_ms);
   out->set_rebalance_rounds(plan.rebalance_rounds);
+  out->set_reachable_area_m2(plan.floor.reachable_area_m2);
+  out->set_swept_reachable_ratio(plan.floor.swept_reachable_ratio);
+  out->set_missed_reachable_m2(plan.floor.missed_reachable_m2);
   TerminationToProto(plan.termination, out->mutable_termination());
   SafetyToProto(plan.safety, out->mutable_safety());
 }
@@ -223,6 +226,10 @@ absl::StatusOr<FleetPlan> FleetPlanFromProto(const v1::PlanFleetResponse& respon
   out.covered_cells = response.covered_cells();
   out.planning_ms = response.planning_ms();
   out.rebalance_rounds = response.rebalance_rounds();
+  out.floor.reachable_area_m2 = response.reachable_area_m2();
+  out.floor.swept_reachable_ratio = response.swept_reachable_ratio();
+  out.floor.missed_reachable_m2 = response.missed_reachable_m2();
+  out.floor.swept_reachable_m2 = out.floor.reachable_area_m2 - out.floor.missed_reachable_m2;
   out.termination = TerminationFromProto(response.termination());
   ASSIGN_OR_RETURN(out.safety, SafetyFromProto(response.safety()));
   return out;

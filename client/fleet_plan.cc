@@ -222,6 +222,12 @@ std::string FormatFleetSummary(const FleetRequest& request, const FleetPlan& pla
                         plan.makespan_s, plan.lower_bound_s, 100.0 * plan.gap, plan.sum_duration_s,
                         plan.planning_ms, plan.rebalance_rounds, TerminationText(plan.termination),
                         closest, s.conflicts.size(), s.clearance_m);
+  if (plan.floor.reachable_area_m2 > 0.0) {
+    absl::StrAppendFormat(&out,
+                          "floor      %.1f %% of the %.1f m2 the tool can reach (%.1f m2 missed)\n",
+                          100.0 * plan.floor.swept_reachable_ratio, plan.floor.reachable_area_m2,
+                          plan.floor.missed_reachable_m2);
+  }
   return out;
 }
 
@@ -243,13 +249,16 @@ absl::StatusOr<std::string> FleetToJson(const LocalFleetRun& run, const std::str
       "{\n  \"fleet_id\": %s,\n  \"map\": %s,\n  \"map_id\": %s,\n  \"division\": %s,\n"
       "  \"makespan_s\": %s,\n  \"lower_bound_s\": %s,\n  \"gap\": %s,\n"
       "  \"sum_duration_s\": %s,\n  \"cover_cells\": %d,\n  \"covered_cells\": %d,\n"
-      "  \"rebalance_rounds\": %d,\n  \"planning_ms\": %s,\n  \"termination\": %s,\n"
+      "  \"rebalance_rounds\": %d,\n  \"planning_ms\": %s,\n  \"reachable_area_m2\": %s,\n"
+      "  \"swept_reachable_ratio\": %s,\n  \"missed_reachable_m2\": %s,\n  \"termination\": %s,\n"
       "  \"safety\": %s,\n  \"robots\": [\n%s\n  ]\n}\n",
       JsonString(plan_id), JsonString(map_path), JsonString(run.map_id),
       JsonString(FleetDivisionName(p.division)), JsonNumber(p.makespan_s),
       JsonNumber(p.lower_bound_s), JsonNumber(p.gap), JsonNumber(p.sum_duration_s), p.cover_cells,
       p.covered_cells, p.rebalance_rounds, JsonNumber(p.planning_ms),
-      TerminationJson(p.termination), SafetyJson(p.safety), absl::StrJoin(robots, ",\n"));
+      JsonNumber(p.floor.reachable_area_m2), JsonNumber(p.floor.swept_reachable_ratio),
+      JsonNumber(p.floor.missed_reachable_m2), TerminationJson(p.termination), SafetyJson(p.safety),
+      absl::StrJoin(robots, ",\n"));
 }
 
 std::string FleetToSvg(const LocalFleetRun& run, const OccupancyMap* map, const SvgZones& zones) {

@@ -175,24 +175,32 @@ absl::StatusOr<bool> PlanningEngine::Setup(const MapSource& source, const PlanRe
   return true;
 }
 
+absl::Status PlanningEngine::BuildArea(const MapSource& source, const PlanRequest& request,
+                                       Built* out) const {
+  ASSIGN_OR_RETURN(out->resolved, Resolve(request));
+  return Setup(source, request, out->resolved, ArtifactUse::kBuild, &out->ctx, &out->all_cached)
+      .status();
+}
+
 absl::Status PlanningEngine::Prepare(const MapSource& source, const PlanRequest& request) const {
-  ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
-  PlanContext ctx;
-  bool all_cached = true;
-  RETURN_IF_ERROR(
-      Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
-  RETURN_IF_ERROR(FloorFor(ctx).status());
-  return resolved.planner->Prepare(ctx);
+  Built built;
+  RETURN_IF_ERROR(BuildArea(source, request, &built));
+  RETURN_IF_ERROR(covplan::FloorFor(built.ctx).status());
+  return built.resolved.planner->Prepare(built.ctx);
+}
+
+absl::StatusOr<std::shared_ptr<const FloorArtifact>> PlanningEngine::FloorFor(
+    const MapSource& source, const PlanRequest& request) const {
+  Built built;
+  RETURN_IF_ERROR(BuildArea(source, request, &built));
+  return covplan::FloorFor(built.ctx);
 }
 
 absl::StatusOr<std::shared_ptr<const CoverageArea>> PlanningEngine::AreaFor(
     const MapSource& source, const PlanRequest& request) const {
-  ASSIGN_OR_RETURN(Resolved resolved, Resolve(request));
-  PlanContext ctx;
-  bool all_cached = true;
-  RETURN_IF_ERROR(
-      Setup(source, request, resolved, ArtifactUse::kBuild, &ctx, &all_cached).status());
-  return ctx.area;
+  Built built;
+  RETURN_IF_ERROR(BuildArea(source, request, &built));
+  return built.ctx.area;
 }
 
 absl::Status PlanningEngine::Finish(const PlanRequest& request, const Resolved& resolved,
@@ -332,6 +340,7 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
       PlanStats& s = hit.plan.stats;
       s.plan_source = PlanOrigin::kCacheHit;
       s.tour_ms = 0.0;
+      s.floor_ms = 0.0;  // measured when it was planned
       s.decomposition_cached = all_cached;
       s.planning_ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
       return hit;
@@ -386,6 +395,7 @@ absl::StatusOr<EngineResult> PlanningEngine::Plan(const MapSource& source,
         plan.termination = termination;
         plan.stats.plan_source = PlanOrigin::kImproved;
         plan.stats.tour_ms = fresh.tour_ms;
+        plan.stats.floor_ms = fresh.floor_ms;
         plan.stats.planning_ms = fresh.planning_ms;
         plan.stats.decomposition_cached = fresh.decomposition_cached;
         plan.stats.tour_cut_short = fresh.tour_cut_short;

@@ -32,6 +32,7 @@
 #include "absl/status/statusor.h"
 #include "planner/energy/battery.h"
 #include "planner/engine/artifact_cache.h"
+#include "planner/engine/floor_artifact.h"
 #include "planner/engine/planner.h"
 #include "planner/engine/site.h"
 #include "planner/geometry/area.h"
@@ -142,6 +143,10 @@ class PlanningEngine {
                                         const std::vector<uint8_t>& drive_mask = {}) const;
   // Builds every per-map artifact `request` needs, without planning.
   absl::Status Prepare(const MapSource& source, const PlanRequest& request) const;
+  // The reachable floor of the request's coverage area (floor_artifact.h),
+  // from the cache or built and cached.
+  absl::StatusOr<std::shared_ptr<const FloorArtifact>> FloorFor(const MapSource& source,
+                                                                const PlanRequest& request) const;
   // The coverage area `request` plans on (validated like Plan), e.g. to
   // continue a plan the server did not retain.
   absl::StatusOr<std::shared_ptr<const CoverageArea>> AreaFor(const MapSource& source,
@@ -163,6 +168,15 @@ class PlanningEngine {
   absl::StatusOr<bool> Setup(const MapSource& source, const PlanRequest& request,
                              const Resolved& resolved, ArtifactUse use, PlanContext* ctx,
                              bool* all_cached) const;
+  // What Prepare, FloorFor and AreaFor work in: the request resolved and
+  // every artifact of its area built (ctx points into the struct: not to be
+  // moved once filled).
+  struct Built {
+    Resolved resolved;
+    PlanContext ctx;
+    bool all_cached = true;
+  };
+  absl::Status BuildArea(const MapSource& source, const PlanRequest& request, Built* out) const;
   PlanMemoryKeys MemoryKeys(const PlanRequest& request, const Resolved& resolved,
                             const PlanContext& ctx) const;
   // Path checks and path-derived statistics of a planner's result.

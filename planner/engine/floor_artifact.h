@@ -23,7 +23,7 @@ namespace covplan {
 class FloorArtifact final : public Artifact {
  public:
   FloorReach reach;
-  size_t MemoryBytes() const override { return sizeof(*this) + reach.MemoryBytes(); }
+  size_t MemoryBytes() const override { return sizeof(*this) + reach.reachable.capacity(); }
 };
 
 // ctx's area's reachable floor: from the cache, or built and cached.

@@ -253,6 +253,23 @@ void FillFleetFigures(const FleetRequest& request, int64_t cover_cells, FleetPla
   plan->safety = FleetSafetyReport(ids, paths, clearance);
 }
 
+namespace {
+
+// The floor the whole site's robots sweep together; nothing for a part.
+absl::Status MeasureFleetFloor(const PlanningEngine& engine, const MapSource& source,
+                               const FleetRequest& request, FleetPlan* plan) {
+  if (!request.cover_mask.empty()) return absl::OkStatus();
+  PlanRequest site = request.RobotRequest(0);
+  site.common.stop = StopToken();  // cached by the plans above: nothing to cut short
+  ASSIGN_OR_RETURN(std::shared_ptr<const FloorArtifact> floor, engine.FloorFor(source, site));
+  std::vector<const std::vector<Waypoint>*> paths;
+  for (const FleetRobotPlan& rp : plan->robots) paths.push_back(&rp.result.plan.path);
+  plan->floor = MeasureFloor(floor->reach, paths, /*keep_missed=*/false);
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSource& source,
                                     const FleetRequest& request) {
   const absl::Time t0 = absl::Now();
@@ -277,6 +294,7 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
         MakespanLowerBound(units, request.robots, best.robots[0].result.area->drive.get()).value();
     best.termination = best.robots[0].result.plan.termination;
     FillFleetFigures(request, best.robots[0].assigned_cells, &best);
+    RETURN_IF_ERROR(MeasureFleetFloor(engine, source, request, &best));
     best.planning_ms = Seconds(t0) * 1e3;
     return best;
   }
@@ -319,6 +337,7 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
                                                      : TerminationLimit::kTime,
                                                  "the budget ended the rebalancing");
   }
+  RETURN_IF_ERROR(MeasureFleetFloor(engine, source, request, &best));
   best.planning_ms = Seconds(t0) * 1e3;
   return best;
 }

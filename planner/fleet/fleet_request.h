@@ -22,6 +22,7 @@
 #include "planner/energy/battery.h"
 #include "planner/engine/engine.h"
 #include "planner/plan/coverage_plan.h"
+#include "planner/plan/floor_measure.h"
 #include "planner/tour/robot_model.h"
 
 namespace covplan {
@@ -108,6 +109,11 @@ struct FleetPlan {
   double sum_duration_s = 0.0;
   int64_t cover_cells = 0;
   int64_t covered_cells = 0;  // distinct cells swept by some robot
+  // The floor the tool can reach on the site's map pixels and the share of
+  // it the robots' paths sweep together (planner/plan/floor_measure.h). Only
+  // for the whole site: all zero for a part (FleetRequest::cover_mask, a
+  // redivision).
+  FloorMeasure floor;
   int rebalance_rounds = 0;
   // The makespan division kept the equal-area regions (they finished first).
   bool from_regions = false;

@@ -87,14 +87,12 @@ std::vector<std::string> Grid::ToRowStrings() const {
   return out;
 }
 
-namespace {
-
-// Snaps x to the nearest integer when it is within floating-point noise, so
-// that e.g. 0.8 / 0.05 is exactly 16 pixels.
-double Snap(double x) {
+double SnapToInteger(double x) {
   const double r = std::round(x);
   return std::abs(x - r) < 1e-9 * std::max(1.0, std::abs(x)) ? r : x;
 }
+
+namespace {
 
 // Free area (in pixel units) of every grid cell, computed exactly with
 // fractional overlap of boundary pixels. Separable: per pixel row, prefix sums
@@ -198,9 +196,9 @@ absl::StatusOr<GridFrame> PlanGridFrame(const OccupancyMap& map, const GridOptio
                         width_m, height_m));
   }
   GridFrame f;
-  f.px_per_cell = Snap(options.cell_size / res);
-  f.cols = static_cast<int>(std::ceil(Snap(map.width() / f.px_per_cell)));
-  f.rows = static_cast<int>(std::ceil(Snap(map.height() / f.px_per_cell)));
+  f.px_per_cell = SnapToInteger(options.cell_size / res);
+  f.cols = static_cast<int>(std::ceil(SnapToInteger(map.width() / f.px_per_cell)));
+  f.rows = static_cast<int>(std::ceil(SnapToInteger(map.height() / f.px_per_cell)));
   f.cell_size = options.cell_size;
   f.origin = map.origin();
   if (static_cast<int64_t>(f.rows) * f.cols > options.max_cells) {
@@ -284,7 +282,7 @@ Grid Grid::WithFreeFlags(std::vector<uint8_t> free) const {
 double CoveredFreeAreaRatio(const OccupancyMap& map, const Grid& grid) {
   const int64_t map_free = map.CountFree();
   if (map_free == 0) return 0.0;
-  const double px_per_cell = Snap(grid.cell_size() / map.resolution());
+  const double px_per_cell = SnapToInteger(grid.cell_size() / map.resolution());
   FreeAreaIntegrator integrator(map);
   double covered = 0.0;
   for (int r = 0; r < grid.rows(); ++r) {

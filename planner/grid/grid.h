@@ -145,6 +145,9 @@ struct GridFrame {
 // InvalidArgument when the cell is smaller than a map pixel, larger than the
 // map, or the grid exceeds max_cells.
 absl::StatusOr<GridFrame> PlanGridFrame(const OccupancyMap& map, const GridOptions& options);
+// x rounded to the nearest integer when it is within floating-point noise
+// of it, else x: the frame's pixels per cell (0.8 m / 0.05 m is 16).
+double SnapToInteger(double x);
 // Exact free share (0..1) of every cell of `frame` over `map`, row-major.
 std::vector<double> CellFreeFractions(const OccupancyMap& map, const GridFrame& frame);
 // The grid whose cells are free when fractions[i] > options.min_free_fraction;

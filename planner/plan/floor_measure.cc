@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "planner/grid/obstacle_pixels.h"
 
@@ -32,11 +33,45 @@ void StampPath(const FloorReach& reach, const std::vector<Waypoint>& path, doubl
   auto px = [&](const Waypoint& p) {
     return Point2{(p.x - reach.origin.x) / reach.pixel_m, (p.y - reach.origin.y) / reach.pixel_m};
   };
-  if (path.size() == 1) stamp(px(path[0]).x, px(path[0]).y);
+  // Only what lies within the radius of the frame can stamp: a segment is
+  // clipped to that box first (Liang-Barsky), so that far or non-finite
+  // coordinates never reach the integer casts.
+  const double lo_x = -radius - 1.0, hi_x = static_cast<double>(w) + radius + 1.0;
+  const double lo_y = -radius - 1.0, hi_y = static_cast<double>(h) + radius + 1.0;
+  auto clip = [&](Point2* a, Point2* b) {
+    if (!std::isfinite(a->x) || !std::isfinite(a->y) || !std::isfinite(b->x) ||
+        !std::isfinite(b->y)) {
+      return false;
+    }
+    const double dx = b->x - a->x, dy = b->y - a->y;
+    double t0 = 0.0, t1 = 1.0;
+    for (auto [p, q] : {std::pair{-dx, a->x - lo_x}, std::pair{dx, hi_x - a->x},
+                        std::pair{-dy, a->y - lo_y}, std::pair{dy, hi_y - a->y}}) {
+      if (p == 0.0) {
+        if (q < 0.0) return false;
+        continue;
+      }
+      const double r = q / p;
+      if (p < 0.0) {
+        if (r > t1) return false;
+        t0 = std::max(t0, r);
+      } else {
+        if (r < t0) return false;
+        t1 = std::min(t1, r);
+      }
+    }
+    *b = Point2{a->x + t1 * dx, a->y + t1 * dy};
+    *a = Point2{a->x + t0 * dx, a->y + t0 * dy};
+    return true;
+  };
+  if (path.size() == 1) {
+    Point2 a = px(path[0]), b = a;
+    if (clip(&a, &b)) stamp(a.x, a.y);
+  }
   for (size_t k = 1; k < path.size(); ++k) {
-    const Point2 a = px(path[k - 1]), b = px(path[k]);
+    Point2 a = px(path[k - 1]), b = px(path[k]);
+    if (!clip(&a, &b)) continue;
     const double len = std::hypot(b.x - a.x, b.y - a.y);
-    if (!std::isfinite(len)) continue;
     const int64_t steps = 1 + static_cast<int64_t>(std::ceil(len / 0.5));
     for (int64_t s = 0; s <= steps; ++s) {
       const double t = static_cast<double>(s) / static_cast<double>(steps);
@@ -59,7 +94,10 @@ std::vector<uint8_t> PixelsInside(const Area& area, const FloorReach& r, double 
 std::vector<uint8_t> NearSites(const std::vector<uint8_t>& site, int64_t width, int64_t height,
                                double radius2) {
   std::vector<uint8_t> out(site.size(), 0);
-  if (width <= 0 || height <= 0 || !(radius2 >= 0.0)) return out;
+  if (width <= 0 || height <= 0 || !(radius2 >= 0.0) ||
+      site.size() != static_cast<size_t>(width) * static_cast<size_t>(height)) {
+    return out;
+  }
   // Down each column, the distance to the nearest site in it: two sweeps
   // over the rows (row-major, so the memory is read in order).
   constexpr int32_t kNone = 1 << 20;
@@ -146,7 +184,7 @@ FloorReach Reach(int64_t width, int64_t height, double ppc, const Blocked& block
   // radius + 1/2 (squared distances are integers: nearer means at most the
   // largest integer below the square).
   const double fit2 = (r.tool_radius_px + 0.5) * (r.tool_radius_px + 0.5);
-  std::vector<uint8_t> fits = NearSites(closed, w, h, std::ceil(fit2) - 1.0);
+  std::vector<uint8_t> fits = NearSites(closed, w, h, std::ceil(fit2 - 1e-9) - 1.0);
   for (uint8_t& f : fits) f = !f;
   std::vector<uint8_t> centre(closed.size(), 0);
   std::vector<int64_t> queue;  // a stack: the order of the flood does not matter
@@ -203,7 +241,7 @@ FloorReach ComputeFloorReach(const Grid& drive, const Area* no_go, const Area* r
 FloorReach ComputeFloorReach(const OccupancyMap& map, const Grid& drive, const Area* no_go,
                              const Area* regions) {
   return Reach(
-      map.width(), map.height(), drive.cell_size() / map.resolution(),
+      map.width(), map.height(), SnapToInteger(drive.cell_size() / map.resolution()),
       [&map](int64_t i, int64_t j) {
         return !map.IsFree(static_cast<int>(j), static_cast<int>(i));
       },

@@ -6,14 +6,17 @@
 //
 //   reachable: every free pixel a tool disc (diameter = the grid's cell
 //              side, the tool width) can touch with its centre at a pixel
-//              centre where the whole disc stays off non-free pixels and
-//              no-go zones, in the part of that free space the robot's
-//              drive grid lies in (the free space opened by the tool's
-//              footprint); with regions, only the pixels whose centre lies
-//              in a region;
+//              centre that is at least r + 1/2 pixel from the centre of
+//              every non-free pixel and every pixel touching a no-go zone
+//              (each such pixel taken as a disc of half a pixel: the tool
+//              may graze a pixel's corner by up to 0.21 pixel), in the part
+//              of that free space the robot's drive grid lies in (the free
+//              space opened by the tool's footprint); with regions, only the
+//              pixels more than half inside a region;
 //   swept:     every pixel whose centre lies within half a tool width of
-//              the plan's path (the whole path: the tool works while the
-//              robot drives).
+//              a point of the plan's path sampled every half pixel (within
+//              0.004 pixel of the exact distance at a radius of 8 pixels;
+//              the whole path: the tool works while the robot drives).
 //
 //   ASSIGN_OR_RETURN(FloorReach reach, ComputeFloorReach(*area.drive, no_go, regions));
 //   FloorMeasure m = MeasureFloor(reach, plan.path, /*keep_missed=*/false);
@@ -75,7 +78,8 @@ FloorMeasure MeasureFloor(const FloorReach& reach,
 
 // Per pixel of a width x height image: 1 when some pixel where `site` is
 // non-zero has its centre within sqrt(radius2) pixels of this pixel's centre
-// (squared distance <= radius2), else 0. Exact; O(pixels).
+// (squared distance <= radius2), else 0. Exact; O(pixels). All 0 when
+// `site` does not hold width x height pixels.
 std::vector<uint8_t> NearSites(const std::vector<uint8_t>& site, int64_t width, int64_t height,
                                double radius2);
 

@@ -244,6 +244,10 @@ TEST(ConvertFleet, PlanRoundTrip) {
   EXPECT_EQ(back->cover_cells, plan->cover_cells);
   EXPECT_EQ(back->covered_cells, plan->covered_cells);
   EXPECT_EQ(back->rebalance_rounds, plan->rebalance_rounds);
+  EXPECT_GT(plan->floor.reachable_area_m2, 0.0);
+  EXPECT_EQ(back->floor.reachable_area_m2, plan->floor.reachable_area_m2);
+  EXPECT_EQ(back->floor.swept_reachable_ratio, plan->floor.swept_reachable_ratio);
+  EXPECT_EQ(back->floor.missed_reachable_m2, plan->floor.missed_reachable_m2);
   EXPECT_EQ(back->termination.reason, plan->termination.reason);
   EXPECT_EQ(back->termination.detail, plan->termination.detail);
   EXPECT_EQ(back->safety.closest_approach_m, plan->safety.closest_approach_m);

@@ -86,7 +86,8 @@ struct Recount {
 Recount RecountFromPixels(const OccupancyMap& map, const Grid& drive,
                           const std::vector<Waypoint>& path, double tool_width_m) {
   const int w = map.width(), h = map.height();
-  const double res = map.resolution(), r = 0.5 * tool_width_m / res;
+  // The radius in pixels as the grid's frame has it (0.8 m at 0.05 m/px: 8).
+  const double res = map.resolution(), r = 0.5 * SnapToInteger(tool_width_m / res);
   auto closed = [&](int i, int j) {
     return i < 0 || j < 0 || i >= w || j >= h || !map.IsFree(j, i);
   };
@@ -180,6 +181,40 @@ TEST(FloorMeasure, NearSitesIsExact) {
       }
     }
   }
+  // Fixed cases: no site at all, one row, one column, a lone corner site
+  // reaching the far corner only with a large radius, a size mismatch.
+  EXPECT_EQ(NearSites(std::vector<uint8_t>(12, 0), 4, 3, 100.0), std::vector<uint8_t>(12, 0));
+  EXPECT_EQ(NearSites({0, 0, 1, 0, 0, 0, 0}, 7, 1, 4.0),
+            (std::vector<uint8_t>{1, 1, 1, 1, 1, 0, 0}));
+  EXPECT_EQ(NearSites({0, 0, 1, 0, 0, 0, 0}, 1, 7, 1.0),
+            (std::vector<uint8_t>{0, 1, 1, 1, 0, 0, 0}));
+  std::vector<uint8_t> corner(30 * 20, 0);
+  corner[0] = 1;
+  const double far2 = 29.0 * 29.0 + 19.0 * 19.0;
+  EXPECT_EQ(NearSites(corner, 30, 20, far2 - 1.0).back(), 0);
+  EXPECT_EQ(NearSites(corner, 30, 20, far2).back(), 1);
+  EXPECT_EQ(NearSites(corner, 30, 21, far2), std::vector<uint8_t>(corner.size(), 0));
+}
+
+// Far and non-finite waypoints: a segment is clipped to the map before it is
+// sampled, so a path to a point far off the map sweeps what a path to just
+// past the map's edge sweeps, and a NaN waypoint's segments sweep nothing.
+TEST(FloorMeasure, FarAndNonFiniteWaypointsAreClippedOrSkipped) {
+  Site s(Room(10.0, 6.0));
+  const FloorReach reach = s.Reach();
+  auto swept = [&](std::vector<Waypoint> path) {
+    return MeasureFloor(reach, path, false).swept_reachable_m2;
+  };
+  Waypoint a, near_edge, far, nan;
+  a.x = 1.0, a.y = 3.0;
+  near_edge.x = 12.0, near_edge.y = 3.0;
+  far.x = 1e300, far.y = 3.0;
+  nan.x = std::nan(""), nan.y = 3.0;
+  EXPECT_GT(swept({a, near_edge}), 0.0);
+  EXPECT_DOUBLE_EQ(swept({a, far}), swept({a, near_edge}));
+  EXPECT_EQ(swept({a, nan}), 0.0);
+  EXPECT_EQ(swept({nan}), 0.0);
+  EXPECT_DOUBLE_EQ(swept({a, nan, a, near_edge}), swept({a, near_edge}));
 }
 
 TEST(FloorMeasure, ARoomIsReachableButItsCornerFillets) {

@@ -51,6 +51,11 @@ TEST(Fleet, OfOneIsTheSingleRobotPlan) {
   }
   EXPECT_EQ(fleet->makespan_s, one->plan.stats.estimated_duration_s);
   EXPECT_EQ(testing::CheckFleetPlan(*fleet, f, *one->area), "");
+  // The fleet's floor is the plan's own.
+  EXPECT_GT(fleet->floor.reachable_area_m2, 0.0);
+  EXPECT_DOUBLE_EQ(fleet->floor.reachable_area_m2, one->plan.stats.reachable_area_m2);
+  EXPECT_DOUBLE_EQ(fleet->floor.swept_reachable_ratio, one->plan.stats.swept_reachable_ratio);
+  EXPECT_DOUBLE_EQ(fleet->floor.missed_reachable_m2, one->plan.stats.missed_reachable_m2);
 }
 
 class EveryPlanner : public ::testing::TestWithParam<std::string> {};
@@ -80,6 +85,27 @@ TEST_P(EveryPlanner, EveryRobotConformsAndTogetherTheySweepEveryCell) {
       int64_t assigned = 0;
       for (const FleetRobotPlan& rp : fleet->robots) assigned += rp.assigned_cells;
       EXPECT_EQ(assigned, (*whole)->cover_cells) << "every cell belongs to exactly one robot";
+      // The floor the robots sweep together: at least what any one of them
+      // sweeps, at most what they sweep added up, and most of what the tool
+      // can reach (they sweep every cell).
+      absl::StatusOr<std::shared_ptr<const FloorArtifact>> floor =
+          engine.FloorFor(source, f.RobotRequest(0));
+      ASSERT_TRUE(floor.ok()) << floor.status();
+      const FloorMeasure& all = fleet->floor;
+      EXPECT_DOUBLE_EQ(
+          all.reachable_area_m2,
+          MeasureFloor((*floor)->reach, std::vector<Waypoint>{}, false).reachable_area_m2);
+      double most = 0.0, sum = 0.0;
+      for (const FleetRobotPlan& rp : fleet->robots) {
+        const double m =
+            MeasureFloor((*floor)->reach, rp.result.plan.path, false).swept_reachable_m2;
+        most = std::max(most, m);
+        sum += m;
+      }
+      EXPECT_GE(all.swept_reachable_m2, most);
+      EXPECT_LE(all.swept_reachable_m2, sum + 1e-9);
+      EXPECT_GT(all.swept_reachable_ratio, 0.85);
+      EXPECT_NEAR(all.missed_reachable_m2, all.reachable_area_m2 - all.swept_reachable_m2, 1e-9);
     }
   }
 }
