@@ -402,6 +402,7 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
   json.Field("max_replan_ms", JsonNumber(max_ms));
   json.Field("obstacle_cells_found", absl::StrCat(r.obstacles_found.size()));
   json.Field("touch_detections", absl::StrCat(r.num_touch_detections));
+  json.Field("small_obstacles_found", absl::StrCat(r.num_small_obstacles));
   json.Field("truth_cleared_px", absl::StrCat(r.truth_cleared_px));
   json.Field("planned_duration_s", JsonNumber(r.planned_duration_s));
   json.Field("offline_lower_bound_s", JsonNumber(bound.duration_s));

@@ -89,6 +89,7 @@ void SimulatedDrive::Observe(CellIndex c) {
 
 void SimulatedDrive::Sense() {
   for (const CellIndex& c : sensor_.Scan(pos_, candidate_, found_)) Observe(c);
+  SenseCrossings();
 }
 
 template <typename F>
@@ -274,6 +275,8 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   seg_ = 1;
   t_seg_ = d_seg_ = 0.0;
   if (!path().empty()) pos_ = At(path()[0]);
+  FindCrossings();
+  SenseCrossings();
   return absl::OkStatus();
 }
 
@@ -339,6 +342,7 @@ void SimulatedDrive::Start() {
   pos_ = At(path()[0]);
   here_ = grid_.CellAt(pos_);
   r_.driven.push_back(path()[0]);
+  FindCrossings();
   Sense();
 }
 
@@ -406,6 +410,7 @@ absl::StatusOr<bool> SimulatedDrive::Step(double until_s) {
     (candidate_[Index(c)] && !found_[Index(c)] ? touch : violation) = c;
     return true;
   });
+  if (!touch && !violation) touch = TouchCrossing(d_next);
   if (touch) {
     ++r_.num_touch_detections;
     Observe(*touch);
@@ -477,30 +482,6 @@ SimulationResult SimulatedDrive::Finish() {
   r_.path_length_m = s.coverage_length_m + s.transition_length_m;
   r_.swept = swept_;
   return r_;
-}
-
-double LengthInObstacles(const OccupancyMap& map, const std::vector<Waypoint>& path) {
-  const double res = map.resolution();
-  auto blocked = [&](double x, double y) {
-    const int c = static_cast<int>(std::floor(x)), r = static_cast<int>(std::floor(y));
-    return c < 0 || r < 0 || c >= map.width() || r >= map.height() || !map.IsFree(r, c);
-  };
-  constexpr double kNudge = 1e-6;  // pixels
-  double inside = 0.0;
-  for (size_t i = 1; i < path.size(); ++i) {
-    const Point2 a = At(path[i - 1]), b = At(path[i]);
-    const double len = Dist(a, b);
-    const int n = static_cast<int>(std::ceil(len / (res / 4)));
-    for (int k = 0; k < n; ++k) {
-      const Point2 p = Lerp(a, b, (k + 0.5) / n);
-      const double x = (p.x - map.origin().x) / res, y = (p.y - map.origin().y) / res;
-      if (blocked(x - kNudge, y - kNudge) && blocked(x + kNudge, y - kNudge) &&
-          blocked(x - kNudge, y + kNudge) && blocked(x + kNudge, y + kNudge)) {
-        inside += len / n;
-      }
-    }
-  }
-  return inside;
 }
 
 }  // namespace covplan::sim_internal

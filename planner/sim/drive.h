@@ -32,6 +32,7 @@
 #include "planner/grid/grid.h"
 #include "planner/grid/occupancy_map.h"
 #include "planner/replan/replanner.h"
+#include "planner/sim/obstacle_crossings.h"
 #include "planner/sim/sensor.h"
 #include "planner/sim/simulator.h"
 
@@ -45,6 +46,7 @@ class SimulatedDrive {
   SimulatedDrive(const OccupancyMap& truth, const Grid& true_grid, const SimulationOptions& options,
                  RetainedPlan plan, std::vector<uint8_t> candidate, PlanSource* source)
       : source_(source),
+        truth_(truth),
         grid_(true_grid),
         sensor_(truth, true_grid, options.sensor_range_m),
         options_(options),
@@ -83,7 +85,8 @@ class SimulatedDrive {
   SimulationResult Finish();
   // Per cell of the grid: swept by the driven path.
   const std::vector<uint8_t>& swept() const { return swept_; }
-  // Per cell of the grid: found blocked by the sensor (or by touch).
+  // Per cell of the grid: found blocked by the sensor (or by touch), or
+  // reported for furniture smaller than the cell on the path.
   const std::vector<uint8_t>& found() const { return found_; }
 
  private:
@@ -91,6 +94,22 @@ class SimulatedDrive {
   int64_t Index(CellIndex c) const { return grid_.Index(c.row, c.col); }
   void Observe(CellIndex c);
   void Sense();
+  // Obstacles smaller than their cells (drive_crossings.cc). The path's
+  // entries into them (obstacle_crossings.h), found after each plan.
+  void FindCrossings();
+  // A crossing ahead on the path, in a cell not reported yet (nor found
+  // to strand the robot since the last plan).
+  bool Ahead(const PathCrossing& x) const;
+  // Closing the crossing's cell would cut the robot off from cells it has
+  // still to sweep (its own cell: from the neighbour the replanner takes
+  // it out to): it does not report it and drives through
+  // (length_in_obstacles_m says how far). Remembered until the next plan.
+  bool Strands(const PathCrossing& x);
+  // Reports the crossings ahead the sensor sees.
+  void SenseCrossings();
+  // The cell of a crossing ahead on the current segment before `d` metres
+  // into it (the bumper found it), counted; none when there is none.
+  std::optional<CellIndex> TouchCrossing(double d);
   // Calls f(sample) along the path still to drive until it returns true.
   template <typename F>
   bool ScanRemaining(F f) const;
@@ -111,6 +130,7 @@ class SimulatedDrive {
   std::optional<std::string> CrossesReported(const std::vector<Waypoint>& path) const;
 
   PlanSource* const source_;
+  const OccupancyMap& truth_;
   const Grid& grid_;  // the true grid (same frame as the plan's grid)
   const RangeSensor sensor_;
   const SimulationOptions& options_;
@@ -119,11 +139,13 @@ class SimulatedDrive {
   const ReplanMethod method_;
   RetainedPlan plan_;
   std::vector<uint8_t> candidate_;     // free on the planned drive grid, blocked on the true one
-  std::vector<uint8_t> found_;         // candidates the robot has found
+  std::vector<uint8_t> found_;         // cells the robot has found (candidates, small furniture)
   std::vector<uint8_t> pending_flag_;  // found, not yet given to a replan
   std::vector<uint8_t> reported_;      // given to a replan
   std::vector<CellIndex> pending_;
-  bool pending_checked_ = true;  // no pending cell added since PendingOnPath() said no
+  std::vector<PathCrossing> crossings_;  // of the current path, in path order
+  std::vector<uint8_t> stranding_;       // per cell: closing it would cut the robot off
+  bool pending_checked_ = true;          // no pending cell added since PendingOnPath() said no
   std::vector<uint8_t> swept_;
   std::vector<int> sweep_of_;         // per waypoint: index into plan.sweeps or -1
   int seg_ = 1;                       // segment path[seg_-1] -> path[seg_] being driven
@@ -143,10 +165,6 @@ class SimulatedDrive {
   int violations_ = 0;
   SimulationResult r_;
 };
-
-// Length of `path` inside the interior of the non-free pixels of `map`
-// (sampled every quarter pixel; faces and corners may be touched).
-double LengthInObstacles(const OccupancyMap& map, const std::vector<Waypoint>& path);
 
 }  // namespace covplan::sim_internal
 

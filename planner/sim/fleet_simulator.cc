@@ -15,6 +15,7 @@
 #include "planner/sim/clutter.h"
 #include "planner/sim/drive.h"
 #include "planner/sim/map_frame.h"
+#include "planner/sim/obstacle_crossings.h"
 #include "planner/sim/run_setup.h"
 #include "planner/tour/grid_paths.h"
 
@@ -324,15 +325,25 @@ void FleetRun::Measure() {
   // Reachable: the mission's cells free on the true grid, in a component
   // that holds a robot's start, as the robots' cell model moves: the true
   // grid's free cells with the known map's walls (new obstacles are blocked
-  // cells to it, whatever they touch).
+  // cells to it, whatever they touch), less the cells a robot reported for
+  // furniture smaller than the cell (a redivision draws that furniture into
+  // the known map, where the grid keeps the cell free with barriers, so the
+  // survivors may still sweep it; it is not counted as owed).
   std::vector<Point2> starts;
   for (const FleetRobotPlan& rp : r.initial.robots) {
     if (rp.result.plan.path.empty()) continue;
     starts.push_back({rp.result.plan.path.front().x, rp.result.plan.path.front().y});
   }
+  std::vector<uint8_t> closed(r.swept.size(), 0);
+  for (const auto& s : robots_) {
+    for (const FleetLeg& leg : s->run.legs) {
+      for (const CellIndex& c : leg.run.obstacles_found) closed[site_.grid.Index(c.row, c.col)] = 1;
+    }
+  }
   const Grid model = sim_internal::ReachableModel(site_, *mission_->drive, starts);
-  for (size_t c = 0; c < model.free_flags().size(); ++c) {
-    if (!mission_->cover->free_flags()[c] || !model.free_flags()[c]) continue;
+  const Grid cells = sim_internal::ReachableModel(site_, *mission_->drive, starts, &closed);
+  for (size_t c = 0; c < cells.free_flags().size(); ++c) {
+    if (!mission_->cover->free_flags()[c] || !cells.free_flags()[c]) continue;
     ++r.reachable_cells;
     if (r.swept[c]) continue;
     ++r.unswept_reachable_cells;

@@ -109,7 +109,8 @@ struct FleetSimulationResult {
   int64_t swept_cells = 0;    // distinct cells any robot swept
   // Free cells of the true grid among the mission's, connected to a robot's
   // start over such cells through the known map's walls (the robots' cell
-  // model), and of these the ones nobody swept (0 when all went well).
+  // model) but for the cells a robot reported for an obstacle smaller than
+  // the cell, and of these the ones nobody swept (0 when all went well).
   int64_t reachable_cells = 0;
   int64_t unswept_reachable_cells = 0;
   std::vector<CellIndex> unswept_reachable;  // those cells

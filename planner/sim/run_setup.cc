@@ -52,10 +52,12 @@ double CoveredFreeAreaRatio(const TrueSite& site, const std::vector<uint8_t>& sw
   return true_free > 0 ? swept_free_px / true_free : 0.0;
 }
 
-Grid ReachableModel(const TrueSite& site, const Grid& drive, const std::vector<Point2>& starts) {
+Grid ReachableModel(const TrueSite& site, const Grid& drive, const std::vector<Point2>& starts,
+                    const std::vector<uint8_t>* closed) {
   std::vector<uint8_t> free(drive.free_flags().begin(), drive.free_flags().end());
   for (size_t c = 0; c < free.size() && c < site.grid.free_flags().size(); ++c) {
     free[c] = free[c] && site.grid.free_flags()[c];
+    if (closed != nullptr && c < closed->size() && (*closed)[c]) free[c] = 0;
   }
   const Grid both = drive.WithFreeFlags(free);
   int32_t num = 0;

@@ -52,10 +52,13 @@ absl::StatusOr<std::vector<uint8_t>> Candidates(const Grid& drive, const Grid& t
 double CoveredFreeAreaRatio(const TrueSite& site, const std::vector<uint8_t>& swept);
 
 // The robots' cell model of the true site: the cells free on both `drive`
-// (the robots' part of the known map, with its walls) and the true grid that
-// lie in a component holding one of `starts`. What a robot can get to as
-// the replanner moves it (new obstacles are blocked cells to it).
-Grid ReachableModel(const TrueSite& site, const Grid& drive, const std::vector<Point2>& starts);
+// (the robots' part of the known map, with its walls) and the true grid,
+// and not flagged in `closed` (when given: per cell, reported by a robot for
+// an obstacle smaller than the cell), that lie in a component holding one of
+// `starts`. What a robot can get to as the replanner moves it (new obstacles
+// are blocked cells to it).
+Grid ReachableModel(const TrueSite& site, const Grid& drive, const std::vector<Point2>& starts,
+                    const std::vector<uint8_t>* closed = nullptr);
 
 // The floor a tool disc can reach on the true map from the free cells of
 // `model` (a ReachableModel; floor_measure.h), outside `no_go` and inside

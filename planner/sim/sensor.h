@@ -1,7 +1,8 @@
 // The simulated robot's sensor (internal to planner/sim): a radial range
 // sensor with line of sight over the true map's pixels. It finds the
 // candidate cells (free on the grid the plan was made on, blocked on the true
-// grid) whose centre lies within range and in sight of the robot.
+// grid) whose centre lies within range and in sight of the robot, and tells
+// whether a point on an obstacle's border is in range and in sight.
 //
 //   RangeSensor sensor(truth, true_grid, options.sensor_range_m);
 //   for (const CellIndex& c : sensor.Scan(position, candidate, found)) Observe(c);
@@ -29,9 +30,17 @@ class RangeSensor {
   // grid) that the robot at `position` sees, row by row from the bottom.
   std::vector<CellIndex> Scan(Point2 position, const std::vector<uint8_t>& candidate,
                               const std::vector<uint8_t>& found) const;
+  // The robot at `from` sees the point `to` (a point on an obstacle's
+  // border): within range, no non-free pixel between them but the one `to`
+  // lies in.
+  bool Sees(Point2 from, Point2 to) const;
 
  private:
   bool Visible(Point2 from, CellIndex target) const;
+  // No non-free pixel on the line from `from` to `to` (the pixel of `from`
+  // left out) but those whose centre `may_block` accepts.
+  template <typename F>
+  bool LineOfSight(Point2 from, Point2 to, F may_block) const;
 
   const OccupancyMap& truth_;
   const Grid& grid_;

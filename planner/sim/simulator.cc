@@ -13,6 +13,7 @@
 #include "planner/sim/clutter.h"
 #include "planner/sim/drive.h"
 #include "planner/sim/map_frame.h"
+#include "planner/sim/obstacle_crossings.h"
 #include "planner/sim/run_setup.h"
 
 namespace covplan {

@@ -1,7 +1,9 @@
 // The replanning simulator (thesis §4.6): plan OARP on the map the robot
 // knows, then drive that plan under the robot model through the map as it
 // really is. A radial range sensor with line of sight reports the cells the
-// known map called free that are in fact blocked; when they cut the path
+// known map called free that are in fact blocked, and the cells whose
+// furniture, too small to block the cell, the path ahead runs into (unless
+// closing such a cell would cut the robot off); when they cut the path
 // still to drive, OARP-Replan (planner/replan) gives a new plan from where
 // the robot is, and the robot drives on along it. The replan's compute time
 // beyond what the robot still drives before it meets the obstacle is
@@ -97,20 +99,26 @@ struct SimulationResult {
   double covered_free_area_ratio = 0.0;
   double planned_duration_s = 0.0;          // the initial plan's estimated duration
   std::vector<Waypoint> driven;             // the path actually driven
-  std::vector<CellIndex> obstacles_found;   // cells found blocked, in order
+  std::vector<CellIndex> obstacles_found;   // cells found blocked or reported, in order
   std::vector<double> replan_ms;            // compute time of each replan
   std::vector<Point2> replan_points;        // where each replan started
   std::vector<std::string> replan_methods;  // ReplanStats::method of each
-  // Length of the driven path inside non-free pixels of the true map. The
-  // replanner takes new obstacles as blocked cells only: obstacles smaller
-  // than half a cell (chair legs, clutter corners) leave their cells free,
-  // and the robot drives through them as through the known map's free cells.
-  // A measure of how optimistic the cell model is; an offline plan of the
-  // true map keeps this at 0.
+  // Length of the driven path inside non-free pixels of the true map. An
+  // obstacle smaller than half a cell (a chair leg, a post) leaves its cell
+  // free on the true grid; the robot finds one on its path by sight or by
+  // touch and reports its cell (num_small_obstacles) unless closing the
+  // cell would cut it off from cells it has still to sweep; what is left is
+  // those obstacles, the way out of a reported cell the robot stood in, and
+  // paths that touch a reported cell's corner. An offline plan of the true
+  // map keeps this at 0.
   double length_in_obstacles_m = 0.0;
   // Cells found by touch rather than sight: the next step would have
-  // entered them while the sensor could not see their centre.
+  // entered them (or, for a small obstacle, the obstacle in them) while the
+  // sensor could not see them.
   int num_touch_detections = 0;
+  // Cells free on the true grid reported for an obstacle smaller than the
+  // cell on the path ahead (by sight or touch).
+  int num_small_obstacles = 0;
   // Nothing can stand where the robot starts (it is there) or on its dock:
   // the true map is taken as the known one within a tool width of the
   // plan's start and end poses. truth_cleared_px counts the pixels that

@@ -4,7 +4,8 @@
 # (`covplan simulate --true-map`, AUTO replanning, the thesis robot and
 # sensor), then measure on the furnished map's pixels the area the tool can
 # reach, the share of it the driven path swept, the offline plan's share
-# (OARP planned on the furnished map), and how far the robot drove through
+# (OARP planned on the furnished map), the cells the robot reported for
+# furniture smaller than a cell, and how far it still drove through
 # furniture (length_in_obstacles_m, issue 32's item 5). The maps are read in
 # place, never copied.
 #   bash scripts/bench/floor_driven.sh     # TOOL=0.8 JOBS=2 IPA_DIR=../shared/data/maps/ipa
@@ -29,15 +30,15 @@ run() {  # one plain map's name
 export -f run
 maps=$(for f in "$IPA"/*_furnitures.png; do basename "$f" _furnitures.png; done)
 printf '%s\n' $maps | xargs -P "$JOBS" -I{} bash -c 'run {}'
-echo "| map | reachable m² (furnished) | driven: swept of reachable | missed m² | offline plan: swept of reachable | in obstacles m | of the driven path |"
-echo "|---|---:|---:|---:|---:|---:|---:|"
+echo "| map | reachable m² (furnished) | driven: swept of reachable | missed m² | offline plan: swept of reachable | small obstacles reported | in obstacles m | of the driven path |"
+echo "|---|---:|---:|---:|---:|---:|---:|---:|"
 for m in $maps; do
   /usr/bin/python3 - "$m" "$out/$m.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[2]))
-print("| %s | %.1f | %.2f %% | %.1f | %.2f %% | %.1f | %.2f %% |" % (
+print("| %s | %.1f | %.2f %% | %.1f | %.2f %% | %d | %.1f | %.2f %% |" % (
     sys.argv[1], r["reachable_area_m2"], 100 * r["swept_reachable_ratio"], r["missed_reachable_m2"],
-    100 * r["offline_swept_reachable_ratio"], r["length_in_obstacles_m"],
+    100 * r["offline_swept_reachable_ratio"], r["small_obstacles_found"], r["length_in_obstacles_m"],
     100 * r["length_in_obstacles_m"] / r["path_length_m"]))
 PY
 done

@@ -1,5 +1,6 @@
-// Test helper of the simulator tests: the true map's grid and a check that a
-// driven path never enters a cell it blocks.
+// Test helper of the simulator tests: the true map's grid, a check that a
+// driven path never enters a cell it blocks, and whether a cell holds an
+// obstacle pixel.
 // Thread-safety: stateless.
 #ifndef COVPLAN_TESTS_SIM_SIM_CHECKS_H_
 #define COVPLAN_TESTS_SIM_SIM_CHECKS_H_
@@ -51,6 +52,20 @@ inline std::string FirstBlockedPoint(const Grid& grid, const std::vector<Waypoin
     }
   }
   return "";
+}
+
+// A pixel of `truth` whose centre lies in `cell` of `grid` is not free:
+// the cell holds an obstacle, however small.
+inline bool CellHoldsObstacle(const OccupancyMap& truth, const Grid& grid, CellIndex cell) {
+  const double res = truth.resolution();
+  for (int r = 0; r < truth.height(); ++r) {
+    const double y = truth.origin().y + (r + 0.5) * res;
+    for (int c = 0; c < truth.width(); ++c) {
+      const Point2 p{truth.origin().x + (c + 0.5) * res, y};
+      if (!truth.IsFree(r, c) && grid.CellAt(p) == cell) return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace covplan::testing

@@ -77,7 +77,16 @@ TEST_P(EveryReplanMethod,
   // Never into furniture.
   const Grid true_grid = TrueGrid(truth);
   EXPECT_EQ(FirstBlockedPoint(true_grid, r->driven), "");
-  for (const CellIndex& c : r->obstacles_found) EXPECT_FALSE(true_grid.IsFree(c));
+  // Nor through an obstacle smaller than its cell: the robot reports the
+  // cell of one it meets (sight or touch), so every cell it reports holds
+  // an obstacle, and it drives less than 0.1 % of its path through them
+  // (issue 32's target; 0 m on this office).
+  for (const CellIndex& c : r->obstacles_found) {
+    EXPECT_TRUE(!true_grid.IsFree(c) || testing::CellHoldsObstacle(truth, true_grid, c))
+        << "cell (" << c.row << ", " << c.col << ") holds no obstacle";
+  }
+  EXPECT_GT(r->num_small_obstacles, 0);
+  EXPECT_LE(r->length_in_obstacles_m, 0.001 * r->path_length_m);
   // Time accounting.
   EXPECT_NEAR(r->total_time_s, r->drive_time_s + r->stoppage_s, 1e-9 * r->total_time_s);
   const PlanStats driven = ComputePathStats(r->driven, o.plan.robot);
@@ -304,10 +313,13 @@ TEST(Simulate, TenPercentClutterIsDrivenAroundByAuto) {
 }
 
 // Clutter dropped onto the parked robot: the true map blocks the cells
-// around the plan's start. The robot is there, so nothing is: the run takes
-// the true map as the known one within a tool width of the start (and end)
-// pose, says how many pixels that freed, and drives the rest as usual,
-// never entering a cell it reported blocked.
+// around the plan's start but for a corridor along the robot's row (a ring
+// of clutter all round would wall it in: the robot finds the clutter on its
+// path and reports those cells). The robot is there, so nothing is: the
+// run takes the true map as the known one within a tool width of the start
+// (and end) pose, says how many pixels that freed, and drives the rest as
+// usual, never entering a cell it reported blocked nor driving through the
+// clutter.
 TEST(Simulate, ClutterOnTheStartPoseIsTakenOffAndTheRunGoesOn) {
   const OccupancyMap office = Load("sample_office.yaml");
   SimulationOptions o = Options(ReplanMethod::kAuto);
@@ -321,7 +333,8 @@ TEST(Simulate, ClutterOnTheStartPoseIsTakenOffAndTheRunGoesOn) {
   for (int r = 0; r < office.height(); ++r) {
     for (int c = 0; c < office.width(); ++c) {
       const double x = office.origin().x + (c + 0.5) * res, y = office.origin().y + (r + 0.5) * res;
-      if (std::abs(x - start.x) <= 1.0 && std::abs(y - start.y) <= 1.0 && office.IsFree(r, c)) {
+      if (std::abs(x - start.x) <= 1.0 && std::abs(y - start.y) <= 1.0 &&
+          std::abs(y - start.y) > 0.3 && office.IsFree(r, c)) {
         truth.set(r, c, CellState::kOccupied);
         ++blocked;
       }
@@ -337,6 +350,7 @@ TEST(Simulate, ClutterOnTheStartPoseIsTakenOffAndTheRunGoesOn) {
   EXPECT_THAT(r->problems, ::testing::IsEmpty());
   EXPECT_GT(r->covered_free_area_ratio, 0.8);
   EXPECT_EQ(FirstBlockedPoint(TrueGrid(*r->truth_used), r->driven), "");
+  EXPECT_LE(r->length_in_obstacles_m, 0.001 * r->path_length_m);
 }
 
 // A number after "key": in the JSON text.
