@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <random>
+#include <utility>
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/string_view.h"
@@ -60,8 +61,10 @@ CallInfo CallGate::Begin(grpc::CallbackServerContext* context, const char* metho
     absl::StatusOr<std::string> tenant = tokens_->Authenticate(authorization);
     if (tenant.ok()) {
       call.tenant_tag = TenantTag(*tenant);
+      call.tenant = *std::move(tenant);
     } else {
       call.auth = tenant.status();
+      call.tenant = "unauthenticated";
     }
   }
   return call;
@@ -101,10 +104,11 @@ void CallGate::Finish(grpc::ServerUnaryReactor* reactor, const CallInfo& call,
 void CallGate::Record(const CallInfo& call, const absl::Status& status, const std::string& detail) {
   const absl::Time now = absl::Now();
   const double seconds = absl::ToDoubleSeconds(now - call.start);
-  metrics_->RecordRequest(call.method, CodeName(status), seconds);
+  metrics_->RecordRequest(call.method, CodeName(status), seconds, call.tenant);
   const bool late = now > call.deadline;
   LogLine(status.ok() ? "info" : "warn", "request finished",
           {{"req", call.request_id},
+           {"tenant", call.tenant.empty() ? "-" : call.tenant},
            {"method", call.method},
            {"code", CodeName(status)},
            {"ms", absl::StrFormat("%.1f", seconds * 1e3)},

@@ -23,6 +23,10 @@ struct CallInfo {
   // With --token_file: the caller's tenant tag (server/tenant_tokens.h), or
   // `auth` says why the call is refused. Empty tag and OK without one.
   std::string tenant_tag;
+  // With --token_file: the caller's tenant, "unauthenticated" when `auth`
+  // refuses the call; a field of the call's log line and a label of its
+  // request metrics. Empty without a token file.
+  std::string tenant;
   absl::Status auth;
 };
 

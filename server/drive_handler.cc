@@ -56,7 +56,8 @@ grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* DriveHandler::Drive(
                         options_.max_sessions)));
   }
   UpdateSessionGauge();
-  LogLine("info", "drive session started", {{"request_id", call.request_id}});
+  LogLine("info", "drive session started",
+          {{"request_id", call.request_id}, {"tenant", call.tenant.empty() ? "-" : call.tenant}});
   session->Start();
   return session;
 }

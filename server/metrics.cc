@@ -105,9 +105,15 @@ void ServerMetrics::SetReplanEstimator(double a, double b, double c, int64_t sam
 }
 
 void ServerMetrics::RecordRequest(const std::string& method, const std::string& code,
-                                  double seconds) {
-  requests_->Add({{"method", method}, {"code", code}}).Increment();
-  request_duration_->Add({{"method", method}}, LatencyBuckets()).Observe(seconds);
+                                  double seconds, const std::string& tenant) {
+  if (tenant.empty()) {
+    requests_->Add({{"method", method}, {"code", code}}).Increment();
+    request_duration_->Add({{"method", method}}, LatencyBuckets()).Observe(seconds);
+    return;
+  }
+  requests_->Add({{"method", method}, {"code", code}, {"tenant", tenant}}).Increment();
+  request_duration_->Add({{"method", method}, {"tenant", tenant}}, LatencyBuckets())
+      .Observe(seconds);
 }
 
 void ServerMetrics::RecordSolve(double seconds, bool cut_short) {

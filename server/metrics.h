@@ -39,7 +39,11 @@ class ServerMetrics : public CacheObserver {
   std::shared_ptr<prometheus::Registry> registry() const { return registry_; }
 
   // `code` is the gRPC status code name, e.g. "OK", "INVALID_ARGUMENT".
-  void RecordRequest(const std::string& method, const std::string& code, double seconds);
+  // `tenant` (with --token_file: the caller's tenant, "unauthenticated"
+  // for a call without a valid token; a set bounded by the token file)
+  // labels the call's series; without one they carry no tenant label.
+  void RecordRequest(const std::string& method, const std::string& code, double seconds,
+                     const std::string& tenant = "");
   void RecordSolve(double seconds, bool cut_short);
   // `source` is PlanOriginName: "cold", "cache_hit", "improved", "warm_start".
   void RecordPlanSource(const std::string& source);

@@ -3,7 +3,8 @@
 // reflection stay open; a tenant sees only its own maps and plans, and
 // another tenant's id answers exactly like an id that does not exist; SIGHUP
 // rereads the token file; the `covplan` CLI reaches a TLS + token server
-// with --tls-ca and --token / --token-file.
+// with --tls-ca and --token / --token-file; the tenant labels the request
+// metrics and the log lines.
 #include <grpcpp/grpcpp.h>
 #include <signal.h>
 
@@ -30,6 +31,7 @@ namespace {
 
 using ::covplan::testing::AsciiToPgm;
 using ::covplan::testing::HealthStatus;
+using ::covplan::testing::HttpGet;
 using ::covplan::testing::PlanRequestFor;
 using ::covplan::testing::RasterMap;
 using ::covplan::testing::ReflectionServices;
@@ -281,6 +283,40 @@ TEST_F(ServerAuthTest, ListMapsPagesOverOnlyTheCallersMaps) {
   } while (!page_token.empty());
   EXPECT_EQ(seen, alpha_maps);
   EXPECT_EQ(pages, 2);
+}
+
+// The caller's tenant labels its call's request metrics and is a field of
+// the call's log line; a call without a valid token is "unauthenticated".
+TEST_F(ServerAuthTest, TheTenantLabelsTheRequestMetricsAndTheLogLine) {
+  StartServer({"--metrics_port=0"});
+  v1::PutMapResponse put;
+  ASSERT_TRUE(PutMap(kAlpha, &put).ok());
+  std::vector<std::string> ids;
+  ASSERT_TRUE(ListMaps(kBeta, &ids).ok());
+  ASSERT_EQ(ListMaps("", &ids).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  absl::StatusOr<std::string> metrics = HttpGet(server_->metrics_port(), "/metrics");
+  ASSERT_TRUE(metrics.ok()) << metrics.status();
+  for (
+      const char* series : {
+          R"(covplan_requests_total{code="OK",method="PutMap",tenant="alpha"} 1)",
+          R"(covplan_requests_total{code="OK",method="ListMaps",tenant="beta"} 1)",
+          R"(covplan_requests_total{code="UNAUTHENTICATED",method="ListMaps",tenant="unauthenticated"} 1)",
+          R"(covplan_request_duration_seconds_count{method="PutMap",tenant="alpha"} 1)",
+      }) {
+    EXPECT_NE(metrics->find(series), std::string::npos) << series << " missing from\n" << *metrics;
+  }
+  EXPECT_EQ(metrics->find(R"(tenant="")"), std::string::npos);
+  // The log lines of the three calls, each with its tenant.
+  std::set<std::string> seen;
+  std::istringstream log(server_->log());
+  for (std::string line; std::getline(log, line);) {
+    if (line.find("msg=\"request finished\"") == std::string::npos) continue;
+    for (const char* tenant : {"alpha", "beta", "unauthenticated"}) {
+      if (line.find(absl::StrCat(" tenant=", tenant, " ")) != std::string::npos)
+        seen.insert(tenant);
+    }
+  }
+  EXPECT_EQ(seen, (std::set<std::string>{"alpha", "beta", "unauthenticated"})) << server_->log();
 }
 
 TEST_F(ServerAuthTest, SighupRereadsTheTokenFile) {
