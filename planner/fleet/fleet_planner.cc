@@ -294,7 +294,16 @@ absl::StatusOr<FleetPlan> PlanFleet(const PlanningEngine& engine, const MapSourc
         MakespanLowerBound(units, request.robots, best.robots[0].result.area->drive.get()).value();
     best.termination = best.robots[0].result.plan.termination;
     FillFleetFigures(request, best.robots[0].assigned_cells, &best);
-    RETURN_IF_ERROR(MeasureFleetFloor(engine, source, request, &best));
+    // The plan measured its floor on the site's floor artifact already.
+    const PlanStats& s = best.robots[0].result.plan.stats;
+    if (request.cover_mask.empty() && s.reachable_area_m2 > 0.0) {
+      best.floor.reachable_area_m2 = s.reachable_area_m2;
+      best.floor.missed_reachable_m2 = s.missed_reachable_m2;
+      best.floor.swept_reachable_m2 = s.reachable_area_m2 - s.missed_reachable_m2;
+      best.floor.swept_reachable_ratio = s.swept_reachable_ratio;
+    } else {
+      RETURN_IF_ERROR(MeasureFleetFloor(engine, source, request, &best));
+    }
     best.planning_ms = Seconds(t0) * 1e3;
     return best;
   }
