@@ -35,9 +35,14 @@ bool SimulatedDrive::Strands(const PathCrossing& x) {
   int32_t n = 0;
   const std::vector<int32_t> comp = FreeComponents(closed, &n);
   // The robot joins the closed grid where the replanner would put it: in
-  // its own cell, or (that cell closed) the free neighbour JoinCell picks.
-  const absl::StatusOr<CellIndex> at = JoinCell(closed, Pose2{pos_.x, pos_.y, 0.0}, "robot");
-  const int32_t robot = at.ok() ? comp[closed.Index(at->row, at->col)] : -1;
+  // its own cell, or (that cell closed) the free neighbour JoinCell picks,
+  // which it must reach without crossing another closed cell (a neighbour
+  // only diagonally reachable past two closed cells does not count: the
+  // way out would clip a reported cell).
+  const Pose2 robot_pose{pos_.x, pos_.y, 0.0};
+  const absl::StatusOr<CellIndex> at = JoinCell(closed, robot_pose, "robot");
+  const int32_t robot =
+      at.ok() && ClearJoin(closed, robot_pose, *at) ? comp[closed.Index(at->row, at->col)] : -1;
   if (robot < 0) return stranding_[cell] = 1, true;
   for (const CoverageSweep& s : plan_.plan.sweeps) {
     if (s.waypoint < seg_) continue;

@@ -406,13 +406,16 @@ absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& p, const char*
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [d2, n] : candidates) {
-    // Only the pose's own cell may be blocked on the way.
-    const bool clear = !SegmentTouches(grid, {p.x, p.y}, grid.CellCenter(n), [&](int r, int col) {
-      return !(r == c.row && col == c.col) && !grid.IsFree(r, col);
-    });
-    if (clear) return n;
+    if (ClearJoin(grid, p, n)) return n;
   }
   return candidates.front().second;
+}
+
+bool ClearJoin(const Grid& grid, const Pose2& p, CellIndex cell) {
+  const CellIndex own = grid.CellAt({p.x, p.y});
+  return !SegmentTouches(grid, {p.x, p.y}, grid.CellCenter(cell), [&](int r, int col) {
+    return !(r == own.row && col == own.col) && !grid.IsFree(r, col);
+  });
 }
 
 }  // namespace covplan

@@ -55,6 +55,11 @@ bool SegmentTouches(const Grid& frame, Point2 a, Point2 b,
 // names the pose in the InvalidArgument error ("start", "end").
 absl::StatusOr<CellIndex> JoinCell(const Grid& grid, const Pose2& pose, const char* what);
 
+// Whether the straight move from `pose` to the centre of `cell` touches no
+// blocked cell but the pose's own (JoinCell's test of an adjacent cell; its
+// last resort, the nearest adjacent free cell, may fail it).
+bool ClearJoin(const Grid& grid, const Pose2& pose, CellIndex cell);
+
 // The moves the drive searches allow from a cell, as bit k of a mask for
 // the step (kDriveDr[k], kDriveDc[k]): 4-neighbours (k < 4) through passable
 // boundaries, and diagonals (k >= 4) whose two L-shaped routes are open (no
