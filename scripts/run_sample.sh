@@ -3,7 +3,8 @@
 # embedded defaults (on-disk map store under ./covplan-data, no external
 # services), plan the shipped sample map through the server, print the
 # figures and write plan.json and plan.svg; then plan the shipped office for
-# a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg.
+# a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg;
+# last, list the stored maps over the JSON API (--http_port).
 #   scripts/run_sample.sh [MAP] [extra `covplan plan` flags...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,9 +19,10 @@ cmake --build build -j"$(nproc)" --target covplan-server covplan
 free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
 PORT=${PORT:-$(free_port)}
 METRICS_PORT=${METRICS_PORT:-$(free_port)}
+HTTP_PORT=${HTTP_PORT:-$(free_port)}
 LOG=$(mktemp -t covplan-server.XXXXXX.log)
 ./build/bin/covplan-server --port "$PORT" --metrics_port "$METRICS_PORT" \
-  --store_dir ./covplan-data/maps 2>"$LOG" &
+  --http_port "$HTTP_PORT" --store_dir ./covplan-data/maps 2>"$LOG" &
 SERVER=$!
 cleanup() { kill -TERM "$SERVER" 2>/dev/null || true; wait "$SERVER" 2>/dev/null || true; }
 trap cleanup EXIT
@@ -32,6 +34,7 @@ for _ in $(seq 1 100); do
   sleep 0.1
 done
 echo "covplan-server on 127.0.0.1:$PORT (metrics on :$METRICS_PORT, log $LOG)"
+echo "JSON API on http://127.0.0.1:$HTTP_PORT/v1/<Method> (docs/json_api.md); console http://127.0.0.1:$HTTP_PORT/"
 
 ./build/bin/covplan plan --map "$MAP" --server "127.0.0.1:$PORT" \
   --out "$OUT_DIR/plan.json" --svg "$OUT_DIR/plan.svg" "$@"
@@ -45,3 +48,9 @@ if [ "${FLEET:-1}" = 1 ]; then
     --out "$OUT_DIR/fleet.json" --svg "$OUT_DIR/fleet.svg"
   echo "wrote $OUT_DIR/fleet.json and $OUT_DIR/fleet.svg"
 fi
+
+# The same server over its JSON API: the maps stored so far.
+echo "curl -X POST http://127.0.0.1:$HTTP_PORT/v1/ListMaps -d '{}':"
+curl -sS --max-time 10 -H 'Content-Type: application/json' -X POST \
+  "http://127.0.0.1:$HTTP_PORT/v1/ListMaps" -d '{}' |
+  /usr/bin/python3 -c 'import json,sys; m=json.load(sys.stdin)["maps"]; print(f"  {len(m)} maps:", ", ".join(x["mapId"][:12] + " " + x.get("name","") for x in m))'

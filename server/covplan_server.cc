@@ -93,6 +93,11 @@ absl::StatusOr<std::unique_ptr<MapRepository>> OpenMapStore(const ServerConfig& 
 
 absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const ServerConfig& config) {
   if (absl::Status s = config.service.Validate(); !s.ok()) return s;
+  if (config.http_port >= 0 && !config.tls_cert_file.empty()) {
+    return absl::InvalidArgumentError(
+        "--http_port: the JSON API does not serve TLS yet; with --tls_cert set, leave it off and "
+        "call the gRPC port");
+  }
   std::unique_ptr<CovplanServer> server(new CovplanServer());
   server->drain_notice_ = config.drain_notice;
   absl::StatusOr<std::unique_ptr<MapRepository>> store = OpenMapStore(config);
@@ -152,6 +157,21 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
     return absl::UnavailableError(
         absl::StrCat("cannot listen on ", address, " (port in use or bad address)"));
   }
+  if (config.http_port >= 0) {
+    HttpGatewayOptions http;
+    http.address = config.http_address;
+    http.port = config.http_port;
+    // bytes fields travel as base64 in JSON: 4/3 of gRPC's limit, and some.
+    http.max_body_bytes = int64_t{config.max_message_bytes} * 4 / 3 + (1 << 20);
+    http.request_timeout_ms = config.http_request_timeout_ms;
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(config.max_message_bytes);
+    args.SetMaxSendMessageSize(config.max_message_bytes);
+    absl::StatusOr<std::unique_ptr<HttpGateway>> gateway =
+        HttpGateway::Start(http, server->server_->InProcessChannel(args));
+    if (!gateway.ok()) return gateway.status();  // ~CovplanServer stops gRPC
+    server->http_ = std::move(*gateway);
+  }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
   const bool indexed = !server->store_->loading();
   health->SetServingStatus(indexed);
@@ -183,6 +203,7 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   LogLine("info", "covplan-server started",
           {{"address", absl::StrCat(config.address, ":", server->port_)},
            {"metrics_port", absl::StrCat(server->metrics_port_)},
+           {"http_port", absl::StrCat(server->http_port())},
            {"store_dir", config.store_dir},
            {"maps", absl::StrCat(server->store_->size())},
            {"workers", absl::StrCat(config.service.worker_threads)},
@@ -267,11 +288,16 @@ void CovplanServer::Drain(absl::Duration grace) {
       }
     }
     // Cancels what is left (streams, calls that did not reply in time), after
-    // a moment for the replies just sent to leave.
+    // a moment for the replies just sent to leave. The JSON API starts no
+    // call from here on.
+    if (http_ != nullptr) http_->StopCalls();
     server_->Shutdown(absl::ToChronoTime(absl::Now() + kDrainFlushBound));
     LogLine("info", "gRPC server shut down",
             {{"ms", absl::StrCat(absl::ToInt64Milliseconds(absl::Now() - start))}});
   }
+  // After the gRPC server: the JSON API's calls in flight are its calls,
+  // answered or cancelled by now, so the HTTP handlers return.
+  http_.reset();
   if (service_ != nullptr) service_->Shutdown();
   exposer_.reset();
   if (server_ != nullptr) {

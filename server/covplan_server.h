@@ -21,6 +21,7 @@
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "server/http_gateway.h"
 #include "server/service.h"
 
 namespace grpc {
@@ -64,6 +65,12 @@ struct ServerConfig {
   // CoveragePlanner call needs a token of a tenant (health and reflection
   // stay open) and sees only that tenant's maps and plans. Empty: open.
   std::string token_file;
+  // The JSON API (server/http_gateway.h): -1 off (the default), 0 picks a
+  // free port.
+  std::string http_address = "127.0.0.1";
+  int http_port = -1;
+  // A client slower than this to send its request is cut off.
+  int http_request_timeout_ms = 15000;
   ServiceOptions service;
 };
 
@@ -80,6 +87,7 @@ class CovplanServer {
 
   int port() const { return port_; }
   int metrics_port() const { return metrics_port_; }
+  int http_port() const { return http_ != nullptr ? http_->port() : -1; }
   CoveragePlannerService& service() { return *service_; }
 
   // Reports NOT_SERVING and refuses new work (for the configured drain
@@ -106,6 +114,7 @@ class CovplanServer {
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<prometheus::Exposer> exposer_;
+  std::unique_ptr<HttpGateway> http_;                         // null without an HTTP port
   std::shared_ptr<prometheus::Collectable> process_metrics_;  // registered weakly
   absl::Duration drain_notice_;
   int port_ = 0;

@@ -36,6 +36,9 @@ ABSL_FLAG(std::string, address, "127.0.0.1", "Address to listen on (0.0.0.0 for 
 ABSL_FLAG(int, port, 50051, "gRPC port (0 picks a free one)");
 ABSL_FLAG(std::string, metrics_address, "127.0.0.1", "Address of the /metrics endpoint");
 ABSL_FLAG(int, metrics_port, 9464, "Prometheus /metrics port (0 picks, -1 disables)");
+ABSL_FLAG(std::string, http_address, "127.0.0.1", "Address of the JSON API (HTTP)");
+ABSL_FLAG(int, http_port, -1,
+          "JSON API port: POST /v1/<Method> in protobuf's JSON mapping (0 picks, -1 disables)");
 ABSL_FLAG(std::string, store_dir, "./covplan-data/maps", "Directory of the map registry");
 ABSL_FLAG(std::string, map_store, "disk",
           "Map registry: disk (embedded, in --store_dir) or postgres (shared by replicas)");
@@ -111,6 +114,9 @@ std::vector<std::string> ValidateFlags() {
   if (absl::GetFlag(FLAGS_store_dir).empty()) errors.push_back("--store_dir: must not be empty");
   CheckRange("port", absl::GetFlag(FLAGS_port), 0, 65535, &errors);
   CheckRange("metrics_port", absl::GetFlag(FLAGS_metrics_port), -1, 65535, &errors);
+  CheckRange("http_port", absl::GetFlag(FLAGS_http_port), -1, 65535, &errors);
+  if (absl::GetFlag(FLAGS_http_address).empty())
+    errors.push_back("--http_address: must not be empty");
   CheckRange("threads", absl::GetFlag(FLAGS_threads), 1, 256, &errors);
   CheckRange("max_queue", absl::GetFlag(FLAGS_max_queue), 0, 100000, &errors);
   CheckRange<int64_t>("cache_mb", absl::GetFlag(FLAGS_cache_mb), 1, 1 << 20, &errors);
@@ -148,6 +154,8 @@ covplan::ServerConfig ConfigFromFlags() {
   config.port = absl::GetFlag(FLAGS_port);
   config.metrics_address = absl::GetFlag(FLAGS_metrics_address);
   config.metrics_port = absl::GetFlag(FLAGS_metrics_port);
+  config.http_address = absl::GetFlag(FLAGS_http_address);
+  config.http_port = absl::GetFlag(FLAGS_http_port);
   config.store_dir = absl::GetFlag(FLAGS_store_dir);
   config.map_store = absl::GetFlag(FLAGS_map_store);
   config.pg_conninfo = absl::GetFlag(FLAGS_pg_conninfo);

@@ -12,6 +12,7 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 
 namespace covplan::testing {
@@ -126,10 +127,12 @@ absl::StatusOr<std::vector<std::string>> ReflectionServices(
   return names;
 }
 
-absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
+absl::StatusOr<HttpReply> HttpRequest(int port, const std::string& method, const std::string& path,
+                                      const std::vector<std::string>& headers,
+                                      const std::string& body) {
   const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return absl::InternalError("socket failed");
-  timeval timeout{5, 0};
+  timeval timeout{30, 0};
   ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
   ::setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &timeout, sizeof(timeout));
   sockaddr_in address{};
@@ -140,25 +143,47 @@ absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
     ::close(fd);
     return absl::UnavailableError(absl::StrCat("cannot connect to 127.0.0.1:", port));
   }
-  const std::string request = absl::StrCat("GET ", path, " HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n");
-  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) !=
-      static_cast<ssize_t>(request.size())) {
-    ::close(fd);
-    return absl::UnavailableError("send failed");
+  std::string request = absl::StrCat(method, " ", path, " HTTP/1.0\r\nHost: 127.0.0.1\r\n");
+  for (const std::string& h : headers) absl::StrAppend(&request, h, "\r\n");
+  bool has_length = false;
+  for (const std::string& h : headers) has_length |= h.rfind("Content-Length:", 0) == 0;
+  if (method != "GET" && !has_length) {
+    absl::StrAppend(&request, "Content-Length: ", body.size(), "\r\n");
+  }
+  absl::StrAppend(&request, "\r\n", body);
+  // A server may answer (413) and close before taking the whole body.
+  size_t sent = 0;
+  while (sent < request.size()) {
+    const ssize_t n = ::send(fd, request.data() + sent, request.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) break;
+    sent += static_cast<size_t>(n);
   }
   std::string reply;
   char buffer[8192];
-  for (int i = 0; i < 100000; ++i) {  // bounded; ends at EOF
+  for (int i = 0; i < 1000000; ++i) {  // bounded; ends at EOF
     const ssize_t n = ::recv(fd, buffer, sizeof(buffer), 0);
     if (n <= 0) break;
     reply.append(buffer, static_cast<size_t>(n));
   }
   ::close(fd);
-  const size_t body = reply.find("\r\n\r\n");
-  if (reply.compare(0, 12, "HTTP/1.1 200") != 0 && reply.compare(0, 12, "HTTP/1.0 200") != 0) {
-    return absl::UnavailableError(absl::StrCat("HTTP reply: ", reply.substr(0, 40)));
+  const size_t end = reply.find("\r\n\r\n");
+  HttpReply r;
+  if (reply.size() < 12 || reply.compare(0, 5, "HTTP/") != 0 || end == std::string::npos ||
+      !absl::SimpleAtoi(reply.substr(9, 3), &r.status)) {
+    return absl::UnavailableError(absl::StrCat("no HTTP reply: '", reply.substr(0, 40), "'"));
   }
-  return body == std::string::npos ? std::string() : reply.substr(body + 4);
+  r.headers = reply.substr(0, end);
+  r.body = reply.substr(end + 4);
+  return r;
+}
+
+absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
+  absl::StatusOr<HttpReply> reply = HttpRequest(port, "GET", path);
+  if (!reply.ok()) return reply.status();
+  if (reply->status != 200) {
+    return absl::UnavailableError(absl::StrCat("HTTP reply: ", reply->headers.substr(0, 40)));
+  }
+  return reply->body;
 }
 
 }  // namespace covplan::testing

@@ -41,6 +41,18 @@ absl::StatusOr<std::vector<std::string>> ReflectionServices(
 // GET http://127.0.0.1:port/path; returns the body of a 200 reply.
 absl::StatusOr<std::string> HttpGet(int port, const std::string& path);
 
+// One HTTP/1.0 exchange with 127.0.0.1:port: `method` `path` with the given
+// header lines ("Name: value") and body; the reply's status, its header
+// block and its body. An error only when no reply came.
+struct HttpReply {
+  int status = 0;
+  std::string headers;
+  std::string body;
+};
+absl::StatusOr<HttpReply> HttpRequest(int port, const std::string& method, const std::string& path,
+                                      const std::vector<std::string>& headers = {},
+                                      const std::string& body = "");
+
 }  // namespace covplan::testing
 
 #endif  // COVPLAN_TESTS_SERVER_GRPC_PROBE_H_
