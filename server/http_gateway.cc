@@ -103,7 +103,6 @@ bool ParseGrpcTimeout(absl::string_view text, std::chrono::nanoseconds* out) {
   // Beyond a day is no client deadline (the server's --max_request_s bounds
   // the call); also keeps the nanosecond count from overflowing.
   if ((text.back() == 'H' && value > 24) || (text.back() == 'M' && value > 24 * 60)) {
-    value = 0;
     *out = std::chrono::nanoseconds::max();
     return true;
   }
@@ -348,7 +347,9 @@ int HttpGateway::Call(mg_connection* conn, const pb::MethodDescriptor& method,
                                     "' is not gRPC's format (up to 8 digits and a unit of H, M, "
                                     "S, m, u, n, e.g. 5S)"));
     }
-    context.set_deadline(std::chrono::system_clock::now() + d);
+    if (d != std::chrono::nanoseconds::max()) {
+      context.set_deadline(std::chrono::system_clock::now() + d);
+    }
   }
   const grpc::ByteBuffer request_bytes = ToByteBuffer(*request);
   grpc::ByteBuffer response_bytes;
