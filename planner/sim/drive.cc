@@ -259,7 +259,7 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
     Waypoint cut = b;
     cut.x = pos_.x, cut.y = pos_.y;
     drive_s_ += robot_.StraightTime(d_seg_);
-    clock_s_ += robot_.StraightTime(d_seg_) + robot_.TurnTime(HeadingChange(a.theta, b.theta));
+    clock_s_ = StopClock();
     PushDriven(cut);
     junction_ = true;
   }
@@ -346,6 +346,12 @@ void SimulatedDrive::Start() {
   Sense();
 }
 
+double SimulatedDrive::StopClock() const {
+  const Waypoint& a = path()[seg_ - 1];
+  const Waypoint& b = path()[seg_];
+  return clock_s_ + robot_.StraightTime(d_seg_) + robot_.TurnTime(HeadingChange(a.theta, b.theta));
+}
+
 double SimulatedDrive::clock_s() const {
   double t = clock_s_;
   if (started_ && !finished_ && seg_ < static_cast<int>(path().size()) && t_seg_ > 0.0) {
@@ -379,6 +385,11 @@ absl::StatusOr<bool> SimulatedDrive::Step(double until_s) {
         r_.termination = absl::StrFormat("stopped: %d replans", r_.num_replans);
         return finished_ = true, false;
       }
+      // A replan mid-segment stops the robot there, which takes longer than
+      // driving on (it brakes): that stop must not carry the clock past
+      // until_s (a fleet robot fails or takes a new plan then). It replans
+      // at the next call.
+      if (t_seg_ > 0.0 && StopClock() > until_s + 1e-9) return false;
       RETURN_IF_ERROR(DoReplan(method_));
       return true;
     }

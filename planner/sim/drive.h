@@ -124,6 +124,9 @@ class SimulatedDrive {
   // swept `d` metres into it (its centre at or behind the robot).
   void SweepTo(double d);
   void Start();
+  // The clock once the robot, mid-segment, has stopped where it stands: the
+  // segment's turn and a straight move of d_seg_ from rest to rest.
+  double StopClock() const;
   // One step of the loop: false when the run is over (finished_) or stopped at `until_s`.
   absl::StatusOr<bool> Step(double until_s);
   // A problem line if `path` enters a cell already given to a replan.
