@@ -97,9 +97,13 @@ std::optional<v1::RobotProgress> DriveHandler::RecordedProgress(const std::strin
   return progress_->Recorded(plan_id);
 }
 
-void DriveHandler::ShareObstacles(const std::string& plan_id, const v1::Obstacles& obstacles) {
+void DriveHandler::ShareObstacles(const std::vector<std::string>& plan_ids,
+                                  const v1::Obstacles& obstacles) {
   if (missions_ == nullptr) return;
-  std::optional<std::pair<FleetMission, size_t>> found = missions_->MissionOfPlan(plan_id);
+  std::optional<std::pair<FleetMission, size_t>> found;
+  for (const std::string& plan_id : plan_ids) {
+    if ((found = missions_->MissionOfPlan(plan_id)).has_value()) break;
+  }
   if (!found.has_value()) return;
   const auto& [mission, from] = *found;
   v1::MissionNotice notice;

@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "server/admission.h"
@@ -55,7 +56,8 @@ class DriveHandler final : public DriveHost {
   bool SubmitSolve(std::function<void()> work) override;
   void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) override;
   std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id) override;
-  void ShareObstacles(const std::string& plan_id, const v1::Obstacles& obstacles) override;
+  void ShareObstacles(const std::vector<std::string>& plan_ids,
+                      const v1::Obstacles& obstacles) override;
   void PlanAdopted(const std::string& previous, const std::string& plan_id) override;
   void CountSuperseded() override;
   void UpdateSessionGauge() override;

@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -54,10 +55,13 @@ class DriveHost {
   virtual std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id) {
     return std::nullopt;
   }
-  // Obstacles a session's robot reported while driving `plan_id`: shared
-  // with the other robots of its fleet mission, if it has one (called
-  // without any session's lock held).
-  virtual void ShareObstacles(const std::string& plan_id, const v1::Obstacles& obstacles) {}
+  // Obstacles a session's robot reported: shared with the other robots of
+  // its fleet mission, if it has one. `plan_ids`: the robot's plans, newest
+  // first (the mission holds one of them: a replan adopted since the report
+  // may or may not have reached it yet). Called without any session's lock
+  // held.
+  virtual void ShareObstacles(const std::vector<std::string>& plan_ids,
+                              const v1::Obstacles& obstacles) {}
   // The session's robot drives `plan_id` now instead of `previous` (a
   // replan or a mission's plan pushed): its fleet mission follows.
   virtual void PlanAdopted(const std::string& previous, const std::string& plan_id) {}

@@ -1,6 +1,9 @@
 #include "server/drive_session.h"
 
+#include <algorithm>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -28,8 +31,8 @@ struct DriveSession::Actions {
   bool read = false;
   bool finish = false;
   grpc::Status status;
-  std::string share_plan;  // obstacles seen on this plan, for the mission
-  v1::Obstacles share;
+  bool share = false;  // `shared` was seen by this session's robot, for its mission
+  v1::Obstacles shared;
   std::vector<std::pair<std::string, std::string>> adopted;  // previous plan, new plan
 };
 
@@ -52,7 +55,17 @@ void DriveSession::Start() {
 
 void DriveSession::Perform(const Actions& a) {
   for (const auto& [previous, plan_id] : a.adopted) host_->PlanAdopted(previous, plan_id);
-  if (!a.share_plan.empty()) host_->ShareObstacles(a.share_plan, a.share);
+  if (a.share) {
+    // The robot's plans as they are now, newest first: its replan may have
+    // been adopted (and the mission moved onto it) since it was read.
+    std::vector<std::string> plans;
+    {
+      absl::MutexLock lock(&mu_);
+      plans.assign(plans_.rbegin(), plans_.rend());
+      if (first_.plan_ref_case() == v1::DriveRequest::kPlanId) plans.push_back(first_.plan_id());
+    }
+    host_->ShareObstacles(plans, a.shared);
+  }
   if (a.write != nullptr) StartWrite(a.write);
   if (a.read) StartRead(&in_);
   if (a.finish) Finish(a.status);  // may delete this (through OnDone): last
@@ -258,8 +271,8 @@ void DriveSession::HandleMessage(Actions* a) {
   job.method = in_.method();
   Enqueue(std::move(job), /*keep_running=*/false, a);
   // The other robots of its fleet mission learn of them (after the lock).
-  a->share_plan = plans_.empty() ? first_.plan_id() : plans_.back();
-  a->share = in_.obstacles();
+  a->share = true;
+  a->shared = in_.obstacles();
 }
 
 void DriveSession::Enqueue(Job job, bool keep_running, Actions* a) {
@@ -322,7 +335,10 @@ void DriveSession::ShareObservation(const std::string& plan_id, const v1::Obstac
   Actions a;
   {
     absl::MutexLock lock(&mu_);
-    if (ending_ || !adopted_ || plans_.empty() || plans_.back() != plan_id) return;
+    // `plan_id` is the plan the mission holds for this robot: this one, or
+    // one it replaced whose successor the mission does not know yet.
+    if (ending_ || !adopted_ || std::find(plans_.begin(), plans_.end(), plan_id) == plans_.end())
+      return;
     const int items = ObstacleItems(obstacles);
     if (items == 0 || seen_items_ + items > kMaxObstacleItems) return;
     if (!CheckObservation(obstacles).ok()) return;
@@ -331,7 +347,7 @@ void DriveSession::ShareObservation(const std::string& plan_id, const v1::Obstac
     // A replan of the robot's own observation waits: it takes these along.
     if (pending_.has_value() && !pending_->start) return;
     Job job;
-    job.plan_id = plan_id;
+    job.plan_id = plans_.back();
     job.notice = notice;
     Enqueue(std::move(job), /*keep_running=*/true, &a);
     CheckFinish(&a);
