@@ -13,6 +13,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 full=0
 if [ "${CI:-}" = true ] || [ "${FULL:-0}" = 1 ]; then full=1; fi
+# The test-only packages: Debian's Chromium, its driver and Selenium for the console's
+# browser test (tests/console; it skips without them outside CI). build.sh installs the rest.
+bash scripts/install-deps.sh --only chromium chromium-driver python3-selenium
 
 # suite DIR [cmake args...]: builds into DIR and runs every test there.
 suite() {

@@ -1,0 +1,378 @@
+#!/usr/bin/python3
+"""The web console in a real browser: Debian's Chromium, headless, driven by
+Selenium through chromedriver, against a covplan-server started here with its
+JSON API on (--http_port).
+
+What the page shows is checked against what the JSON API returns for the same
+plan id: one line per rank, the path's polyline point for point, the figures;
+and on the pixels of a screenshot (the rank lines change the picture where
+they are drawn). A no-go zone drawn with the mouse reaches the planner: the
+plan drawn keeps its coverage out of it, where the plan without it swept
+through. Bad input shows the server's INVALID_ARGUMENT message and adds no map.
+
+  /usr/bin/python3 tests/console/console_browser_test.py --server build/bin/covplan-server
+
+Exit code 77 (ctest: skipped) when Chromium, chromedriver or Selenium are
+missing and CI is not set; under CI=true they are required (install-deps).
+"""
+import argparse
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+import urllib.error
+import urllib.request
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SKIP = 77
+CHROMIUM = "/usr/bin/chromium"
+CHROMEDRIVER = "/usr/bin/chromedriver"
+ARGS = None
+
+try:
+    from selenium import webdriver
+    from selenium.common.exceptions import TimeoutException
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+except ImportError:  # reported by main()
+    webdriver = None
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Server:
+    """covplan-server on free ports with a store of its own."""
+
+    def __init__(self, binary):
+        self.dir = tempfile.mkdtemp(prefix="covplan-console-")
+        self.grpc_port, self.http_port = free_port(), free_port()
+        self.log = open(os.path.join(self.dir, "server.log"), "w+")
+        self.proc = subprocess.Popen(
+            [binary, f"--port={self.grpc_port}", "--metrics_port=-1",
+             f"--http_port={self.http_port}", f"--store_dir={self.dir}/maps", "--threads=2"],
+            stdout=self.log, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + 60
+        while True:
+            if self.proc.poll() is not None:
+                raise RuntimeError("covplan-server exited: " + self.output())
+            try:
+                self.call("ListMaps", {})
+                return
+            except (urllib.error.URLError, ConnectionError):
+                if time.monotonic() > deadline:
+                    raise RuntimeError("covplan-server did not answer: " + self.output())
+                time.sleep(0.2)
+
+    @property
+    def url(self):
+        return f"http://127.0.0.1:{self.http_port}/"
+
+    def call(self, method, body):
+        request = urllib.request.Request(
+            f"{self.url}v1/{method}", data=json.dumps(body).encode(),
+            headers={"Content-Type": "application/json"}, method="POST")
+        with urllib.request.urlopen(request, timeout=60) as reply:
+            return json.load(reply)
+
+    def output(self):
+        self.log.seek(0)
+        return self.log.read()[-4000:]
+
+    def stop(self):
+        self.proc.terminate()
+        try:
+            code = self.proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            code = self.proc.wait()
+        self.log.close()
+        shutil.rmtree(self.dir, ignore_errors=True)
+        return code
+
+
+def chromium():
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                "--window-size=1280,900", "--force-device-scale-factor=1"):
+        options.add_argument(arg)
+    return webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
+
+
+def screenshot_pixels(driver):
+    """The page's screenshot as (width, height, rgb bytes), decoded with
+    Chromium itself (no imaging package needed): a canvas in the page."""
+    png = driver.get_screenshot_as_base64()
+    return driver.execute_async_script(
+        """
+        const [png, done] = arguments;
+        const img = new Image();
+        img.onload = () => {
+          const c = document.createElement('canvas');
+          c.width = img.width; c.height = img.height;
+          const g = c.getContext('2d');
+          g.drawImage(img, 0, 0);
+          const d = g.getImageData(0, 0, c.width, c.height).data;
+          done({w: c.width, h: c.height, rgba: Array.from(d)});
+        };
+        img.src = 'data:image/png;base64,' + png;
+        """, png)
+
+
+def cell_centre(grid, cell):
+    """The centre of `cell` (an API CellRef) on `grid` (an API GridInfo), as (x, y)."""
+    size = grid["cellSizeM"]
+    return (grid.get("originXM", 0.0) + (cell.get("col", 0) + 0.5) * size,
+            grid.get("originYM", 0.0) + (cell.get("row", 0) + 0.5) * size)
+
+
+def segments_inside(path, box, margin):
+    """The coverage moves of `path` (API waypoints) that pass through the
+    rectangle `box` (x0, y0, x1, y1) shrunk by `margin`, sampled every 2 cm."""
+    x0, y0, x1, y1 = box[0] + margin, box[1] + margin, box[2] - margin, box[3] - margin
+    hits = []
+    for i in range(1, len(path)):
+        if path[i].get("kind", "COVERAGE") != "COVERAGE":
+            continue
+        a, b = path[i - 1], path[i]
+        ax, ay, bx, by = a.get("x", 0.0), a.get("y", 0.0), b.get("x", 0.0), b.get("y", 0.0)
+        n = max(1, int(((bx - ax) ** 2 + (by - ay) ** 2) ** 0.5 / 0.02))
+        for k in range(n + 1):
+            x, y = ax + (bx - ax) * k / n, ay + (by - ay) * k / n
+            if x0 < x < x1 and y0 < y < y1:
+                hits.append(i)
+                break
+    return hits
+
+
+class ConsoleInTheBrowser(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.server = Server(ARGS.server)
+        cls.driver = chromium()
+        cls.driver.set_script_timeout(60)
+        cls.wait = WebDriverWait(cls.driver, 60)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.driver.quit()
+        code = cls.server.stop()
+        if code != 0:
+            raise AssertionError(f"covplan-server exited with {code}")
+
+    def by_id(self, name):
+        return self.driver.find_element(By.ID, name)
+
+    def status(self):
+        return self.by_id("status").text
+
+    def open_console(self):
+        self.driver.get(self.server.url)
+        self.wait.until(lambda d: d.find_element(By.ID, "status").text.endswith("maps"))
+
+    def upload_office(self):
+        """Uploads the shipped office (PGM + YAML) with the page's own form."""
+        self.open_console()
+        before = len(self.server.call("ListMaps", {}).get("maps", []))
+        self.driver.execute_script("document.getElementById('upload').open = true")
+        self.by_id("upload-image").send_keys(os.path.join(ROOT, "maps", "sample_office.pgm"))
+        self.by_id("upload-yaml").send_keys(os.path.join(ROOT, "maps", "sample_office.yaml"))
+        name = self.by_id("upload-name")
+        name.clear()
+        name.send_keys("office")
+        self.by_id("upload-button").click()
+        self.wait.until(lambda d: d.find_element(By.ID, "plan-form").is_displayed())
+        maps = self.server.call("ListMaps", {})["maps"]
+        self.assertGreaterEqual(len(maps), max(1, before))
+        return [m for m in maps if m.get("name") == "office"][0]
+
+    def plan(self, previous=None):
+        self.by_id("plan-button").click()
+        try:
+            self.wait.until(lambda d: d.find_element(By.ID, "view").get_attribute("data-plan-id")
+                            not in (None, "", previous))
+        except TimeoutException:
+            self.fail("no plan drawn; status: " + self.status())
+        plan_id = self.by_id("view").get_attribute("data-plan-id")
+        return self.server.call("GetPlan", {"planId": plan_id})
+
+    def drawn_path(self):
+        points = self.driver.find_element(By.CSS_SELECTOR, "#transitions polyline.path")
+        return [tuple(float(v) for v in p.split(","))
+                for p in points.get_attribute("points").split()]
+
+    def test_the_page_draws_the_plan_the_api_returns(self):
+        office = self.upload_office()
+        self.assertIn("map", self.status())
+        plan = self.plan()
+        self.assertEqual(plan["mapId"], office["mapId"])
+        ranks = plan.get("ranks", [])
+        num_ranks = int(plan["stats"]["numRanks"])
+        self.assertGreater(num_ranks, 0)
+        self.assertEqual(len(ranks), num_ranks)
+        lines = self.driver.find_elements(By.CSS_SELECTOR, "#ranks line.rank")
+        self.assertEqual(len(lines), num_ranks)
+        # Each rank line runs between the centres of its first and last cells.
+        for line, rank in zip(lines, ranks):
+            want = cell_centre(plan["grid"], rank["firstCell"]) + cell_centre(plan["grid"], rank["lastCell"])
+            got = tuple(float(line.get_attribute(k)) for k in ("x1", "y1", "x2", "y2"))
+            for w, v in zip(want, got):
+                self.assertAlmostEqual(w, v, places=6)
+        # The path, point for point.
+        drawn = self.drawn_path()
+        self.assertEqual(len(drawn), len(plan["path"]))
+        for (x, y), w in zip(drawn, plan["path"]):
+            self.assertAlmostEqual(x, w.get("x", 0.0), places=6)
+            self.assertAlmostEqual(y, w.get("y", 0.0), places=6)
+        # The figures.
+        figures = {dd.get_attribute("data-figure"): dd.text
+                   for dd in self.driver.find_elements(By.CSS_SELECTOR, "#figure-list dd")}
+        self.assertEqual(figures["Ranks"], str(num_ranks))
+        self.assertEqual(figures["Planner"], plan["planner"])
+        self.assertEqual(figures["Duration"], f"{plan['stats']['estimatedDurationS']:.0f} s")
+        self.assertTrue(plan["planId"].startswith(figures["Plan"]))
+        # On the pixels: hiding the ranks changes the picture at each rank's
+        # middle (where no other line of the plan needs to be).
+        middles = self.driver.execute_script(
+            """
+            const svg = document.getElementById('view');
+            const box = svg.getBoundingClientRect();
+            return [...document.querySelectorAll('#ranks line.rank')].map((l) => {
+              const m = l.getScreenCTM();
+              const x = (Number(l.getAttribute('x1')) + Number(l.getAttribute('x2'))) / 2;
+              const y = (Number(l.getAttribute('y1')) + Number(l.getAttribute('y2'))) / 2;
+              const p = new DOMPoint(x, y).matrixTransform(m);
+              return [Math.round(p.x), Math.round(p.y), p.x >= box.left && p.x < box.right &&
+                      p.y >= box.top && p.y < box.bottom];
+            });
+            """)
+        visible = [(x, y) for x, y, inside in middles if inside]
+        self.assertGreater(len(visible), num_ranks // 2, "most rank middles are in the view")
+        shown = screenshot_pixels(self.driver)
+        self.driver.execute_script("document.getElementById('ranks').style.display = 'none'")
+        hidden = screenshot_pixels(self.driver)
+        self.driver.execute_script("document.getElementById('ranks').style.display = ''")
+        self.assertEqual((shown["w"], shown["h"]), (hidden["w"], hidden["h"]))
+
+        def differs(x, y):  # any pixel within 1 px of (x, y)
+            for dx in (-1, 0, 1):
+                for dy in (-1, 0, 1):
+                    i = 4 * ((y + dy) * shown["w"] + (x + dx))
+                    if shown["rgba"][i:i + 3] != hidden["rgba"][i:i + 3]:
+                        return True
+            return False
+
+        drawn_ranks = sum(1 for x, y in visible if differs(x, y))
+        print(f"\n  {num_ranks} ranks drawn, {len(plan['path'])} waypoints; {drawn_ranks} of "
+              f"{len(visible)} rank middles in view change the picture", file=sys.stderr)
+        self.assertEqual(drawn_ranks, len(visible), "rank lines missing from the picture")
+
+    def test_a_no_go_zone_drawn_with_the_mouse_keeps_the_coverage_out(self):
+        self.upload_office()
+        free_plan = self.plan()
+        # The zone: a square three cells wide around the middle of the
+        # longest rank (in the plan's frame), entered by clicks at its
+        # corners' screen points.
+        g = free_plan["grid"]
+        size = g["cellSizeM"]
+
+        def length(r):
+            (ax, ay), (bx, by) = cell_centre(g, r["firstCell"]), cell_centre(g, r["lastCell"])
+            return abs(bx - ax) + abs(by - ay)
+
+        longest = max(free_plan["ranks"], key=length)
+        (ax, ay), (bx, by) = cell_centre(g, longest["firstCell"]), cell_centre(g, longest["lastCell"])
+        cx, cy = (ax + bx) / 2, (ay + by) / 2
+        half = 1.5 * size
+        corners = [(cx - half, cy - half), (cx + half, cy - half), (cx + half, cy + half),
+                   (cx - half, cy + half)]
+        self.assertTrue(segments_inside(free_plan["path"], (cx - half, cy - half, cx + half, cy + half),
+                                        0.0), "the plan without the zone sweeps through it")
+        self.by_id("draw-nogo").click()
+        view = self.by_id("view")
+        box = self.driver.execute_script(
+            "const r = arguments[0].getBoundingClientRect(); return [r.left, r.top, r.width, r.height];",
+            view)
+        for x, y in corners:
+            px, py = self.driver.execute_script(
+                """
+                const p = new DOMPoint(arguments[0], arguments[1])
+                    .matrixTransform(document.getElementById('world').getScreenCTM());
+                return [p.x, p.y];
+                """, x, y)
+            # Offsets from the element's centre (Selenium 4's reference point).
+            ActionChains(self.driver).move_to_element_with_offset(
+                view, int(round(px - box[0] - box[2] / 2)), int(round(py - box[1] - box[3] / 2))
+            ).click().perform()
+        self.by_id("finish-zone").click()
+        zone = self.driver.find_element(By.CSS_SELECTOR, "#zones polygon")
+        points = [tuple(float(v) for v in p.split(",")) for p in zone.get_attribute("points").split()]
+        self.assertEqual(len(points), 4)
+        xs, ys = [p[0] for p in points], [p[1] for p in points]
+        # The clicks land within a pixel of the corners.
+        self.assertAlmostEqual(min(xs), cx - half, delta=0.1)
+        self.assertAlmostEqual(max(ys), cy + half, delta=0.1)
+        zoned = self.plan(previous=free_plan["planId"])
+        # Nothing swept inside the zone (a tool half-width from its edges),
+        # and fewer cells covered than without it.
+        inside = segments_inside(zoned["path"], (min(xs), min(ys), max(xs), max(ys)),
+                                 zoned["grid"]["cellSizeM"] / 2)
+        print(f"\n  zone ({min(xs):.2f}, {min(ys):.2f})-({max(xs):.2f}, {max(ys):.2f}): "
+              f"{len(segments_inside(free_plan['path'], (min(xs), min(ys), max(xs), max(ys)), 0.0))} "
+              f"coverage moves through it without the zone, {len(inside)} with it; covered cells "
+              f"{free_plan['stats']['coveredCells']} -> {zoned['stats']['coveredCells']} (closed "
+              f"{zoned['stats'].get('noGoCells', 0)}, cut off {zoned['stats'].get('unreachableFreeCells', 0)})", file=sys.stderr)
+        self.assertEqual(inside, [], "coverage moves through the drawn no-go zone")
+        # Every cell is accounted for: covered, closed by the zone, or cut
+        # off by it (on the office the square closes the corridor).
+        zs, fs = zoned["stats"], free_plan["stats"]
+        self.assertGreater(zs.get("noGoCells", 0), 0)
+        self.assertLess(zs["coveredCells"], fs["coveredCells"])
+        self.assertEqual(zs["coveredCells"] + zs.get("noGoCells", 0) + zs.get("unreachableFreeCells", 0),
+                         fs["coveredCells"] + fs.get("unreachableFreeCells", 0))
+
+    def test_bad_input_shows_the_servers_message_and_adds_no_map(self):
+        self.open_console()
+        before = self.server.call("ListMaps", {}).get("maps", [])
+        bad = os.path.join(self.server.dir, "not_an_image.png")
+        with open(bad, "wb") as f:
+            f.write(b"this is not a PNG")
+        self.driver.execute_script("document.getElementById('upload').open = true")
+        self.driver.execute_script(
+            "for (const id of ['upload-yaml', 'upload-image', 'upload-geojson'])"
+            " document.getElementById(id).value = '';")
+        self.by_id("upload-image").send_keys(bad)
+        self.by_id("upload-button").click()
+        self.wait.until(lambda d: "error" in (d.find_element(By.ID, "status").get_attribute("class") or ""))
+        self.assertIn("INVALID_ARGUMENT", self.status())
+        self.assertEqual(self.server.call("ListMaps", {}).get("maps", []), before)
+
+
+def main():
+    global ARGS
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--server", required=True, help="the covplan-server binary")
+    ARGS, rest = parser.parse_known_args()
+    missing = [what for what, ok in (("python3-selenium", webdriver is not None),
+                                     ("chromium", os.access(CHROMIUM, os.X_OK)),
+                                     ("chromium-driver", os.access(CHROMEDRIVER, os.X_OK))) if not ok]
+    if missing:
+        print("console browser test: missing " + ", ".join(missing) + " (scripts/install-deps.sh)")
+        return 1 if os.environ.get("CI") == "true" else SKIP
+    program = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2)
+    return 0 if program.result.wasSuccessful() else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
