@@ -168,7 +168,7 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
     args.SetMaxReceiveMessageSize(config.max_message_bytes);
     args.SetMaxSendMessageSize(config.max_message_bytes);
     absl::StatusOr<std::unique_ptr<HttpGateway>> gateway =
-        HttpGateway::Start(http, server->server_->InProcessChannel(args));
+        HttpGateway::Start(http, server->server_->InProcessChannel(args), server->service_->live());
     if (!gateway.ok()) return gateway.status();  // ~CovplanServer stops gRPC
     server->http_ = std::move(*gateway);
   }

@@ -21,7 +21,7 @@ class RefusedDrive final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
 
 DriveHandler::DriveHandler(const ServiceOptions& options, ServerMetrics* metrics, CallGate* gate,
                            SolveAdmission* admission, ReplanWork* work, ProgressLog* progress,
-                           FleetMissions* missions)
+                           FleetMissions* missions, LiveEvents* live)
     : options_(options),
       metrics_(metrics),
       gate_(gate),
@@ -29,6 +29,7 @@ DriveHandler::DriveHandler(const ServiceOptions& options, ServerMetrics* metrics
       work_(work),
       progress_(progress),
       missions_(missions),
+      live_(live),
       sessions_(options.max_sessions, options.session_idle) {}
 
 grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* DriveHandler::Drive(
@@ -129,6 +130,22 @@ bool DriveHandler::PushMissionPlan(const std::string& old_plan_id, const v1::Dri
   const bool taken = session->PushMissionPlan(old_plan_id, event);
   session->Unref();
   return taken;
+}
+
+bool DriveHandler::Watched(const std::string& map_id) { return live_->Watched(map_id); }
+
+void DriveHandler::Live(const v1::LiveEvent& event) {
+  v1::LiveEvent e = event;
+  e.set_time_unix_s(absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch()));
+  if (missions_ != nullptr) {
+    if (std::optional<std::pair<FleetMission, size_t>> found =
+            missions_->MissionOfPlan(e.has_replan() ? e.replan().previous_plan_id() : e.plan_id());
+        found.has_value() || (found = missions_->MissionOfPlan(e.plan_id())).has_value()) {
+      e.set_mission_id(found->first.mission_id);
+      e.set_robot_id(found->first.robot_ids[found->second]);
+    }
+  }
+  live_->Publish(e);
 }
 
 void DriveHandler::CountSuperseded() { metrics_->drive_superseded().Increment(); }

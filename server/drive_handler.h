@@ -22,6 +22,7 @@
 #include "server/drive_host.h"
 #include "server/drive_session.h"
 #include "server/fleet_missions.h"
+#include "server/live_events.h"
 #include "server/metrics.h"
 #include "server/progress_log.h"
 #include "server/replan_work.h"
@@ -34,7 +35,7 @@ class DriveHandler final : public DriveHost {
   // Every pointer outlives this.
   DriveHandler(const ServiceOptions& options, ServerMetrics* metrics, CallGate* gate,
                SolveAdmission* admission, ReplanWork* work, ProgressLog* progress,
-               FleetMissions* missions);
+               FleetMissions* missions, LiveEvents* live);
 
   grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* Drive(
       grpc::CallbackServerContext* context);
@@ -59,6 +60,8 @@ class DriveHandler final : public DriveHost {
   void ShareObstacles(const std::vector<std::string>& plan_ids,
                       const v1::Obstacles& obstacles) override;
   void PlanAdopted(const std::string& previous, const std::string& plan_id) override;
+  bool Watched(const std::string& map_id) override;
+  void Live(const v1::LiveEvent& event) override;
   void CountSuperseded() override;
   void UpdateSessionGauge() override;
 
@@ -69,6 +72,7 @@ class DriveHandler final : public DriveHost {
   ReplanWork* const work_;
   ProgressLog* const progress_;
   FleetMissions* const missions_;
+  LiveEvents* const live_;
   SessionRegistry sessions_;
 };
 

@@ -33,6 +33,7 @@ class DriveHost {
   // and retained (inline), with its grid.
   struct AdoptedPlan {
     std::string plan_id;
+    std::string map_id;
     std::shared_ptr<const Grid> grid;
   };
 
@@ -62,6 +63,12 @@ class DriveHost {
   // held.
   virtual void ShareObstacles(const std::vector<std::string>& plan_ids,
                               const v1::Obstacles& obstacles) {}
+  // True when someone watches the map's live events (server/live_events.h).
+  virtual bool Watched(const std::string& map_id) { return false; }
+  // A live event of a session's robot (map, session and plan set): the host
+  // adds its fleet mission and the time and publishes it. Called without any
+  // session's lock held.
+  virtual void Live(const v1::LiveEvent& event) {}
   // The session's robot drives `plan_id` now instead of `previous` (a
   // replan or a mission's plan pushed): its fleet mission follows.
   virtual void PlanAdopted(const std::string& previous, const std::string& plan_id) {}

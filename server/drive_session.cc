@@ -34,6 +34,7 @@ struct DriveSession::Actions {
   bool share = false;  // `shared` was seen by this session's robot, for its mission
   v1::Obstacles shared;
   std::vector<std::pair<std::string, std::string>> adopted;  // previous plan, new plan
+  std::vector<v1::LiveEvent> live;                           // for the map's watchers
 };
 
 DriveSession::DriveSession(DriveHost* host, grpc::CallbackServerContext* context,
@@ -66,6 +67,7 @@ void DriveSession::Perform(const Actions& a) {
     }
     host_->ShareObstacles(plans, a.shared);
   }
+  for (const v1::LiveEvent& e : a.live) host_->Live(e);
   if (a.write != nullptr) StartWrite(a.write);
   if (a.read) StartRead(&in_);
   if (a.finish) Finish(a.status);  // may delete this (through OnDone): last
@@ -116,6 +118,16 @@ void DriveSession::OnCancel() {
 
 void DriveSession::OnDone() {
   LogLine("info", "drive session ended", {{"session", session_id_}});
+  Actions a;
+  {
+    absl::MutexLock lock(&mu_);
+    if (v1::LiveEvent* e = LiveEventLocked(&a)) {
+      const int code = ending_ ? static_cast<int>(end_status_.error_code()) : 0;
+      e->mutable_ended()->set_status(
+          CodeName(absl::Status(static_cast<absl::StatusCode>(code), "")));
+    }
+  }
+  for (const v1::LiveEvent& e : a.live) host_->Live(e);
   registry_->Remove(this);
   host_->UpdateSessionGauge();
   Unref();
@@ -242,6 +254,7 @@ void DriveSession::HandleMessage(Actions* a) {
       if (plan_id.empty() && first_.plan_ref_case() == v1::DriveRequest::kPlanId)
         plan_id = first_.plan_id();
       if (!plan_id.empty()) host_->RecordProgress(plan_id, in_.progress());
+      if (v1::LiveEvent* e = LiveEventLocked(a)) *e->mutable_progress() = in_.progress();
     }
     return;
   }
@@ -264,6 +277,10 @@ void DriveSession::HandleMessage(Actions* a) {
   }
   seen_.MergeFrom(in_.obstacles());
   seen_items_ += items;
+  if (v1::LiveEvent* e = LiveEventLocked(a)) *e->mutable_obstacles() = in_.obstacles();
+  if (in_.has_progress()) {
+    if (v1::LiveEvent* e = LiveEventLocked(a)) *e->mutable_progress() = in_.progress();
+  }
   Job job;
   job.sequence = seq;
   job.plan_id = plan_id;
@@ -292,6 +309,15 @@ void DriveSession::Enqueue(Job job, bool keep_running, Actions* a) {
   if (!running_) StartJob(a);
 }
 
+v1::LiveEvent* DriveSession::LiveEventLocked(Actions* a) {
+  if (map_id_.empty() || !host_->Watched(map_id_)) return nullptr;
+  v1::LiveEvent& e = a->live.emplace_back();
+  e.set_map_id(map_id_);
+  e.set_session_id(session_id_);
+  if (!plans_.empty()) e.set_plan_id(plans_.back());
+  return &e;
+}
+
 void DriveSession::Adopt(const std::string& plan_id) {
   const std::string previous = plans_.empty() ? "" : plans_.back();
   plans_.push_back(plan_id);
@@ -313,7 +339,14 @@ bool DriveSession::PushMissionPlan(const std::string& plan_id, const v1::DriveEv
       pending_.reset();
     }
     const std::string& fresh = event.replan().plan().plan_id();
+    const std::string previous = plans_.back();
     Adopt(fresh);
+    if (v1::LiveEvent* e = LiveEventLocked(&a)) {
+      v1::LiveReplan* r = e->mutable_replan();
+      r->set_previous_plan_id(previous);
+      *r->mutable_replan() = event.replan().replan();
+      *r->mutable_mission() = event.mission();
+    }
     v1::DriveEvent pushed = event;
     pushed.set_sequence(0);
     for (uint64_t s : superseded) pushed.add_superseded(s);
@@ -402,12 +435,14 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
   event.set_sequence(job.sequence);
   absl::Status status;
   std::shared_ptr<const Grid> grid;
-  std::string adopted;
+  std::string adopted, map_id;
+  double compute_ms = 0.0;
   if (job.start) {
     absl::StatusOr<DriveHost::AdoptedPlan> plan = host_->AdoptPlan(first, stop, tenant_tag_);
     status = plan.status();
     if (plan.ok()) {
       adopted = plan->plan_id;
+      map_id = plan->map_id;
       grid = plan->grid;
       v1::DriveReady* ready = event.mutable_ready();
       ready->set_session_id(session_id_);
@@ -429,8 +464,10 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     *request.mutable_obstacles() = seen;
     request.set_method(job.method != v1::REPLAN_METHOD_UNSPECIFIED ? job.method : first.method());
     request.set_seed(first.seed());
+    const absl::Time t0 = absl::Now();
     status = host_->Replan(absl::StrCat(session_id_, "/", job.sequence), tenant_tag_, request, stop,
                            event.mutable_replan());
+    compute_ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
   }
   Actions a;
   {
@@ -442,7 +479,9 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
       } else {
         adopted_ = true;
         grid_ = grid;
+        map_id_ = map_id;
         Adopt(adopted);
+        if (v1::LiveEvent* e = LiveEventLocked(&a)) e->mutable_started();
         Push(std::move(event), &a);
       }
     } else if (pending_.has_value() || job.generation != generation_) {
@@ -461,6 +500,13 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     } else {
       a.adopted.emplace_back(plans_.back(), event.replan().plan().plan_id());
       Adopt(event.replan().plan().plan_id());
+      if (v1::LiveEvent* e = LiveEventLocked(&a)) {
+        v1::LiveReplan* r = e->mutable_replan();
+        r->set_previous_plan_id(a.adopted.back().first);
+        *r->mutable_replan() = event.replan().replan();
+        r->set_compute_ms(compute_ms);
+        if (job.notice.has_value()) *r->mutable_mission() = *job.notice;
+      }
       for (uint64_t s : job.superseded) event.add_superseded(s);
       if (job.notice.has_value()) *event.mutable_mission() = *job.notice;
       Push(std::move(event), &a);

@@ -117,6 +117,9 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   void Enqueue(Job job, bool keep_running, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // The session drives `plan_id` now (newest last; the registry's index).
   void Adopt(const std::string& plan_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // A LiveEvent of this robot added to `a` (map, session and plan set), or
+  // null when nobody watches its map (or no plan is adopted yet).
+  v1::LiveEvent* LiveEventLocked(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen,
               const StopToken& stop);
   void Push(v1::DriveEvent event, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -144,6 +147,7 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   bool ending_ ABSL_GUARDED_BY(mu_) = false;  // cancelled, expired or failed: push nothing more
   bool finished_ ABSL_GUARDED_BY(mu_) = false;
   grpc::Status end_status_ ABSL_GUARDED_BY(mu_);
+  std::string map_id_ ABSL_GUARDED_BY(mu_);                // the adopted plan's map
   v1::DriveRequest first_ ABSL_GUARDED_BY(mu_);            // method, seed, plan_ref
   std::shared_ptr<const Grid> grid_ ABSL_GUARDED_BY(mu_);  // the plans' grid (for checks)
   std::deque<std::string> plans_ ABSL_GUARDED_BY(mu_);     // newest last

@@ -12,6 +12,7 @@
 #include <grpcpp/support/byte_buffer.h>
 
 #include <chrono>
+#include <cstring>
 #include <mutex>
 #include <utility>
 #include <vector>
@@ -33,6 +34,8 @@ namespace {
 namespace pb = google::protobuf;
 
 constexpr absl::string_view kApiPrefix = "/v1/";
+// The live event stream (server/live_events.h), beside the methods.
+constexpr absl::string_view kEventsPath = "/v1/events";
 const std::string kEmptyObject = "{}";
 
 // gRPC's code as an HTTP status (the mapping of google.rpc.Code).
@@ -179,14 +182,16 @@ bool FromByteBuffer(const grpc::ByteBuffer& buffer, pb::Message* message) {
 
 }  // namespace
 
-HttpGateway::HttpGateway(const HttpGatewayOptions& options, std::shared_ptr<grpc::Channel> channel)
+HttpGateway::HttpGateway(const HttpGatewayOptions& options, std::shared_ptr<grpc::Channel> channel,
+                         LiveEvents* live)
     : options_(options),
+      live_(live),
       channel_(std::move(channel)),
       stub_(std::make_unique<grpc::GenericStub>(channel_)) {}
 
 absl::StatusOr<std::unique_ptr<HttpGateway>> HttpGateway::Start(
-    const HttpGatewayOptions& options, std::shared_ptr<grpc::Channel> channel) {
-  std::unique_ptr<HttpGateway> gateway(new HttpGateway(options, std::move(channel)));
+    const HttpGatewayOptions& options, std::shared_ptr<grpc::Channel> channel, LiveEvents* live) {
+  std::unique_ptr<HttpGateway> gateway(new HttpGateway(options, std::move(channel), live));
   // Once per process, never undone: prometheus-cpp's Exposer shares
   // civetweb's process-wide state.
   static std::once_flag civetweb_initialised;
@@ -221,8 +226,11 @@ HttpGateway::~HttpGateway() {
 }
 
 void HttpGateway::StopCalls() {
-  absl::MutexLock lock(&calls_mu_);
-  closing_ = true;
+  {
+    absl::MutexLock lock(&calls_mu_);
+    closing_ = true;
+  }
+  if (live_ != nullptr) live_->Close();  // the event streams end
 }
 
 int HttpGateway::HandleApi(mg_connection* conn, void* self) {
@@ -233,6 +241,7 @@ int HttpGateway::Serve(mg_connection* conn) {
   const mg_request_info* request = mg_get_request_info(conn);
   const absl::string_view uri = request->local_uri != nullptr ? request->local_uri : "";
   if (!absl::StartsWith(uri, kApiPrefix)) return ServeConsole(conn, uri);
+  if (uri == kEventsPath) return ServeEvents(conn);
   const std::string method_name(uri.substr(kApiPrefix.size()));
   const pb::ServiceDescriptor* service = pb::DescriptorPool::generated_pool()->FindServiceByName(
       v1::CoveragePlanner::service_full_name());
@@ -319,6 +328,105 @@ int HttpGateway::ServeConsole(mg_connection* conn, absl::string_view uri) {
                    /*close=*/true);
 }
 
+int HttpGateway::ServeEvents(mg_connection* conn) {
+  const mg_request_info* request = mg_get_request_info(conn);
+  if (absl::string_view(request->request_method) != "GET") {
+    return SendError(conn, grpc::StatusCode::UNIMPLEMENTED,
+                     absl::StrCat(request->request_method, " ", kEventsPath,
+                                  ": the event stream is a GET (Server-Sent Events)"),
+                     /*close=*/true, /*http_status=*/405);
+  }
+  char map_id[256] = {};
+  const char* query = request->query_string != nullptr ? request->query_string : "";
+  if (mg_get_var(query, std::strlen(query), "map_id", map_id, sizeof(map_id)) <= 0) {
+    return SendError(conn, grpc::StatusCode::INVALID_ARGUMENT,
+                     absl::StrCat("GET ", kEventsPath, " needs ?map_id=<the map's id>"),
+                     /*close=*/true);
+  }
+  // The caller must be able to read the map (token, tenant): gRPC decides.
+  v1::GetMapRequest get;
+  get.set_map_id(map_id);
+  v1::GetMapResponse map;
+  const pb::MethodDescriptor* get_map =
+      pb::DescriptorPool::generated_pool()
+          ->FindServiceByName(v1::CoveragePlanner::service_full_name())
+          ->FindMethodByName("GetMap");
+  if (grpc::Status s = Invoke(conn, *get_map, get, &map); !s.ok()) {
+    return SendError(conn, s.error_code(), s.error_message(), /*close=*/true);
+  }
+  std::shared_ptr<LiveEvents::Subscription> events =
+      live_ != nullptr ? live_->Subscribe(map_id) : nullptr;
+  if (events == nullptr) {
+    return SendError(conn, grpc::StatusCode::UNAVAILABLE,
+                     "the server holds as many live event streams as it allows; try again later",
+                     /*close=*/true);
+  }
+  mg_printf(conn,
+            "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n"
+            "X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n");
+  std::string out = absl::StrCat(": live events of map ", map_id, "\n\n");
+  while (mg_write(conn, out.data(), out.size()) > 0) {
+    // A comment every few seconds at the least: a client gone is found by
+    // the failed write.
+    LiveEvents::Batch batch = events->Next(absl::Seconds(5));
+    if (batch.closed) break;
+    out.clear();
+    if (batch.dropped > 0) {
+      absl::StrAppend(&out, ": ", batch.dropped, " events dropped (this client fell behind)\n\n");
+    }
+    for (const std::string& e : batch.events) absl::StrAppend(&out, "data: ", e, "\n\n");
+    if (out.empty()) out = ":\n\n";
+  }
+  return 200;
+}
+
+grpc::Status HttpGateway::Invoke(mg_connection* conn, const pb::MethodDescriptor& method,
+                                 const pb::Message& request, pb::Message* response) {
+  grpc::ClientContext context;
+  if (const char* authorization = mg_get_header(conn, "Authorization")) {
+    if (!PrintableAscii(authorization)) {
+      return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                          "the Authorization header holds bytes other than printable ASCII");
+    }
+    context.AddMetadata("authorization", authorization);
+  }
+  if (const char* timeout = mg_get_header(conn, "Grpc-Timeout")) {
+    std::chrono::nanoseconds d{};
+    if (!ParseGrpcTimeout(timeout, &d)) {
+      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          absl::StrCat("Grpc-Timeout '", timeout,
+                                       "' is not gRPC's format (up to 8 digits and a unit of H, M, "
+                                       "S, m, u, n, e.g. 5S)"));
+    }
+    if (d != std::chrono::nanoseconds::max()) {
+      context.set_deadline(std::chrono::system_clock::now() + d);
+    }
+  }
+  const grpc::ByteBuffer request_bytes = ToByteBuffer(request);
+  grpc::ByteBuffer response_bytes;
+  grpc::Status status;
+  absl::Notification done;
+  {
+    // No call starts once the gRPC server shuts down (gRPC 1.51's in-process
+    // transport must not see a new call then); a started one is its to end.
+    absl::ReaderMutexLock calls(&calls_mu_);
+    if (closing_) return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+    stub_->UnaryCall(&context, absl::StrCat("/", method.service()->full_name(), "/", method.name()),
+                     grpc::StubOptions(), &request_bytes, &response_bytes, [&](grpc::Status s) {
+                       status = std::move(s);
+                       done.Notify();
+                     });
+  }
+  done.WaitForNotification();
+  if (!status.ok()) return status;
+  if (!FromByteBuffer(response_bytes, response)) {
+    return grpc::Status(
+        grpc::StatusCode::INTERNAL,
+        absl::StrCat("the server's ", method.output_type()->full_name(), " did not parse"));
+  }
+  return grpc::Status::OK;
+}
+
 int HttpGateway::Call(mg_connection* conn, const pb::MethodDescriptor& method,
                       const std::string& body) {
   pb::MessageFactory* factory = pb::MessageFactory::generated_factory();
@@ -331,51 +439,11 @@ int HttpGateway::Call(mg_connection* conn, const pb::MethodDescriptor& method,
                      absl::StrCat("the body is not a ", method.input_type()->full_name(),
                                   " in protobuf's JSON mapping: ", parsed.message().as_string()));
   }
-  grpc::ClientContext context;
-  if (const char* authorization = mg_get_header(conn, "Authorization")) {
-    if (!PrintableAscii(authorization)) {
-      return SendError(conn, grpc::StatusCode::UNAUTHENTICATED,
-                       "the Authorization header holds bytes other than printable ASCII");
-    }
-    context.AddMetadata("authorization", authorization);
-  }
-  if (const char* timeout = mg_get_header(conn, "Grpc-Timeout")) {
-    std::chrono::nanoseconds d{};
-    if (!ParseGrpcTimeout(timeout, &d)) {
-      return SendError(conn, grpc::StatusCode::INVALID_ARGUMENT,
-                       absl::StrCat("Grpc-Timeout '", timeout,
-                                    "' is not gRPC's format (up to 8 digits and a unit of H, M, "
-                                    "S, m, u, n, e.g. 5S)"));
-    }
-    if (d != std::chrono::nanoseconds::max()) {
-      context.set_deadline(std::chrono::system_clock::now() + d);
-    }
-  }
-  const grpc::ByteBuffer request_bytes = ToByteBuffer(*request);
-  grpc::ByteBuffer response_bytes;
-  grpc::Status status;
-  absl::Notification done;
-  {
-    // No call starts once the gRPC server shuts down (gRPC 1.51's in-process
-    // transport must not see a new call then); a started one is its to end.
-    absl::ReaderMutexLock calls(&calls_mu_);
-    if (closing_) {
-      return SendError(conn, grpc::StatusCode::UNAVAILABLE, "the server is shutting down",
-                       /*close=*/true);
-    }
-    stub_->UnaryCall(&context, absl::StrCat("/", method.service()->full_name(), "/", method.name()),
-                     grpc::StubOptions(), &request_bytes, &response_bytes, [&](grpc::Status s) {
-                       status = std::move(s);
-                       done.Notify();
-                     });
-  }
-  done.WaitForNotification();
-  if (!status.ok()) return SendError(conn, status.error_code(), status.error_message());
   std::unique_ptr<pb::Message> response(factory->GetPrototype(method.output_type())->New());
-  if (!FromByteBuffer(response_bytes, response.get())) {
-    return SendError(
-        conn, grpc::StatusCode::INTERNAL,
-        absl::StrCat("the server's ", method.output_type()->full_name(), " did not parse"));
+  const grpc::Status status = Invoke(conn, method, *request, response.get());
+  if (!status.ok()) {
+    return SendError(conn, status.error_code(), status.error_message(),
+                     /*close=*/status.error_code() == grpc::StatusCode::UNAVAILABLE);
   }
   pb::util::JsonPrintOptions print;
   print.always_print_primitive_fields = true;

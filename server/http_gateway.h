@@ -17,6 +17,10 @@
 //
 //   ASSIGN_OR_RETURN(std::unique_ptr<HttpGateway> http,
 //                    HttpGateway::Start(options, server->InProcessChannel(args)));
+//   GET /v1/events?map_id=<id>   the map's live events (server/live_events.h)
+//                                as Server-Sent Events: one LiveEvent per
+//                                `data:` line, in the same JSON mapping
+//
 //   http->port();  // the bound port (options.port 0 picks one)
 //   http.reset();  // stops listening; waits for the handlers in flight
 //
@@ -35,11 +39,13 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/synchronization/mutex.h"
+#include "server/live_events.h"
 
 struct mg_context;
 struct mg_connection;
 
 namespace google::protobuf {
+class Message;
 class MethodDescriptor;
 }  // namespace google::protobuf
 
@@ -54,36 +60,51 @@ struct HttpGatewayOptions {
   // A client that sends its request (headers and body) slower than this is
   // cut off, so slow clients cannot hold the worker threads.
   int request_timeout_ms = 15000;
-  int worker_threads = 8;
+  // Threads serving requests; each open event stream holds one (the
+  // service's max_live_streams bounds them).
+  int worker_threads = 12;
 };
 
 class HttpGateway {
  public:
   // UNAVAILABLE naming the address when the port cannot be bound.
+  // `live` (optional, outlives the gateway) feeds GET /v1/events.
   static absl::StatusOr<std::unique_ptr<HttpGateway>> Start(const HttpGatewayOptions& options,
-                                                            std::shared_ptr<grpc::Channel> channel);
+                                                            std::shared_ptr<grpc::Channel> channel,
+                                                            LiveEvents* live = nullptr);
   ~HttpGateway();
   HttpGateway(const HttpGateway&) = delete;
   HttpGateway& operator=(const HttpGateway&) = delete;
 
   int port() const { return port_; }
 
-  // From now on every API call answers UNAVAILABLE without reaching gRPC;
-  // returns once the calls already started are under way. Call before the
-  // gRPC server shuts down.
+  // From now on every API call answers UNAVAILABLE without reaching gRPC,
+  // and the event streams end (the LiveEvents hub closes); returns once the
+  // calls already started are under way. Call before the gRPC server shuts
+  // down.
   void StopCalls();
 
  private:
-  explicit HttpGateway(const HttpGatewayOptions& options, std::shared_ptr<grpc::Channel> channel);
+  HttpGateway(const HttpGatewayOptions& options, std::shared_ptr<grpc::Channel> channel,
+              LiveEvents* live);
   static int HandleApi(mg_connection* conn, void* self);
   int Serve(mg_connection* conn);
   // GET / and the console's files (server/console_assets.h); 404 else.
   int ServeConsole(mg_connection* conn, absl::string_view uri);
+  // GET /v1/events: the map's live events once GetMap says the caller may
+  // read it; returns when the client goes or StopCalls.
+  int ServeEvents(mg_connection* conn);
+  // Calls `method` in process with the request's Authorization and
+  // Grpc-Timeout headers; UNAVAILABLE once StopCalls.
+  grpc::Status Invoke(mg_connection* conn, const google::protobuf::MethodDescriptor& method,
+                      const google::protobuf::Message& request,
+                      google::protobuf::Message* response);
   // Parses `body` as the method's request, calls it in process, answers.
   int Call(mg_connection* conn, const google::protobuf::MethodDescriptor& method,
            const std::string& body);
 
   HttpGatewayOptions options_;
+  LiveEvents* const live_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<grpc::GenericStub> stub_;
   absl::Mutex calls_mu_;

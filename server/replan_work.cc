@@ -198,6 +198,7 @@ absl::StatusOr<DriveHost::AdoptedPlan> ReplanWork::AdoptPlan(const v1::DriveRequ
                   bounded, &resolved));
   DriveHost::AdoptedPlan out;
   out.grid = resolved.plan->plan.grid;
+  out.map_id = resolved.plan->map_id;
   if (first.plan_ref_case() == v1::DriveRequest::kPlanId) {
     out.plan_id = first.plan_id();
     return out;

@@ -14,6 +14,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       admission_(options_, metrics, &pool_),
       archive_(options_, store, metrics, &engine_, &io_pool_),
       progress_(store, &io_pool_, 4 * options.max_retained_plans + 64),
+      live_(options.max_live_streams, /*queue_limit=*/1024),
       missions_(4 * options.max_retained_plans + 16, store),
       replan_work_(options_, store, metrics, &engine_, &archive_, &progress_, &admission_,
                    &missions_),
@@ -24,7 +25,7 @@ CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, Ma
       missions_rpc_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &progress_,
                     &missions_, &drive_),
       replans_(&gate_, &admission_, &replan_work_),
-      drive_(options_, metrics, &gate_, &admission_, &replan_work_, &progress_, &missions_),
+      drive_(options_, metrics, &gate_, &admission_, &replan_work_, &progress_, &missions_, &live_),
       io_pool_(/*threads=*/2, /*max_queue=*/64),
       read_pool_(/*threads=*/1, /*max_queue=*/256),
       // Admission is bounded by SolveAdmission; the pool's own bound is slack

@@ -52,6 +52,7 @@
 #include "server/drive_session.h"
 #include "server/fleet_handlers.h"
 #include "server/fleet_missions.h"
+#include "server/live_events.h"
 #include "server/map_handlers.h"
 #include "server/map_repository.h"
 #include "server/metrics.h"
@@ -156,6 +157,8 @@ class CoveragePlannerService final
   const ArtifactLru& cache() const { return cache_; }
   const ReplanEstimator& estimator() const { return archive_.estimator(); }
   const SessionRegistry& sessions() const { return drive_.sessions(); }
+  // What the Drive sessions do, per map, for the JSON API's event stream.
+  LiveEvents* live() { return &live_; }
   const FleetMissions& missions() const { return missions_; }
 
  private:
@@ -169,6 +172,7 @@ class CoveragePlannerService final
   ServedReplies served_;
   PlanArchive archive_;
   ProgressLog progress_;
+  LiveEvents live_;         // before drive_: the sessions publish to it
   FleetMissions missions_;  // before replan_work_: a mission follows its robots' replans
   ReplanWork replan_work_;
   MapHandlers maps_;

@@ -14,6 +14,7 @@ absl::Status ServiceOptions::Validate() const {
     return absl::InvalidArgumentError("max_request_time must be > 0");
   }
   if (max_sessions < 0) return absl::InvalidArgumentError("max_sessions must be >= 0");
+  if (max_live_streams < 0) return absl::InvalidArgumentError("max_live_streams must be >= 0");
   if (session_idle <= absl::ZeroDuration())
     return absl::InvalidArgumentError("session_idle must be > 0");
   return absl::OkStatus();

@@ -45,6 +45,9 @@ struct ServiceOptions {
   // without a message before it is ended.
   int max_sessions = 64;
   absl::Duration session_idle = absl::Seconds(120);
+  // Live event streams (GET /v1/events on the JSON API) open at once; each
+  // holds one of the HTTP server's threads.
+  int max_live_streams = 4;
 
   absl::Status Validate() const;
 };

@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
@@ -184,6 +185,45 @@ absl::StatusOr<std::string> HttpGet(int port, const std::string& path) {
     return absl::UnavailableError(absl::StrCat("HTTP reply: ", reply->headers.substr(0, 40)));
   }
   return reply->body;
+}
+
+HttpStream::~HttpStream() { ::close(fd_); }
+
+absl::StatusOr<std::unique_ptr<HttpStream>> HttpStream::Open(
+    int port, const std::string& path, const std::vector<std::string>& headers) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return absl::InternalError("socket failed");
+  std::unique_ptr<HttpStream> stream(new HttpStream(fd));
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    return absl::UnavailableError(absl::StrCat("cannot connect to 127.0.0.1:", port));
+  }
+  std::string request = absl::StrCat("GET ", path, " HTTP/1.1\r\nHost: 127.0.0.1\r\n");
+  for (const std::string& h : headers) absl::StrAppend(&request, h, "\r\n");
+  absl::StrAppend(&request, "\r\n");
+  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) !=
+      static_cast<ssize_t>(request.size())) {
+    return absl::UnavailableError("cannot send the request");
+  }
+  return stream;
+}
+
+bool HttpStream::ReadUntil(const std::string& text, absl::Duration timeout) {
+  const absl::Time deadline = absl::Now() + timeout;
+  while (received_.find(text) == std::string::npos) {
+    const absl::Duration left = deadline - absl::Now();
+    if (left <= absl::ZeroDuration()) return false;
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(absl::ToInt64Milliseconds(left)) + 1) <= 0) continue;
+    char buffer[8192];
+    const ssize_t n = ::recv(fd_, buffer, sizeof(buffer), 0);
+    if (n <= 0) return received_.find(text) != std::string::npos;  // closed
+    received_.append(buffer, static_cast<size_t>(n));
+  }
+  return true;
 }
 
 }  // namespace covplan::testing

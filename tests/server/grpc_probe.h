@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 
 namespace covplan::testing {
 
@@ -52,6 +53,23 @@ struct HttpReply {
 absl::StatusOr<HttpReply> HttpRequest(int port, const std::string& method, const std::string& path,
                                       const std::vector<std::string>& headers = {},
                                       const std::string& body = "");
+
+// An HTTP response read as it arrives (an event stream): Open sends the
+// request; ReadUntil reads until `text` has arrived (true) or `timeout`.
+class HttpStream {
+ public:
+  ~HttpStream();
+  static absl::StatusOr<std::unique_ptr<HttpStream>> Open(
+      int port, const std::string& path, const std::vector<std::string>& headers = {});
+  bool ReadUntil(const std::string& text, absl::Duration timeout);
+  // Everything read so far (headers included).
+  const std::string& received() const { return received_; }
+
+ private:
+  explicit HttpStream(int fd) : fd_(fd) {}
+  const int fd_;
+  std::string received_;
+};
 
 }  // namespace covplan::testing
 
