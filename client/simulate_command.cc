@@ -33,8 +33,8 @@ constexpr char kUsage[] =
     "usage: covplan simulate --map KNOWN [--resolution M] [--tool-width M]\n"
     "                        (--true-map TRUE | --clutter PCT) [--seed N]\n"
     "                        [--method auto|ilp1|ilp2|greedy_detour|full] [--sensor-range M]\n"
-    "                        [--local | --server HOST:PORT] [--svg run.svg] [--time-limit S] "
-    "[--step S]\n"
+    "                        [--local | --server HOST:PORT [--watch SPEED]] [--svg run.svg]\n"
+    "                        [--time-limit S] [--step S]\n"
     "                        [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--token T | "
     "--token-file F]\n"
     "                        [--replan-tour-limit S] [--clutter-may-disconnect]\n"
@@ -74,6 +74,8 @@ constexpr char kUsage[] =
     "server instead: PutMap and Plan for the known map, then one Drive session in which\n"
     "every replan is an observation; the compute time charged then includes the network\n"
     "and the server's queue (the offline bounds are still computed locally).\n"
+    "--watch SPEED (with --server) drives at SPEED times real time and reports the\n"
+    "robot's progress on the session, so the web console shows it driving live.\n"
     "--svg draws the true map, the driven path, the replan points (blue) and the\n"
     "obstacle cells found (red).\n"
     "--planner plans with another registered planner (default oarp; the offline bounds\n"
@@ -230,6 +232,7 @@ std::set<std::string> SimulateValueFlags() {
           "free-thresh",
           "occupied-thresh",
           "server",
+          "watch",
           "replan-tour-limit",
           "planner",
           "battery-capacity",
@@ -430,6 +433,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
       ParseArgs(args, value_flags,
                 {"local", "negate", "clutter-may-disconnect", "no-offline-bound", "interruptible"},
                 fleet != nullptr ? fleet->repeatable_flags : std::set<std::string>()));
+  if (a.Get("watch") && !a.Get("server"))
+    return absl::InvalidArgumentError("--watch needs --server HOST:PORT: the run is watched there");
   if (a.Get("server") && a.Has("local"))
     return absl::InvalidArgumentError("give --local or --server, not both");
   if (a.Get("server") && a.Get("server")->empty())
@@ -462,11 +467,15 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
   std::unique_ptr<PlanSource> remote;
   if (auto server = a.Get("server")) {
     if (!make_remote) return absl::InvalidArgumentError("--server is not available in this build");
-    SimulateMapFlags flags;
+    SimulateRemoteFlags flags;
     flags.resolution = resolution;
     flags.free_thresh = free_thresh;
     flags.occupied_thresh = occupied_thresh;
     flags.negate = load.negate;
+    ASSIGN_OR_RETURN(std::optional<double> watch, a.GetDouble("watch"));
+    if (watch && !(*watch > 0.0 && *watch <= 1000.0))
+      return absl::InvalidArgumentError("--watch: the speed-up must be in (0, 1000]");
+    flags.watch_speed = watch.value_or(0.0);
     ASSIGN_OR_RETURN(Connection connection, ConnectionFromArgs(a, *server));
     ASSIGN_OR_RETURN(remote, make_remote(connection, *a.Get("map"), flags, o));
   }

@@ -30,17 +30,22 @@
 
 namespace covplan {
 
-// The map flags, as given (for a server that reads the map file itself).
-struct SimulateMapFlags {
+// What a run through a server needs of the flags: the map flags, as given
+// (the server is sent the map file itself), and --watch.
+struct SimulateRemoteFlags {
   std::optional<double> resolution, free_thresh, occupied_thresh;
   bool negate = false;
+  // --watch SPEED: the robot drives at SPEED times real time and reports its
+  // progress on the Drive session (at most 10 times a second), so a person
+  // can watch it in the web console; 0 = as fast as it computes, unreported.
+  double watch_speed = 0.0;
 };
 // Makes the PlanSource of --server HOST:PORT (with the connection flags,
 // client/connection.h) for the known map file. The
 // covplan binary passes client/simulate_remote.h's; without one, --server is
 // refused. (This unit stays free of gRPC: the simulator tests compile it.)
 using RemotePlanSourceFactory = std::function<absl::StatusOr<std::unique_ptr<PlanSource>>(
-    const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const Connection& server, const std::string& known_map_path, const SimulateRemoteFlags& flags,
     const SimulationOptions& options)>;
 
 // A fleet of simulated robots (--robot ... or --robots K, --fail-robot ...):

@@ -3,6 +3,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "api/convert.h"
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
@@ -13,11 +15,12 @@ namespace {
 class ServerPlanSource final : public PlanSource {
  public:
   ServerPlanSource(std::unique_ptr<RemotePlanner> remote, v1::Map map,
-                   const SimulationOptions& options)
+                   const SimulationOptions& options, double watch_speed)
       : remote_(std::move(remote)),
         map_(std::move(map)),
         method_(ReplanMethodToProto(options.method)),
-        seed_(static_cast<uint32_t>(options.seed)) {}
+        seed_(static_cast<uint32_t>(options.seed)),
+        watch_speed_(watch_speed) {}
   ~ServerPlanSource() override {
     if (session_ != nullptr) session_->Close().IgnoreError();
   }
@@ -47,6 +50,7 @@ class ServerPlanSource final : public PlanSource {
     first.set_sequence(next_sequence_++);
     ASSIGN_OR_RETURN(session_, remote_->Drive(first));
     current_plan_id_ = planned.plan_id();
+    started_ = absl::Now();
     RetainedPlan retained;
     retained.plan_id = planned.plan_id();
     retained.map_id = planned.map_id();
@@ -85,11 +89,30 @@ class ServerPlanSource final : public PlanSource {
     return out;
   }
 
+  bool WatchesMoves() const override { return watch_speed_ > 0.0; }
+
+  // Paced: the run's clock at watch_speed_ times real time; reported at most
+  // every 100 ms (a failed report ends nothing: the next replan says).
+  void Moved(const RobotProgress& at, double clock_s) override {
+    if (session_ == nullptr) return;
+    const absl::Time due = started_ + absl::Seconds(clock_s / watch_speed_);
+    if (const absl::Time now = absl::Now(); due > now) absl::SleepFor(due - now);
+    if (absl::Now() - last_report_ < absl::Milliseconds(100)) return;
+    last_report_ = absl::Now();
+    v1::DriveRequest report;
+    report.set_sequence(next_sequence_++);
+    report.set_plan_id(current_plan_id_);
+    ProgressToProto(at, report.mutable_progress());
+    session_->Report(report).IgnoreError();
+  }
+
  private:
   std::unique_ptr<RemotePlanner> remote_;
   const v1::Map map_;
   const v1::ReplanMethod method_;
   const uint32_t seed_;
+  const double watch_speed_;  // 0: not watched
+  absl::Time started_, last_report_ = absl::InfinitePast();
   std::unique_ptr<RemotePlanner::DriveSession> session_;
   std::string current_plan_id_;
   uint64_t next_sequence_ = 1;
@@ -98,7 +121,7 @@ class ServerPlanSource final : public PlanSource {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(
-    const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const Connection& server, const std::string& known_map_path, const SimulateRemoteFlags& flags,
     const SimulationOptions& options) {
   MapFileOverrides overrides;
   overrides.resolution = flags.resolution;
@@ -106,8 +129,8 @@ absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(
   overrides.occupied_thresh = flags.occupied_thresh;
   if (flags.negate) overrides.negate = true;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(known_map_path, overrides, EngineLimits()));
-  return std::unique_ptr<PlanSource>(
-      new ServerPlanSource(RemotePlanner::Connect(server), std::move(map), options));
+  return std::unique_ptr<PlanSource>(new ServerPlanSource(
+      RemotePlanner::Connect(server), std::move(map), options, flags.watch_speed));
 }
 
 }  // namespace covplan

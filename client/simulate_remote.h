@@ -26,7 +26,7 @@ namespace covplan {
 
 // A RemotePlanSourceFactory (client/simulate_command.h).
 absl::StatusOr<std::unique_ptr<PlanSource>> ConnectServerPlanSource(
-    const Connection& server, const std::string& known_map_path, const SimulateMapFlags& flags,
+    const Connection& server, const std::string& known_map_path, const SimulateRemoteFlags& flags,
     const SimulationOptions& options);
 
 }  // namespace covplan

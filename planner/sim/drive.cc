@@ -445,6 +445,7 @@ absl::StatusOr<bool> SimulatedDrive::Step(double until_s) {
     t_seg_ = d_seg_ = 0.0;
     pos_ = At(b);
   }
+  if (source_->WatchesMoves()) source_->Moved(Progress(), clock_s());
   Sense();
   return true;
 }

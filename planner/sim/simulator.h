@@ -161,6 +161,11 @@ class PlanSource {
   virtual absl::StatusOr<ReplanResult> Replan(const RetainedPlan& plan, const RobotProgress& at,
                                               const Observations& seen,
                                               const ReplanOptions& options) = 0;
+  // True when the source wants Moved after every step of the drive.
+  virtual bool WatchesMoves() const { return false; }
+  // The robot moved: it stands at `at` on the plan it drives, `clock_s`
+  // seconds into the run (a watched run paces itself and reports it).
+  virtual void Moved(const RobotProgress& at, double clock_s) {}
 };
 
 // InvalidArgument when the options are bad, the maps differ in size,
