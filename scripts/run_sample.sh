@@ -4,8 +4,11 @@
 # services), plan the shipped sample map through the server, print the
 # figures and write plan.json and plan.svg; then plan the shipped office for
 # a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg;
-# last, list the stored maps over the JSON API (--http_port).
+# last, list the stored maps over the JSON API (--http_port). With WATCH=1 it
+# then drives a simulated robot through the server at 10x real time (covplan
+# simulate --watch) to watch live in the web console, and stops when it ends.
 #   scripts/run_sample.sh [MAP] [extra `covplan plan` flags...]
+#   WATCH=1 scripts/run_sample.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 MAP=${1:-maps/sample_office.yaml}
@@ -54,3 +57,12 @@ echo "curl -X POST http://127.0.0.1:$HTTP_PORT/v1/ListMaps -d '{}':"
 curl -sS --max-time 10 -H 'Content-Type: application/json' -X POST \
   "http://127.0.0.1:$HTTP_PORT/v1/ListMaps" -d '{}' |
   /usr/bin/python3 -c 'import json,sys; m=json.load(sys.stdin)["maps"]; print(f"  {len(m)} maps:", ", ".join(x["mapId"][:12] + " " + x.get("name","") for x in m))'
+
+# WATCH=1: a robot drives the furnished office through the server, live in the console.
+if [ "${WATCH:-0}" = 1 ]; then
+  echo "open http://127.0.0.1:$HTTP_PORT/ and pick the sample office: a robot drives it live"
+  ./build/bin/covplan simulate --map maps/sample_office.yaml \
+    --true-map maps/sample_office_furnished.yaml --server "127.0.0.1:$PORT" --watch 10 \
+    >"$OUT_DIR/watch.json"
+  echo "wrote $OUT_DIR/watch.json (the watched run's figures)"
+fi

@@ -7,6 +7,8 @@
 // axis points down, so a map point (x, y) sits at (x, -y)); #world inside it
 // flips y, so every vector layer is drawn in plain map coordinates.
 
+import { createLiveView } from './live.js';
+
 const $ = (id) => document.getElementById(id);
 const SVG_NS = 'http://www.w3.org/2000/svg';
 
@@ -275,6 +277,7 @@ async function openMap(mapId) {
   const margin = 0.05 * Math.max(w, h);
   setBox([ox - margin, -(oy + h) - margin, w + 2 * margin, h + 2 * margin]);
   $('plan-form').hidden = false;
+  live.watch(mapId);
   $('hint').textContent = `${reply.info.name || mapId}: drag to pan, wheel to zoom.`;
   setStatus(`map ${mapId.slice(0, 12)} open`);
 }
@@ -440,7 +443,10 @@ function showError(e) {
   setStatus(e.message || String(e), true);
 }
 
+let live = null;
+
 function main() {
+  live = createLiveView({ api, svgEl, token: () => state.token });
   setUpPanZoom();
   $('draw-nogo').onclick = () => startZone('nogo');
   $('draw-region').onclick = () => startZone('region');

@@ -9,8 +9,12 @@ and on the pixels of a screenshot (the rank lines change the picture where
 they are drawn). A no-go zone drawn with the mouse reaches the planner: the
 plan drawn keeps its coverage out of it, where the plan without it swept
 through. Bad input shows the server's INVALID_ARGUMENT message and adds no map.
+A robot simulated through the server (covplan simulate --server --watch) is
+seen live: its marker moves at least five times and a replan appears in the
+log. Each step leaves a screenshot in --artifacts.
 
-  /usr/bin/python3 tests/console/console_browser_test.py --server build/bin/covplan-server
+  /usr/bin/python3 tests/console/console_browser_test.py --server build/bin/covplan-server \
+      --client build/bin/covplan --artifacts /tmp/console-shots
 
 Exit code 77 (ctest: skipped) when Chromium, chromedriver or Selenium are
 missing and CI is not set; under CI=true they are required (install-deps).
@@ -156,7 +160,9 @@ def segments_inside(path, box, margin):
     return hits
 
 
-class ConsoleInTheBrowser(unittest.TestCase):
+class Browser(unittest.TestCase):
+    """A server and a headless Chromium for the test cases below (no tests of its own)."""
+
     @classmethod
     def setUpClass(cls):
         cls.server = Server(ARGS.server)
@@ -170,6 +176,11 @@ class ConsoleInTheBrowser(unittest.TestCase):
         code = cls.server.stop()
         if code != 0:
             raise AssertionError(f"covplan-server exited with {code}")
+
+    def shot(self, name):
+        """A screenshot of this step, kept as a test artefact."""
+        os.makedirs(ARGS.artifacts, exist_ok=True)
+        self.driver.save_screenshot(os.path.join(ARGS.artifacts, name + ".png"))
 
     def by_id(self, name):
         return self.driver.find_element(By.ID, name)
@@ -212,10 +223,17 @@ class ConsoleInTheBrowser(unittest.TestCase):
         return [tuple(float(v) for v in p.split(","))
                 for p in points.get_attribute("points").split()]
 
+
+
+class ConsoleInTheBrowser(Browser):
+    """Maps, plans, zones and errors on the page against the JSON API."""
+
     def test_the_page_draws_the_plan_the_api_returns(self):
         office = self.upload_office()
         self.assertIn("map", self.status())
+        self.shot("1_map_open")
         plan = self.plan()
+        self.shot("2_plan_drawn")
         self.assertEqual(plan["mapId"], office["mapId"])
         ranks = plan.get("ranks", [])
         num_ranks = int(plan["stats"]["numRanks"])
@@ -324,6 +342,7 @@ class ConsoleInTheBrowser(unittest.TestCase):
         self.assertAlmostEqual(min(xs), cx - half, delta=0.1)
         self.assertAlmostEqual(max(ys), cy + half, delta=0.1)
         zoned = self.plan(previous=free_plan["planId"])
+        self.shot("3_no_go_zone_planned")
         # Nothing swept inside the zone (a tool half-width from its edges),
         # and fewer cells covered than without it.
         inside = segments_inside(zoned["path"], (min(xs), min(ys), max(xs), max(ys)),
@@ -356,13 +375,75 @@ class ConsoleInTheBrowser(unittest.TestCase):
         self.by_id("upload-button").click()
         self.wait.until(lambda d: "error" in (d.find_element(By.ID, "status").get_attribute("class") or ""))
         self.assertIn("INVALID_ARGUMENT", self.status())
+        self.shot("4_bad_upload")
         self.assertEqual(self.server.call("ListMaps", {}).get("maps", []), before)
+
+
+class LiveRobotInTheBrowser(Browser):
+    """The live view, against a robot simulated through the same server."""
+
+    def test_a_robot_driving_through_the_server_is_seen_live(self):
+        before = {m["mapId"] for m in self.server.call("ListMaps", {}).get("maps", [])}
+        log = open(os.path.join(self.server.dir, "simulate.log"), "w+")
+        sim = subprocess.Popen(
+            [ARGS.client, "simulate", "--map", os.path.join(ROOT, "maps", "small_rooms.yaml"),
+             "--clutter", "5", "--seed", "3", "--server", f"127.0.0.1:{self.server.grpc_port}",
+             "--watch", "10"], stdout=log, stderr=subprocess.STDOUT)
+        try:
+            map_id = None
+            deadline = time.monotonic() + 60
+            while map_id is None and time.monotonic() < deadline and sim.poll() is None:
+                new = [m["mapId"] for m in self.server.call("ListMaps", {}).get("maps", [])
+                       if m["mapId"] not in before]
+                map_id = new[0] if new else None
+                time.sleep(0.2)
+            log.seek(0)
+            self.assertIsNotNone(map_id, "simulate stored no map: " + log.read()[-2000:])
+            self.open_console()
+            self.driver.find_element(By.CSS_SELECTOR, f'li[data-map-id="{map_id}"]').click()
+            self.wait.until(lambda d: d.find_element(By.ID, "plan-form").is_displayed())
+            # The marker moves: five different positions, each a reported one.
+            positions = []
+            deadline = time.monotonic() + 60
+            while len(set(positions)) < 5 and time.monotonic() < deadline:
+                markers = self.driver.find_elements(By.CSS_SELECTOR, "#live circle.robot")
+                if markers and markers[0].get_attribute("cx") is not None:
+                    positions.append((markers[0].get_attribute("cx"), markers[0].get_attribute("cy")))
+                time.sleep(0.15)
+            self.assertGreaterEqual(len(set(positions)), 5, f"the marker sat at {set(positions)}")
+            info = self.server.call("GetMap", {"mapId": map_id})["info"]
+            x0, y0 = info.get("originXM", 0.0), info.get("originYM", 0.0)
+            w, h = info["widthPx"] * info["resolution"], info["heightPx"] * info["resolution"]
+            for cx, cy in set(positions):
+                self.assertTrue(x0 <= float(cx) <= x0 + w and y0 <= float(cy) <= y0 + h, (cx, cy))
+            self.shot("5_live_robot")
+            # A replan (the clutter is found) shows in the log, with its method.
+            try:
+                WebDriverWait(self.driver, 90).until(lambda d: d.find_elements(
+                    By.CSS_SELECTOR, '#live-log li[data-kind="replan"]'))
+            except TimeoutException:
+                log.seek(0)
+                self.fail("no replan shown; simulate: " + log.read()[-2000:])
+            entry = self.driver.find_element(By.CSS_SELECTOR, '#live-log li[data-kind="replan"]').text
+            self.assertRegex(entry, r"replanned.*: \S+, \d+ ms")
+            rows = self.driver.find_elements(By.CSS_SELECTOR, "#live-robots li")
+            self.assertEqual(len(rows), 1)
+            self.assertRegex(rows[0].text, r"\d+ % of its plan, about \d+ s left")
+            self.shot("6_live_replan")
+            print(f"\n  marker at {len(set(positions))} positions; log: {entry}", file=sys.stderr)
+        finally:
+            sim.kill()
+            sim.wait()
+            log.close()
 
 
 def main():
     global ARGS
     parser = argparse.ArgumentParser()
     parser.add_argument("--server", required=True, help="the covplan-server binary")
+    parser.add_argument("--client", required=True, help="the covplan binary (simulate --watch)")
+    parser.add_argument("--artifacts", default=os.path.join(tempfile.gettempdir(), "covplan-console"),
+                        help="where each step's screenshot goes")
     ARGS, rest = parser.parse_known_args()
     missing = [what for what, ok in (("python3-selenium", webdriver is not None),
                                      ("chromium", os.access(CHROMIUM, os.X_OK)),
