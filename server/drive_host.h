@@ -66,8 +66,8 @@ class DriveHost {
   // True when someone watches the map's live events (server/live_events.h).
   virtual bool Watched(const std::string& map_id) { return false; }
   // A live event of a session's robot (map, session and plan set): the host
-  // adds its fleet mission and the time and publishes it. Called without any
-  // session's lock held.
+  // adds its fleet mission and the time and publishes it. Called under the
+  // session's lock: it must never call into a session.
   virtual void Live(const v1::LiveEvent& event) {}
   // The session's robot drives `plan_id` now instead of `previous` (a
   // replan or a mission's plan pushed): its fleet mission follows.

@@ -34,7 +34,6 @@ struct DriveSession::Actions {
   bool share = false;  // `shared` was seen by this session's robot, for its mission
   v1::Obstacles shared;
   std::vector<std::pair<std::string, std::string>> adopted;  // previous plan, new plan
-  std::vector<v1::LiveEvent> live;                           // for the map's watchers
 };
 
 DriveSession::DriveSession(DriveHost* host, grpc::CallbackServerContext* context,
@@ -67,7 +66,6 @@ void DriveSession::Perform(const Actions& a) {
     }
     host_->ShareObstacles(plans, a.shared);
   }
-  for (const v1::LiveEvent& e : a.live) host_->Live(e);
   if (a.write != nullptr) StartWrite(a.write);
   if (a.read) StartRead(&in_);
   if (a.finish) Finish(a.status);  // may delete this (through OnDone): last
@@ -118,16 +116,15 @@ void DriveSession::OnCancel() {
 
 void DriveSession::OnDone() {
   LogLine("info", "drive session ended", {{"session", session_id_}});
-  Actions a;
   {
     absl::MutexLock lock(&mu_);
-    if (v1::LiveEvent* e = LiveEventLocked(&a)) {
+    if (v1::LiveEvent e; LiveEventLocked(&e)) {
       const int code = ending_ ? static_cast<int>(end_status_.error_code()) : 0;
-      e->mutable_ended()->set_status(
+      e.mutable_ended()->set_status(
           CodeName(absl::Status(static_cast<absl::StatusCode>(code), "")));
+      host_->Live(e);
     }
   }
-  for (const v1::LiveEvent& e : a.live) host_->Live(e);
   registry_->Remove(this);
   host_->UpdateSessionGauge();
   Unref();
@@ -178,7 +175,7 @@ void DriveSession::CheckFinish(Actions* a) {
 }
 
 void DriveSession::Push(v1::DriveEvent event, Actions* a) {
-  if (ending_) return;
+  if (ending_ || finished_) return;  // finished: the call is over (OnDone comes)
   out_.push_back(std::move(event));
   if (!writing_) {
     writing_ = true;
@@ -254,7 +251,11 @@ void DriveSession::HandleMessage(Actions* a) {
       if (plan_id.empty() && first_.plan_ref_case() == v1::DriveRequest::kPlanId)
         plan_id = first_.plan_id();
       if (!plan_id.empty()) host_->RecordProgress(plan_id, in_.progress());
-      if (v1::LiveEvent* e = LiveEventLocked(a)) *e->mutable_progress() = in_.progress();
+      if (v1::LiveEvent e; LiveEventLocked(&e)) {
+        if (!plan_id.empty()) e.set_plan_id(plan_id);  // as far as the robot knows
+        *e.mutable_progress() = in_.progress();
+        host_->Live(e);
+      }
     }
     return;
   }
@@ -277,9 +278,15 @@ void DriveSession::HandleMessage(Actions* a) {
   }
   seen_.MergeFrom(in_.obstacles());
   seen_items_ += items;
-  if (v1::LiveEvent* e = LiveEventLocked(a)) *e->mutable_obstacles() = in_.obstacles();
-  if (in_.has_progress()) {
-    if (v1::LiveEvent* e = LiveEventLocked(a)) *e->mutable_progress() = in_.progress();
+  if (v1::LiveEvent e; LiveEventLocked(&e)) {
+    if (!plan_id.empty()) e.set_plan_id(plan_id);
+    *e.mutable_obstacles() = in_.obstacles();
+    host_->Live(e);
+    if (in_.has_progress()) {
+      e.clear_obstacles();
+      *e.mutable_progress() = in_.progress();
+      host_->Live(e);
+    }
   }
   Job job;
   job.sequence = seq;
@@ -309,27 +316,29 @@ void DriveSession::Enqueue(Job job, bool keep_running, Actions* a) {
   if (!running_) StartJob(a);
 }
 
-v1::LiveEvent* DriveSession::LiveEventLocked(Actions* a) {
-  if (map_id_.empty() || !host_->Watched(map_id_)) return nullptr;
-  v1::LiveEvent& e = a->live.emplace_back();
-  e.set_map_id(map_id_);
-  e.set_session_id(session_id_);
-  if (!plans_.empty()) e.set_plan_id(plans_.back());
-  return &e;
+bool DriveSession::LiveEventLocked(v1::LiveEvent* e) {
+  if (map_id_.empty() || !host_->Watched(map_id_)) return false;
+  e->set_map_id(map_id_);
+  e->set_session_id(session_id_);
+  if (!plans_.empty()) e->set_plan_id(plans_.back());
+  return true;
 }
 
 void DriveSession::Adopt(const std::string& plan_id) {
-  const std::string previous = plans_.empty() ? "" : plans_.back();
   plans_.push_back(plan_id);
-  while (plans_.size() > kMaxSessionPlans) plans_.pop_front();
-  registry_->Track(this, previous, plan_id);
+  while (plans_.size() > kMaxSessionPlans) {
+    registry_->Untrack(this, plans_.front());
+    plans_.pop_front();
+  }
+  registry_->Track(this, plan_id);
 }
 
 bool DriveSession::PushMissionPlan(const std::string& plan_id, const v1::DriveEvent& event) {
   Actions a;
   {
     absl::MutexLock lock(&mu_);
-    if (ending_ || !adopted_ || plans_.empty() || plans_.back() != plan_id) return false;
+    if (ending_ || finished_ || !adopted_ || plans_.empty() || plans_.back() != plan_id)
+      return false;
     ++generation_;  // results of jobs queued before are stale now
     if (running_ && !running_start_) running_stop_.Cancel();
     std::vector<uint64_t> superseded;
@@ -341,11 +350,12 @@ bool DriveSession::PushMissionPlan(const std::string& plan_id, const v1::DriveEv
     const std::string& fresh = event.replan().plan().plan_id();
     const std::string previous = plans_.back();
     Adopt(fresh);
-    if (v1::LiveEvent* e = LiveEventLocked(&a)) {
-      v1::LiveReplan* r = e->mutable_replan();
+    if (v1::LiveEvent e; LiveEventLocked(&e)) {
+      v1::LiveReplan* r = e.mutable_replan();
       r->set_previous_plan_id(previous);
       *r->mutable_replan() = event.replan().replan();
       *r->mutable_mission() = event.mission();
+      host_->Live(e);
     }
     v1::DriveEvent pushed = event;
     pushed.set_sequence(0);
@@ -370,7 +380,8 @@ void DriveSession::ShareObservation(const std::string& plan_id, const v1::Obstac
     absl::MutexLock lock(&mu_);
     // `plan_id` is the plan the mission holds for this robot: this one, or
     // one it replaced whose successor the mission does not know yet.
-    if (ending_ || !adopted_ || std::find(plans_.begin(), plans_.end(), plan_id) == plans_.end())
+    if (ending_ || finished_ || !adopted_ ||
+        std::find(plans_.begin(), plans_.end(), plan_id) == plans_.end())
       return;
     const int items = ObstacleItems(obstacles);
     if (items == 0 || seen_items_ + items > kMaxObstacleItems) return;
@@ -398,7 +409,7 @@ absl::Status DriveSession::CheckObservation(const v1::Obstacles& obstacles) cons
 }
 
 void DriveSession::StartJob(Actions* a) {
-  if (!pending_.has_value() || running_ || ending_) return;
+  if (!pending_.has_value() || running_ || ending_ || finished_) return;
   Job job = std::move(*pending_);
   pending_.reset();
   if (!job.start && job.plan_id.empty() && !plans_.empty()) job.plan_id = plans_.back();
@@ -481,7 +492,10 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
         grid_ = grid;
         map_id_ = map_id;
         Adopt(adopted);
-        if (v1::LiveEvent* e = LiveEventLocked(&a)) e->mutable_started();
+        if (v1::LiveEvent e; LiveEventLocked(&e)) {
+          e.mutable_started();
+          host_->Live(e);
+        }
         Push(std::move(event), &a);
       }
     } else if (pending_.has_value() || job.generation != generation_) {
@@ -500,12 +514,13 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     } else {
       a.adopted.emplace_back(plans_.back(), event.replan().plan().plan_id());
       Adopt(event.replan().plan().plan_id());
-      if (v1::LiveEvent* e = LiveEventLocked(&a)) {
-        v1::LiveReplan* r = e->mutable_replan();
+      if (v1::LiveEvent e; LiveEventLocked(&e)) {
+        v1::LiveReplan* r = e.mutable_replan();
         r->set_previous_plan_id(a.adopted.back().first);
         *r->mutable_replan() = event.replan().replan();
         r->set_compute_ms(compute_ms);
         if (job.notice.has_value()) *r->mutable_mission() = *job.notice;
+        host_->Live(e);
       }
       for (uint64_t s : job.superseded) event.add_superseded(s);
       if (job.notice.has_value()) *event.mutable_mission() = *job.notice;
@@ -515,86 +530,6 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     CheckFinish(&a);
   }
   Perform(a);
-}
-
-// ---------------------------------------------------------------- registry
-
-SessionRegistry::SessionRegistry(int max_sessions, absl::Duration idle_timeout)
-    : max_sessions_(max_sessions), idle_timeout_(idle_timeout), reaper_([this] { Reap(); }) {}
-
-SessionRegistry::~SessionRegistry() {
-  {
-    absl::MutexLock lock(&mu_);
-    stop_ = true;
-  }
-  reaper_.join();
-}
-
-bool SessionRegistry::Add(DriveSession* session) {
-  absl::MutexLock lock(&mu_);
-  if (static_cast<int>(sessions_.size()) >= max_sessions_) return false;
-  sessions_.insert(session);
-  return true;
-}
-
-void SessionRegistry::Remove(DriveSession* session) {
-  absl::MutexLock lock(&mu_);
-  sessions_.erase(session);
-  for (auto it = by_plan_.begin(); it != by_plan_.end();) {
-    it = it->second == session ? by_plan_.erase(it) : std::next(it);
-  }
-}
-
-DriveSession* SessionRegistry::Find(const std::string& plan_id) {
-  absl::MutexLock lock(&mu_);
-  auto it = by_plan_.find(plan_id);
-  if (it == by_plan_.end()) return nullptr;
-  it->second->Ref();
-  return it->second;
-}
-
-void SessionRegistry::Track(DriveSession* session, const std::string& previous,
-                            const std::string& plan_id) {
-  absl::MutexLock lock(&mu_);
-  if (!sessions_.count(session)) return;  // removed (or never admitted)
-  if (auto it = by_plan_.find(previous); it != by_plan_.end() && it->second == session) {
-    by_plan_.erase(it);
-  }
-  by_plan_[plan_id] = session;
-}
-
-int SessionRegistry::size() const {
-  absl::MutexLock lock(&mu_);
-  return static_cast<int>(sessions_.size());
-}
-
-std::vector<DriveSession*> SessionRegistry::Snapshot() {
-  absl::MutexLock lock(&mu_);
-  std::vector<DriveSession*> out(sessions_.begin(), sessions_.end());
-  for (DriveSession* s : out) s->Ref();  // kept alive while inspected
-  return out;
-}
-
-void SessionRegistry::EndAll() {
-  for (DriveSession* s : Snapshot()) {
-    s->End(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
-    s->Unref();
-  }
-}
-
-void SessionRegistry::Reap() {
-  const absl::Duration tick = std::min(absl::Seconds(1), idle_timeout_ / 4);
-  for (;;) {
-    {
-      absl::MutexLock lock(&mu_);
-      if (mu_.AwaitWithTimeout(absl::Condition(&stop_), tick)) return;
-    }
-    const absl::Time idle_before = absl::Now() - idle_timeout_;
-    for (DriveSession* s : Snapshot()) {
-      s->ExpireIfIdle(idle_before);
-      s->Unref();
-    }
-  }
 }
 
 }  // namespace covplan

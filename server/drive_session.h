@@ -117,9 +117,11 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   void Enqueue(Job job, bool keep_running, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   // The session drives `plan_id` now (newest last; the registry's index).
   void Adopt(const std::string& plan_id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  // A LiveEvent of this robot added to `a` (map, session and plan set), or
-  // null when nobody watches its map (or no plan is adopted yet).
-  v1::LiveEvent* LiveEventLocked(Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Starts a LiveEvent of this robot in `e` (map, session, current plan);
+  // false when nobody watches its map (or no plan is adopted yet). Events
+  // are published under mu_ (host_->Live), so watchers see them in the
+  // order the session changed; the host never calls back into a session.
+  bool LiveEventLocked(v1::LiveEvent* e) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void RunJob(const Job& job, const v1::DriveRequest& first, const v1::Obstacles& seen,
               const StopToken& stop);
   void Push(v1::DriveEvent event, Actions* a) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
@@ -177,11 +179,13 @@ class SessionRegistry {
   bool Add(DriveSession* session);
   void Remove(DriveSession* session);
   int size() const;
-  // The session whose newest plan is `plan_id`, with a reference the caller
-  // drops (Unref); null when none.
+  // The session that drives or drove `plan_id` (one of its recent plans),
+  // with a reference the caller drops (Unref); null when none.
   DriveSession* Find(const std::string& plan_id);
-  // `session` drives `plan_id` now instead of `previous` ("" = none).
-  void Track(DriveSession* session, const std::string& previous, const std::string& plan_id);
+  // `session` drives `plan_id` now (its earlier plans stay found until
+  // Untrack: a fleet mission may still name one).
+  void Track(DriveSession* session, const std::string& plan_id);
+  void Untrack(DriveSession* session, const std::string& plan_id);
   absl::Duration idle_timeout() const { return idle_timeout_; }
   // Ends every open session with UNAVAILABLE (the server is draining).
   void EndAll();
