@@ -36,7 +36,7 @@ struct SimulateRemoteFlags {
   std::optional<double> resolution, free_thresh, occupied_thresh;
   bool negate = false;
   // --watch SPEED: the robot drives at SPEED times real time and reports its
-  // progress on the Drive session (at most 10 times a second), so a person
+  // progress on the Drive session (at most 20 times a second), so a person
   // can watch it in the web console; 0 = as fast as it computes, unreported.
   double watch_speed = 0.0;
 };

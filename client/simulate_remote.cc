@@ -1,5 +1,6 @@
 #include "client/simulate_remote.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -91,19 +92,24 @@ class ServerPlanSource final : public PlanSource {
 
   bool WatchesMoves() const override { return watch_speed_ > 0.0; }
 
-  // Paced: the run's clock at watch_speed_ times real time; reported at most
-  // every 100 ms (a failed report ends nothing: the next replan says).
+  // Paced: the run's clock at watch_speed_ times real time. Like a real
+  // robot it reports at a steady 20 Hz, turning in place or driving (a
+  // failed report ends nothing: the next replan says).
   void Moved(const RobotProgress& at, double clock_s) override {
     if (session_ == nullptr) return;
     const absl::Time due = started_ + absl::Seconds(clock_s / watch_speed_);
-    if (const absl::Time now = absl::Now(); due > now) absl::SleepFor(due - now);
-    if (absl::Now() - last_report_ < absl::Milliseconds(100)) return;
-    last_report_ = absl::Now();
-    v1::DriveRequest report;
-    report.set_sequence(next_sequence_++);
-    report.set_plan_id(current_plan_id_);
-    ProgressToProto(at, report.mutable_progress());
-    session_->Report(report).IgnoreError();
+    for (absl::Time now = absl::Now();; now = absl::Now()) {
+      if (now >= next_report_) {
+        v1::DriveRequest report;
+        report.set_sequence(next_sequence_++);
+        report.set_plan_id(current_plan_id_);
+        ProgressToProto(at, report.mutable_progress());
+        session_->Report(report).IgnoreError();
+        next_report_ = now + absl::Milliseconds(50);
+      }
+      if (now >= due) return;
+      absl::SleepFor(std::min(due, next_report_) - now);
+    }
   }
 
  private:
@@ -112,7 +118,7 @@ class ServerPlanSource final : public PlanSource {
   const v1::ReplanMethod method_;
   const uint32_t seed_;
   const double watch_speed_;  // 0: not watched
-  absl::Time started_, last_report_ = absl::InfinitePast();
+  absl::Time started_, next_report_ = absl::InfinitePast();
   std::unique_ptr<RemotePlanner::DriveSession> session_;
   std::string current_plan_id_;
   uint64_t next_sequence_ = 1;

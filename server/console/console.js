@@ -355,6 +355,10 @@ async function plan() {
   const drawn = performance.now();
   $('view').dataset.planId = state.plan.planId;
   $('view').dataset.drawMs = (drawn - drawStart).toFixed(1);
+  // The frame after the one that painted it (two animation frames on).
+  requestAnimationFrame(() => requestAnimationFrame(() => {
+    $('view').dataset.paintMs = (performance.now() - drawStart).toFixed(1);
+  }));
   setStatus(`plan ${state.plan.planId.slice(0, 12)}: ${((drawn - started) / 1000).toFixed(2)} s`);
 }
 
@@ -446,7 +450,7 @@ function showError(e) {
 let live = null;
 
 function main() {
-  live = createLiveView({ api, svgEl, token: () => state.token });
+  live = createLiveView({ api, svgEl, token: () => state.token, setStatus });
   setUpPanZoom();
   $('draw-nogo').onclick = () => startZone('nogo');
   $('draw-region').onclick = () => startZone('region');

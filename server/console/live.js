@@ -17,7 +17,12 @@
 const COLOURS = ['#cf222e', '#1a7f37', '#8250df', '#bc4c00', '#0550ae', '#bf3989', '#116329', '#953800'];
 const $ = (id) => document.getElementById(id);
 
-export function createLiveView({ api, svgEl, token }) {
+// A stream the server refused for good (401, 403, 404): not retried.
+class Refused extends Error {}
+
+const MAX_TRACK_POINTS = 5000;  // per robot; older points are thinned out
+
+export function createLiveView({ api, svgEl, token, setStatus }) {
   let controller = null;
   let robots = new Map();  // session id -> robot
   let mapId = null;
@@ -53,6 +58,7 @@ export function createLiveView({ api, svgEl, token }) {
     r.grid = p.grid;
     r.duration = p.stats.estimatedDurationS || 0;
     r.plan.setAttribute('points', p.path.map((w) => `${w.x || 0},${w.y || 0}`).join(' '));
+    r.g.dataset.planId = planId;  // the plan drawn
     r.trail.setAttribute('stroke-width', p.grid.cellSizeM);
     showRow(r, null);
   }
@@ -98,8 +104,11 @@ export function createLiveView({ api, svgEl, token }) {
       r.marker.setAttribute('cx', x);
       r.marker.setAttribute('cy', y);
       r.marker.dataset.moves = Number(r.marker.dataset.moves) + 1;
-      r.points.push(`${x},${y}`);
-      r.trail.setAttribute('points', r.points.join(' '));
+      r.marker.dataset.time = e.timeUnixS;  // when the server saw it (lag = now - this)
+      const last = r.points[r.points.length - 1];
+      if (!last || Math.hypot(last[0] - x, last[1] - y) > 0.02) r.points.push([x, y]);
+      if (r.points.length > MAX_TRACK_POINTS) r.points = r.points.filter((_, i) => i % 2 === 0);
+      r.trail.setAttribute('points', r.points.map((p) => p.join(',')).join(' '));
       showRow(r, e.progress);
     }
     if (e.obstacles) {
@@ -128,21 +137,29 @@ export function createLiveView({ api, svgEl, token }) {
     const headers = {};
     if (token()) headers.Authorization = `Bearer ${token()}`;
     const reply = await fetch(`/v1/events?map_id=${encodeURIComponent(id)}`, { headers, signal });
+    if ([401, 403, 404].includes(reply.status)) {
+      const body = await reply.json().catch(() => ({}));
+      throw new Refused(`live events: ${body.status || reply.status}: ${body.message || ''}`);
+    }
     if (!reply.ok) throw new Error(`live events: HTTP ${reply.status}`);
     const reader = reply.body.pipeThrough(new TextDecoderStream()).getReader();
     let buffer = '';
-    for (;;) {
-      const { value, done } = await reader.read();
-      if (done) return;
-      buffer += value;
-      let end;
-      while ((end = buffer.indexOf('\n\n')) >= 0) {
-        const block = buffer.slice(0, end);
-        buffer = buffer.slice(end + 2);
-        for (const line of block.split('\n')) {
-          if (line.startsWith('data: ')) handle(JSON.parse(line.slice(6)));
+    try {
+      for (;;) {
+        const { value, done } = await reader.read();
+        if (done) return;
+        buffer = (buffer + value).replace(/\r\n?/g, '\n');
+        let end;
+        while ((end = buffer.indexOf('\n\n')) >= 0) {
+          const block = buffer.slice(0, end);
+          buffer = buffer.slice(end + 2);
+          for (const line of block.split('\n')) {
+            if (line.startsWith('data: ')) handle(JSON.parse(line.slice(6)));
+          }
         }
       }
+    } finally {
+      reader.cancel().catch(() => {});
     }
   }
 
@@ -162,6 +179,10 @@ export function createLiveView({ api, svgEl, token }) {
           await read(id, signal);
         } catch (err) {
           if (signal.aborted) return;
+          if (err instanceof Refused) {
+            setStatus(err.message, true);
+            return;
+          }
         }
         await new Promise((resolve) => setTimeout(resolve, 2000));  // then reconnect
       }

@@ -20,118 +20,22 @@ Exit code 77 (ctest: skipped) when Chromium, chromedriver or Selenium are
 missing and CI is not set; under CI=true they are required (install-deps).
 """
 import argparse
-import json
 import os
-import shutil
-import socket
 import subprocess
 import sys
 import tempfile
 import time
 import unittest
-import urllib.error
-import urllib.request
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SKIP = 77
-CHROMIUM = "/usr/bin/chromium"
-CHROMEDRIVER = "/usr/bin/chromedriver"
-ARGS = None
+from harness import (ROOT, SKIP, Server, chromium, missing_tools, screenshot_pixels, webdriver)
 
-try:
-    from selenium import webdriver
+if webdriver is not None:
     from selenium.common.exceptions import TimeoutException
-    from selenium.webdriver.chrome.service import Service
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import WebDriverWait
-except ImportError:  # reported by main()
-    webdriver = None
 
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-class Server:
-    """covplan-server on free ports with a store of its own."""
-
-    def __init__(self, binary):
-        self.dir = tempfile.mkdtemp(prefix="covplan-console-")
-        self.grpc_port, self.http_port = free_port(), free_port()
-        self.log = open(os.path.join(self.dir, "server.log"), "w+")
-        self.proc = subprocess.Popen(
-            [binary, f"--port={self.grpc_port}", "--metrics_port=-1",
-             f"--http_port={self.http_port}", f"--store_dir={self.dir}/maps", "--threads=2"],
-            stdout=self.log, stderr=subprocess.STDOUT)
-        deadline = time.monotonic() + 60
-        while True:
-            if self.proc.poll() is not None:
-                raise RuntimeError("covplan-server exited: " + self.output())
-            try:
-                self.call("ListMaps", {})
-                return
-            except (urllib.error.URLError, ConnectionError):
-                if time.monotonic() > deadline:
-                    raise RuntimeError("covplan-server did not answer: " + self.output())
-                time.sleep(0.2)
-
-    @property
-    def url(self):
-        return f"http://127.0.0.1:{self.http_port}/"
-
-    def call(self, method, body):
-        request = urllib.request.Request(
-            f"{self.url}v1/{method}", data=json.dumps(body).encode(),
-            headers={"Content-Type": "application/json"}, method="POST")
-        with urllib.request.urlopen(request, timeout=60) as reply:
-            return json.load(reply)
-
-    def output(self):
-        self.log.seek(0)
-        return self.log.read()[-4000:]
-
-    def stop(self):
-        self.proc.terminate()
-        try:
-            code = self.proc.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            code = self.proc.wait()
-        self.log.close()
-        shutil.rmtree(self.dir, ignore_errors=True)
-        return code
-
-
-def chromium():
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--window-size=1280,900", "--force-device-scale-factor=1"):
-        options.add_argument(arg)
-    return webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
-
-
-def screenshot_pixels(driver):
-    """The page's screenshot as (width, height, rgb bytes), decoded with
-    Chromium itself (no imaging package needed): a canvas in the page."""
-    png = driver.get_screenshot_as_base64()
-    return driver.execute_async_script(
-        """
-        const [png, done] = arguments;
-        const img = new Image();
-        img.onload = () => {
-          const c = document.createElement('canvas');
-          c.width = img.width; c.height = img.height;
-          const g = c.getContext('2d');
-          g.drawImage(img, 0, 0);
-          const d = g.getImageData(0, 0, c.width, c.height).data;
-          done({w: c.width, h: c.height, rgba: Array.from(d)});
-        };
-        img.src = 'data:image/png;base64,' + png;
-        """, png)
+ARGS = None
 
 
 def cell_centre(grid, cell):
@@ -388,7 +292,7 @@ class LiveRobotInTheBrowser(Browser):
         sim = subprocess.Popen(
             [ARGS.client, "simulate", "--map", os.path.join(ROOT, "maps", "small_rooms.yaml"),
              "--clutter", "5", "--seed", "3", "--server", f"127.0.0.1:{self.server.grpc_port}",
-             "--watch", "10"], stdout=log, stderr=subprocess.STDOUT)
+             "--watch", "5"], stdout=log, stderr=subprocess.STDOUT)
         try:
             map_id = None
             deadline = time.monotonic() + 60
@@ -425,10 +329,24 @@ class LiveRobotInTheBrowser(Browser):
                 log.seek(0)
                 self.fail("no replan shown; simulate: " + log.read()[-2000:])
             entry = self.driver.find_element(By.CSS_SELECTOR, '#live-log li[data-kind="replan"]').text
-            self.assertRegex(entry, r"replanned.*: \S+, \d+ ms")
+            self.assertRegex(entry, r"replanned.*: (auto/)?[a-z0-9_]+, \d+ ms, \d+ encounters")
             rows = self.driver.find_elements(By.CSS_SELECTOR, "#live-robots li")
             self.assertEqual(len(rows), 1)
             self.assertRegex(rows[0].text, r"\d+ % of its plan, about \d+ s left")
+            # The robot's plan drawn is the one the API holds under the id it shows.
+            WebDriverWait(self.driver, 30).until(lambda d: d.find_element(
+                By.CSS_SELECTOR, "#live g.live-robot").get_attribute("data-plan-id"))
+            robot = self.driver.find_element(By.CSS_SELECTOR, "#live g.live-robot")
+            shown = robot.get_attribute("data-plan-id")
+            drawn = [tuple(float(v) for v in p.split(",")) for p in robot.find_element(
+                By.CSS_SELECTOR, "polyline.live-plan").get_attribute("points").split()]
+            path = self.server.call("GetPlan", {"planId": shown})["path"]
+            self.assertEqual(len(drawn), len(path))
+            for (x, y), w in zip(drawn, path):
+                self.assertAlmostEqual(x, w.get("x", 0.0), places=6)
+                self.assertAlmostEqual(y, w.get("y", 0.0), places=6)
+            left = int(rows[0].text.split("about ")[1].split(" s")[0])
+            self.assertGreater(left, 0, "the time left needs the plan's duration")
             self.shot("6_live_replan")
             print(f"\n  marker at {len(set(positions))} positions; log: {entry}", file=sys.stderr)
         finally:
@@ -445,9 +363,7 @@ def main():
     parser.add_argument("--artifacts", default=os.path.join(tempfile.gettempdir(), "covplan-console"),
                         help="where each step's screenshot goes")
     ARGS, rest = parser.parse_known_args()
-    missing = [what for what, ok in (("python3-selenium", webdriver is not None),
-                                     ("chromium", os.access(CHROMIUM, os.X_OK)),
-                                     ("chromium-driver", os.access(CHROMEDRIVER, os.X_OK))) if not ok]
+    missing = missing_tools()
     if missing:
         print("console browser test: missing " + ", ".join(missing) + " (scripts/install-deps.sh)")
         return 1 if os.environ.get("CI") == "true" else SKIP

@@ -230,17 +230,17 @@ TEST_F(LiveStreamTest, AWatcherSeesTheRobotDriveReportGetItsNewPlanAndEnd) {
 TEST_F(LiveStreamTest, OnlyCallersWhoMayReadTheMapWatchIt) {
   const std::string map_id = PutTwoRooms(kAlpha);
   // Another tenant's map is not found; no token is unauthenticated.
-  absl::StatusOr<HttpReply> other = HttpRequest(server_->http_port(), "GET",
-                                                "/v1/events?map_id=" + map_id,
-                                                {absl::StrCat("Authorization: Bearer ", kBeta)});
+  absl::StatusOr<HttpReply> other =
+      HttpRequest(server_->http_port(), "GET", "/v1/events?map_id=" + map_id,
+                  {absl::StrCat("Authorization: Bearer ", kBeta)});
   ASSERT_TRUE(other.ok()) << other.status();
   EXPECT_EQ(other->status, 404) << other->body;
   absl::StatusOr<HttpReply> anonymous =
       HttpRequest(server_->http_port(), "GET", "/v1/events?map_id=" + map_id);
   ASSERT_TRUE(anonymous.ok());
   EXPECT_EQ(anonymous->status, 401);
-  absl::StatusOr<HttpReply> no_map = HttpRequest(
-      server_->http_port(), "GET", "/v1/events", {absl::StrCat("Authorization: Bearer ", kAlpha)});
+  absl::StatusOr<HttpReply> no_map = HttpRequest(server_->http_port(), "GET", "/v1/events",
+                                                 {absl::StrCat("Authorization: Bearer ", kAlpha)});
   ASSERT_TRUE(no_map.ok());
   EXPECT_EQ(no_map->status, 400);
   EXPECT_NE(no_map->body.find("map_id"), std::string::npos) << no_map->body;
