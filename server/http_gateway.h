@@ -62,7 +62,7 @@ struct HttpGatewayOptions {
   int request_timeout_ms = 15000;
   // Threads serving requests; each open event stream holds one (the
   // service's max_live_streams bounds them).
-  int worker_threads = 12;
+  int worker_threads = 48;
 };
 
 class HttpGateway {
