@@ -138,9 +138,12 @@ void DriveHandler::Live(const v1::LiveEvent& event) {
   v1::LiveEvent e = event;
   e.set_time_unix_s(absl::ToDoubleSeconds(absl::Now() - absl::UnixEpoch()));
   if (missions_ != nullptr) {
-    if (std::optional<std::pair<FleetMission, size_t>> found =
-            missions_->MissionOfPlan(e.has_replan() ? e.replan().previous_plan_id() : e.plan_id());
-        found.has_value() || (found = missions_->MissionOfPlan(e.plan_id())).has_value()) {
+    // A replan's mission may still name the previous plan, or already the new one.
+    std::optional<std::pair<FleetMission, size_t>> found = missions_->MissionOfPlan(e.plan_id());
+    if (!found.has_value() && e.has_replan()) {
+      found = missions_->MissionOfPlan(e.replan().previous_plan_id());
+    }
+    if (found.has_value()) {
       e.set_mission_id(found->first.mission_id);
       e.set_robot_id(found->first.robot_ids[found->second]);
     }
