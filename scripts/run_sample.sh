@@ -4,8 +4,9 @@
 # services), plan the shipped sample map through the server, print the
 # figures and write plan.json and plan.svg; then plan the shipped office for
 # a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg;
-# last, list the stored maps over the JSON API (--http_port). With WATCH=1 it
-# then drives a simulated robot through the server at 10x real time (covplan
+# list the stored maps over the JSON API (--http_port); last, install the Python
+# client into .venv and run its examples (plan_py.json, plan_py.svg; a robot
+# driven through a Drive session). With WATCH=1 it then drives a simulated robot through the server at 10x real time (covplan
 # simulate --watch) to watch live in the web console, and stops when it ends.
 #   scripts/run_sample.sh [MAP] [extra `covplan plan` flags...]
 #   WATCH=1 scripts/run_sample.sh
@@ -57,6 +58,17 @@ echo "curl -X POST http://127.0.0.1:$HTTP_PORT/v1/ListMaps -d '{}':"
 curl -sS --max-time 10 -H 'Content-Type: application/json' -X POST \
   "http://127.0.0.1:$HTTP_PORT/v1/ListMaps" -d '{}' |
   /usr/bin/python3 -c 'import json,sys; m=json.load(sys.stdin)["maps"]; print(f"  {len(m)} maps:", ", ".join(x["mapId"][:12] + " " + x.get("name","") for x in m))'
+
+# The Python client (clients/python) against the same server: pip-installed into .venv on
+# Debian's python3-grpcio (scripts/python_env.sh), then its two examples (PYTHON=0 skips).
+if [ "${PYTHON:-1}" = 1 ]; then
+  VENV=$(bash scripts/python_env.sh .venv)
+  echo "python client: $VENV/bin/python clients/python/examples/plan_map.py"
+  "$VENV/bin/python" clients/python/examples/plan_map.py --server "127.0.0.1:$PORT" \
+    --map maps/sample_yard.geojson --no-go maps/sample_yard_no_go.geojson --out "$OUT_DIR/plan_py"
+  "$VENV/bin/python" clients/python/examples/drive_robot.py --server "127.0.0.1:$PORT" \
+    --map maps/sample_office.yaml
+fi
 
 # WATCH=1: a robot drives the furnished office through the server, live in the console.
 if [ "${WATCH:-0}" = 1 ]; then
