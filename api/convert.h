@@ -71,9 +71,13 @@ void PolygonsToProto(const std::vector<PolygonInput>& polygons,
 std::vector<PolygonInput> PolygonsFromProto(
     const google::protobuf::RepeatedPtrField<v1::Polygon>& polygons);
 
-// Fills everything but plan_id, map_id and the zones.
+// Fills everything but plan_id, map_id, the zones and the waypoints' times.
 void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out);
-// Everything, zones included.
+// What only the retained plan knows, over what PlanToProto wrote of its plan:
+// plan_id, map_id, the request's zones, and each waypoint's time_s on the
+// request's robot model.
+void RetainedPlanFieldsToProto(const RetainedPlan& plan, v1::PlanResponse* out);
+// Everything: PlanToProto, then RetainedPlanFieldsToProto.
 void RetainedPlanToProto(const RetainedPlan& plan, v1::PlanResponse* out);
 
 // The inverse (e.g. to render a server's answer as SVG). InvalidArgument on

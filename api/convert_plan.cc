@@ -17,6 +17,7 @@
 #include "planner/grid/grid.h"
 #include "planner/oarp/oarp_planner.h"
 #include "planner/partition/rank.h"
+#include "planner/tour/path_timing.h"
 
 namespace covplan {
 
@@ -460,12 +461,19 @@ void PlanToProto(const CoveragePlan& plan, v1::PlanResponse* out) {
   o->set_energy_lower_bound(s.energy_lower_bound);
 }
 
-void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
-  PlanToProto(retained.plan, out);
+void RetainedPlanFieldsToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
   out->set_plan_id(retained.plan_id);
   out->set_map_id(retained.map_id);
   PolygonsToProto(retained.request.regions, out->mutable_regions());
   PolygonsToProto(retained.request.no_go, out->mutable_no_go());
+  const std::vector<double> times = ArrivalTimes(retained.request.common.robot, retained.plan.path);
+  for (int i = 0; i < out->path_size() && i < static_cast<int>(times.size()); ++i)
+    out->mutable_path(i)->set_time_s(times[i]);
+}
+
+void RetainedPlanToProto(const RetainedPlan& retained, v1::PlanResponse* out) {
+  PlanToProto(retained.plan, out);
+  RetainedPlanFieldsToProto(retained, out);
 }
 
 absl::StatusOr<CoveragePlan> PlanFromProto(const v1::PlanResponse& response) {

@@ -93,12 +93,9 @@ void FleetHandlers::RetainRobotPlans(const CallInfo& call, const v1::PlanFleetRe
     retained->area = std::move(rp.result.area);
     retained->request = fleet.RobotRequest(i);
     retained->request.common.stop = StopToken();  // the call's token ends with the call
-    // FleetPlanToProto wrote the plan; add what RetainedPlanToProto adds.
+    // FleetPlanToProto wrote the plan; add what only the retained plan knows.
     v1::PlanResponse* out = response->mutable_robots(static_cast<int>(i))->mutable_plan();
-    out->set_plan_id(retained->plan_id);
-    out->set_map_id(map_id);
-    PolygonsToProto(retained->request.regions, out->mutable_regions());
-    PolygonsToProto(retained->request.no_go, out->mutable_no_go());
+    RetainedPlanFieldsToProto(*retained, out);
     // An idle robot's plan (no area) could not be rebuilt after a restart.
     if (stored_map && retained->area != nullptr) {
       archive_->Persist(FleetRobotPlanRequest(request, static_cast<int>(i)), *out);

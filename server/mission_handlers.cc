@@ -372,10 +372,7 @@ absl::Status MissionHandlers::KeepPlans(const CallInfo& call, const FleetMission
     retained->request.battery = robot.battery;
     retained->request.common.stop = StopToken();  // the call's token ends with the call
     v1::PlanResponse* out = response->mutable_robots(static_cast<int>(i))->mutable_plan();
-    out->set_plan_id(retained->plan_id);
-    out->set_map_id(mission.map_id);
-    PolygonsToProto(retained->request.regions, out->mutable_regions());
-    PolygonsToProto(retained->request.no_go, out->mutable_no_go());
+    RetainedPlanFieldsToProto(*retained, out);
     if (stored_map && retained->area != nullptr) {
       archive_->Persist(OriginFor(roster.origins[k], robot), *out);
     }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "planner/tour/path_timing.h"
+
 namespace covplan {
 namespace {
 
@@ -32,21 +34,11 @@ double DistanceAfter(const RobotModel& robot, double length, double t) {
 
 TimedPath::TimedPath(const std::vector<Waypoint>& path, const RobotModel& robot,
                      const std::vector<ChargeCycle>& cycles, double recharge_s)
-    : path_(path), robot_(robot) {
-  times_.assign(path.size(), 0.0);
+    : path_(path), times_(ArrivalTimes(robot, path, cycles, recharge_s)), robot_(robot) {
   depart_.assign(path.size(), 0.0);
-  std::vector<uint8_t> charge_at(path.size(), 0);
-  for (size_t c = 0; c + 1 < cycles.size(); ++c) {
-    const int w = cycles[c].last_waypoint;
-    if (w >= 0 && static_cast<size_t>(w) < path.size()) charge_at[w] = 1;
-  }
-  double t = 0.0;
   for (size_t i = 1; i < path.size(); ++i) {
-    if (charge_at[i - 1]) t += recharge_s;
-    t += robot.TurnTime(HeadingChange(path[i - 1].theta, path[i].theta));
-    depart_[i] = t;
-    t += robot.StraightTime(std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y));
-    times_[i] = t;
+    depart_[i] = times_[i] - robot.StraightTime(
+                                 std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y));
   }
 }
 

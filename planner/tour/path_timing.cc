@@ -1,6 +1,7 @@
 #include "planner/tour/path_timing.h"
 
 #include <cmath>
+#include <cstdint>
 
 namespace covplan {
 
@@ -30,6 +31,25 @@ PolylineTiming TimePolyline(const RobotModel& robot, const std::vector<Point2>& 
   t.time_s += t.turn_time_s;
   t.final_heading = heading.value_or(0.0);
   return t;
+}
+
+std::vector<double> ArrivalTimes(const RobotModel& robot, const std::vector<Waypoint>& path,
+                                 const std::vector<ChargeCycle>& cycles, double recharge_s) {
+  std::vector<double> times(path.size(), 0.0);
+  std::vector<uint8_t> charge_at(path.size(), 0);
+  for (size_t c = 0; c + 1 < cycles.size(); ++c) {
+    const int w = cycles[c].last_waypoint;
+    if (w >= 0 && static_cast<size_t>(w) < path.size()) charge_at[w] = 1;
+  }
+  double t = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) {
+    if (charge_at[i - 1]) t += recharge_s;
+    const double change = HeadingChange(path[i - 1].theta, path[i].theta);
+    if (change > kTurnEpsilonRad) t += robot.TurnTime(change);
+    t += robot.StraightTime(std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y));
+    times[i] = t;
+  }
+  return times;
 }
 
 }  // namespace covplan

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "planner/grid/occupancy_map.h"
+#include "planner/plan/coverage_plan.h"
 #include "planner/tour/robot_model.h"
 
 namespace covplan {
@@ -31,6 +32,15 @@ struct PolylineTiming {
 // adds the final turn onto it. Zero-length segments are skipped.
 PolylineTiming TimePolyline(const RobotModel& robot, const std::vector<Point2>& points,
                             std::optional<double> heading_in, std::optional<double> heading_out);
+
+// When the robot reaches each waypoint of `path`, from 0 at path[0]: at each
+// waypoint it turns in place onto the next segment's heading, then drives it
+// rest to rest (as PlanStats.estimated_duration_s counts, whose value is the
+// last entry). With `cycles` (a battery plan) it also waits `recharge_s` at
+// the station after every cycle but the last.
+std::vector<double> ArrivalTimes(const RobotModel& robot, const std::vector<Waypoint>& path,
+                                 const std::vector<ChargeCycle>& cycles = {},
+                                 double recharge_s = 0.0);
 
 }  // namespace covplan
 
