@@ -22,6 +22,7 @@
 #include "client/load_command.h"
 #include "client/partition_command.h"
 #include "client/plan_command.h"
+#include "client/plan_exports.h"
 #include "client/replan_command.h"
 #include "client/simulate_command.h"
 #include "client/simulate_fleet.h"
@@ -41,6 +42,7 @@ constexpr char kUsage[] =
     "  compare   plan one map with several planners and print one table (and JSON)\n"
     "  partition time the minimum rank partition alone on a map (one JSON object)\n"
     "  health exit 0 when a server's gRPC health check reports SERVING\n"
+    "  export a plan.json as GeoJSON, CSV waypoints or a nav_msgs/Path JSON\n"
     "Run 'covplan <command> --help' for its flags.\n";
 
 }  // namespace
@@ -66,6 +68,7 @@ int main(int argc, char** argv) {
   if (command == "compare") return covplan::RunCompareCommand(args);
   if (command == "partition") return covplan::RunPartitionCommand(args);
   if (command == "health") return covplan::RunHealthCommand(args);
+  if (command == "export") return covplan::RunExportCommand(args);
   if (command == "--help" || command == "-h" || command == "help") {
     std::fputs(kUsage, stdout);
     return 0;

@@ -21,6 +21,7 @@
 #include "client/fleet_plan.h"
 #include "client/local_engine.h"
 #include "client/map_flags.h"
+#include "client/plan_exports.h"
 #include "client/remote.h"
 #include "planner/common/status_macros.h"
 #include "planner/engine/engine.h"
@@ -64,6 +65,8 @@ constexpr char kUsage[] =
     "                     [--interruptible [--atomic-units ID,ID...]]]\n"
     "                    [--robot [ID=]X,Y[,THETA]]... | [--robots K]   (a fleet)\n"
     "                    [--division makespan|equal_area] [--clearance M]\n"
+    "                    [--out-geojson FILE] [--out-csv FILE]\n"
+    "                    [--out-nav-path FILE [--frame-id ID] [--nav-stamp UNIX_S]]\n"
     "--algorithm is another name for --planner. The --stc-* flags and --sweep-direction\n"
     "set the stc planner's options (--sweep-direction: the prim tree only).\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
@@ -84,7 +87,12 @@ constexpr char kUsage[] =
     "early; equal_area gives each robot as many cells. --clearance M (default the tool\n"
     "width) is the distance the safety report counts robots coming closer than. Prints\n"
     "one line per robot and the fleet's makespan, lower bound and gap; --out writes the\n"
-    "fleet JSON (each robot's plan as plan.json), --svg one picture of every robot.\n";
+    "fleet JSON (each robot's plan as plan.json), --svg one picture of every robot.\n"
+    "Exports (one robot's plan; a fleet's with covplan export): --out-geojson a GeoJSON\n"
+    "FeatureCollection in the map frame (the path with per-vertex times_s and\n"
+    "headings_rad, ranks, charge cycles, zones); --out-csv x,y,heading_rad,time_s,kind,rank\n"
+    "per waypoint; --out-nav-path a nav_msgs/Path as JSON (--frame-id, default map;\n"
+    "--nav-stamp, the start stamp in Unix seconds, default 0).\n";
 
 // "X,Y" or "X,Y,THETA" (finite numbers) into `pose`.
 absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pose* pose) {
@@ -145,6 +153,7 @@ struct PlanCommand {
   int threads = 1;                        // --local only
   std::optional<GtspEffort> tour_effort;  // --local only
   std::optional<FleetFlags> fleet;        // --robot / --robots: a fleet plan
+  PlanExports exports;                    // --out-geojson, --out-csv, --out-nav-path
 };
 
 // The value flags `covplan plan` accepts, besides the connection flags.
@@ -337,6 +346,7 @@ absl::Status ParseFleetPlanFlags(const ParsedArgs& a, PlanCommand* c) {
 absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& args) {
   std::set<std::string> value_flags = WithConnectionFlags(PlanValueFlags());
   value_flags.merge(FleetValueFlags());
+  value_flags.merge(PlanExportFlags());
   ASSIGN_OR_RETURN(
       ParsedArgs a,
       ParseArgs(args, value_flags, {"local", "negate", "interruptible", "improve-remembered"},
@@ -358,6 +368,12 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   }
   RETURN_IF_ERROR(ParseLocalEngineFlags(a, &c));
   RETURN_IF_ERROR(ParseFleetPlanFlags(a, &c));
+  ASSIGN_OR_RETURN(c.exports, PlanExportsFromFlags(a));
+  if (c.fleet && c.exports.any()) {
+    return absl::InvalidArgumentError(
+        "--out-geojson, --out-csv and --out-nav-path export one robot's plan; for a fleet, "
+        "write --out and export each robot's plan from it (covplan export --plan)");
+  }
 
   v1::PlanRequest& r = c.request;
   RETURN_IF_ERROR(ParseRobotFlags(a, r.mutable_robot()));
@@ -449,7 +465,7 @@ absl::Status Run(const std::vector<std::string>& args) {
     zones.no_go = PolygonsFromProto(response.no_go());
     RETURN_IF_ERROR(WriteTextFile(*c.svg, RenderPlanSvg(plan, site.raster.get(), zones)));
   }
-  return absl::OkStatus();
+  return WritePlanExports(c.exports, response);
 }
 
 }  // namespace

@@ -1,0 +1,47 @@
+// A plan in the formats robot stacks read, written from its PlanResponse (what
+// the server answers, plan.json holds and GetPlan returns):
+//
+//   ASSIGN_OR_RETURN(std::string geojson, PlanToGeoJson(response));
+//   std::string csv = PlanToCsv(response);
+//   ASSIGN_OR_RETURN(std::string path, PlanToNavPath(response, {.frame_id = "map"}));
+//
+// - GeoJSON: a FeatureCollection (RFC 7946 structure: closed rings, exteriors
+//   counter-clockwise and holes clockwise, positions [x, y]) in the map
+//   frame, metres. Features, each with a "feature" property naming it: the
+//   path ("path": a LineString with per-vertex "times_s", "headings_rad",
+//   "kinds" and "ranks" arrays), each rank of an OARP plan ("rank": the line
+//   between its end cells' centres), each charge cycle ("cycle": its part of
+//   the path, with its energy), the regions and no-go zones ("region",
+//   "no_go": Polygons).
+// - CSV: a header, then one line per waypoint: x,y,heading_rad,time_s,kind,rank
+//   (numbers printed to round-trip exactly).
+// - nav_msgs/Path as JSON (the ROS 2 message's fields, as rosbridge and
+//   rclpy's message converters take them): header (frame_id, stamp) and one
+//   PoseStamped per waypoint, its stamp the start stamp plus the waypoint's
+//   time_s, its orientation the quaternion of a yaw of theta.
+//
+// Thread-safety: stateless functions.
+#ifndef COVPLAN_API_PLAN_EXPORT_H_
+#define COVPLAN_API_PLAN_EXPORT_H_
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "covplan/v1/covplan.pb.h"
+
+namespace covplan {
+
+absl::StatusOr<std::string> PlanToGeoJson(const v1::PlanResponse& plan);
+
+std::string PlanToCsv(const v1::PlanResponse& plan);
+
+struct NavPathOptions {
+  std::string frame_id = "map";
+  double start_stamp_s = 0.0;  // Unix seconds of the path's start (0: unset, as ROS reads it)
+};
+absl::StatusOr<std::string> PlanToNavPath(const v1::PlanResponse& plan,
+                                          const NavPathOptions& options);
+
+}  // namespace covplan
+
+#endif  // COVPLAN_API_PLAN_EXPORT_H_
