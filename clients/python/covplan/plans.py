@@ -4,6 +4,7 @@ import collections
 
 from google.protobuf import json_format
 
+from covplan import exports
 from covplan.v1 import covplan_pb2 as pb
 
 try:
@@ -11,10 +12,11 @@ try:
 except ImportError:  # numpy is optional: path_array() says so
     numpy = None
 
-Waypoint = collections.namedtuple("Waypoint", "x y theta kind rank")
+Waypoint = collections.namedtuple("Waypoint", "x y theta kind rank time_s")
 Waypoint.__doc__ = ("One path vertex: position (m), heading (rad), the kind of the segment "
                     "ending here (\"START\", \"COVERAGE\", \"TRANSITION\", \"TO_STATION\", "
-                    "\"FROM_STATION\") and the rank (or cell) it sweeps, else -1.")
+                    "\"FROM_STATION\"), the rank (or cell) it sweeps, else -1, and when the "
+                    "robot reaches it (s from the plan's start).")
 
 
 class Plan:
@@ -35,16 +37,16 @@ class Plan:
 
     @property
     def path(self):
-        """The path as a list of Waypoint(x, y, theta, kind, rank)."""
-        return [Waypoint(w.x, w.y, w.theta, pb.SegmentKind.Name(w.kind), w.rank)
+        """The path as a list of Waypoint(x, y, theta, kind, rank, time_s)."""
+        return [Waypoint(w.x, w.y, w.theta, pb.SegmentKind.Name(w.kind), w.rank, w.time_s)
                 for w in self.response.path]
 
     def path_array(self):
-        """The path as a numpy array of rows (x, y, theta, kind number, rank)."""
+        """The path as a numpy array of rows (x, y, theta, time_s, kind number, rank)."""
         if numpy is None:
             raise RuntimeError("path_array() needs numpy (Debian: python3-numpy)")
-        return numpy.array([(w.x, w.y, w.theta, w.kind, w.rank) for w in self.response.path],
-                           dtype=float).reshape(-1, 5)
+        return numpy.array([(w.x, w.y, w.theta, w.time_s, w.kind, w.rank)
+                            for w in self.response.path], dtype=float).reshape(-1, 6)
 
     def length_m(self, kind=None):
         """Length of the path's segments (of one kind, e.g. "COVERAGE", when given)."""
@@ -58,6 +60,18 @@ class Plan:
         """The plan drawn as SVG text (covplan.svg.plan_svg)."""
         from covplan.svg import plan_svg
         return plan_svg(self, width)
+
+    def to_geojson(self):
+        """The plan as a GeoJSON FeatureCollection dict (covplan.exports.to_geojson)."""
+        return exports.to_geojson(self)
+
+    def to_csv(self):
+        """CSV waypoints: x,y,heading_rad,time_s,kind,rank (covplan.exports.to_csv)."""
+        return exports.to_csv(self)
+
+    def to_nav_path(self, frame_id="map", start_stamp_s=0.0):
+        """A nav_msgs/Path as a dict in the ROS 2 message's form (covplan.exports)."""
+        return exports.to_nav_path(self, frame_id, start_stamp_s)
 
     def to_json(self):
         """The plan in the proto's JSON form (as the CLI's plan.json)."""

@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""Plan a map through covplan-server and save the plan as JSON and an SVG picture.
+"""Plan a map through covplan-server and save the plan as JSON, an SVG picture and the
+exports a robot stack reads (GeoJSON, CSV waypoints, a nav_msgs/Path JSON).
 
     python plan_map.py --server 127.0.0.1:50051 --map maps/sample_office.yaml \
         --tool-width 0.5 --out plan_py
-writes plan_py.json and plan_py.svg and prints the figures.
+writes plan_py.json, .svg, .geojson, .csv and .nav_path.json and prints the figures.
 """
 import argparse
+import json
 import pathlib
 import sys
 
@@ -43,7 +45,10 @@ def main():
     out = pathlib.Path(args.out)
     out.with_suffix(".json").write_text(plan.to_json())
     out.with_suffix(".svg").write_text(plan.to_svg())
-    print(f"wrote {out.with_suffix('.json')} and {out.with_suffix('.svg')}")
+    out.with_suffix(".geojson").write_text(json.dumps(plan.to_geojson()))
+    out.with_suffix(".csv").write_text(plan.to_csv())
+    out.with_suffix(".nav_path.json").write_text(json.dumps(plan.to_nav_path(frame_id="map")))
+    print(f"wrote {out}.json, .svg, .geojson, .csv and .nav_path.json")
 
 
 if __name__ == "__main__":

@@ -23,6 +23,11 @@ def test_plan_map_writes_json_and_svg(server, tmp_path):
     plan = json.loads(out.with_suffix(".json").read_text())
     assert plan["planId"] in text
     assert out.with_suffix(".svg").read_text().startswith("<svg")
+    geojson = json.loads(out.with_suffix(".geojson").read_text())
+    assert len(geojson["features"][0]["geometry"]["coordinates"]) == len(plan["path"])
+    assert len(out.with_suffix(".csv").read_text().splitlines()) == len(plan["path"]) + 1
+    nav = json.loads(out.with_suffix(".nav_path.json").read_text())
+    assert len(nav["poses"]) == len(plan["path"])
 
 
 def test_drive_robot_meets_an_obstacle_and_finishes(server):

@@ -28,8 +28,10 @@ def test_path_array_matches_the_path(client, office_id):
     numpy = pytest.importorskip("numpy")
     plan = client.plan(office_id, tool_width=0.5, seed=1, time_limit_s=0.5)
     array = plan.path_array()
-    assert array.shape == (len(plan.path), 5)
-    assert numpy.allclose(array[:, :3], [(w.x, w.y, w.theta) for w in plan.path])
+    assert array.shape == (len(plan.path), 6)
+    assert numpy.allclose(array[:, :4], [(w.x, w.y, w.theta, w.time_s) for w in plan.path])
+    assert numpy.all(numpy.diff(array[:, 3]) >= 0)  # times never go back
+    assert array[-1, 3] == pytest.approx(plan.duration_s, rel=1e-9)
 
 
 @pytest.mark.parametrize("planner,options", [

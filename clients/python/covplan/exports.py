@@ -1,0 +1,102 @@
+"""A plan in the formats robot stacks read, as `covplan export` and `covplan plan --out-*`
+write them (api/plan_export.h is the reference; docs/clients.md shows them):
+
+    geojson = covplan.exports.to_geojson(plan)     # dict: a GeoJSON FeatureCollection
+    csv_text = covplan.exports.to_csv(plan)        # x,y,heading_rad,time_s,kind,rank
+    path = covplan.exports.to_nav_path(plan, frame_id="map", start_stamp_s=time.time())
+
+Coordinates are the map frame's metres. Rings are closed and follow RFC 7946's right-hand
+rule (exteriors counter-clockwise, holes clockwise).
+"""
+import math
+
+from covplan.v1 import covplan_pb2 as pb
+
+
+def _response(plan):
+    return getattr(plan, "response", plan)
+
+
+def _ring(ring, exterior):
+    points = [[p.x, p.y] for p in ring.points]
+    if points and points[0] != points[-1]:
+        points.append(list(points[0]))
+    twice_area = sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(points, points[1:]))
+    if (twice_area > 0) != exterior:
+        points.reverse()
+    return points
+
+
+def _polygon(polygon):
+    return {"type": "Polygon",
+            "coordinates": [_ring(polygon.outer, True)] + [_ring(h, False) for h in polygon.holes]}
+
+
+def _feature(name, geometry, **properties):
+    properties["feature"] = name
+    return {"type": "Feature", "geometry": geometry, "properties": properties}
+
+
+def _cell_centre(grid, cell):
+    return [grid.origin_x_m + (cell.col + 0.5) * grid.cell_size_m,
+            grid.origin_y_m + (cell.row + 0.5) * grid.cell_size_m]
+
+
+def to_geojson(plan):
+    """The plan as a GeoJSON FeatureCollection (a dict; json.dump it): the path with per-vertex
+    times_s, headings_rad, kinds and ranks; each OARP rank; each charge cycle; the zones."""
+    r = _response(plan)
+    path = r.path
+    features = [_feature(
+        "path", {"type": "LineString", "coordinates": [[w.x, w.y] for w in path]},
+        plan_id=r.plan_id, planner=r.planner, duration_s=r.stats.estimated_duration_s,
+        times_s=[w.time_s for w in path], headings_rad=[w.theta for w in path],
+        kinds=[pb.SegmentKind.Name(w.kind) for w in path], ranks=[w.rank for w in path])]
+    for i, rank in enumerate(r.ranks):
+        features.append(_feature(
+            "rank", {"type": "LineString", "coordinates": [_cell_centre(r.grid, rank.first_cell),
+                                                           _cell_centre(r.grid, rank.last_cell)]},
+            index=i, orientation=pb.Orientation.Name(rank.orientation)))
+    for i, cycle in enumerate(r.cycles):
+        points = [[w.x, w.y] for w in path[max(0, cycle.first_waypoint):cycle.last_waypoint + 1]]
+        if len(points) >= 2:
+            features.append(_feature("cycle", {"type": "LineString", "coordinates": points},
+                                     index=i, energy=cycle.energy))
+    features += [_feature("region", _polygon(z)) for z in r.regions]
+    features += [_feature("no_go", _polygon(z)) for z in r.no_go]
+    return {"type": "FeatureCollection", "features": features}
+
+
+def to_csv(plan):
+    """One line per waypoint after a header: x,y,heading_rad,time_s,kind,rank (repr floats:
+    they read back exactly)."""
+    lines = ["x,y,heading_rad,time_s,kind,rank"]
+    for w in _response(plan).path:
+        lines.append(f"{w.x!r},{w.y!r},{w.theta!r},{w.time_s!r},"
+                     f"{pb.SegmentKind.Name(w.kind)},{w.rank}")
+    return "\n".join(lines) + "\n"
+
+
+def _stamp(t):
+    sec = math.floor(t)
+    nanosec = round((t - sec) * 1e9)
+    if nanosec >= 1_000_000_000:
+        sec, nanosec = sec + 1, nanosec - 1_000_000_000
+    return {"sec": int(sec), "nanosec": int(nanosec)}
+
+
+def to_nav_path(plan, frame_id="map", start_stamp_s=0.0):
+    """The plan as a nav_msgs/Path in the ROS 2 message's JSON form (a dict): each pose
+    stamped start_stamp_s + its waypoint's time_s, its orientation the yaw quaternion."""
+    if not frame_id:
+        raise ValueError("frame_id must not be empty")
+
+    def header(t):
+        return {"frame_id": frame_id, "stamp": _stamp(t)}
+
+    poses = [{"header": header(start_stamp_s + w.time_s),
+              "pose": {"position": {"x": w.x, "y": w.y, "z": 0.0},
+                       "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(w.theta / 2),
+                                       "w": math.cos(w.theta / 2)}}}
+             for w in _response(plan).path]
+    return {"header": header(start_stamp_s), "poses": poses}
