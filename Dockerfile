@@ -29,7 +29,7 @@ ENV DEBIAN_FRONTEND=noninteractive
 RUN apt-get update && apt-get install -y --no-install-recommends \
       libgrpc++1.51 libgrpc29 libprotobuf32 libabsl20220623 libglpk40 libyaml-cpp0.7 \
       libpng16-16 libprometheus-cpp-core1.0 libprometheus-cpp-pull1.0 libcivetweb1 \
-      libpq5 libssl3 libc-ares2 libre2-9 zlib1g \
+      libpq5 libssl3 libc-ares2 libre2-9 zlib1g libproj25 \
     && rm -rf /var/lib/apt/lists/* /var/cache/apt/* /usr/share/doc/* /usr/share/man/* \
     && useradd --system --uid 10001 --user-group --home-dir /data --no-create-home covplan \
     && mkdir -p /data && chown covplan:covplan /data

@@ -3,8 +3,10 @@
 #include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -37,7 +39,11 @@ Value List(std::vector<Value> items) {
   return out;
 }
 
-Value Position(double x, double y) { return List({Number(x), Number(y)}); }
+// A position [x, y] of the map frame, in the export's CRS.
+Value Position(const ExportFrame& f, double x, double y) {
+  if (f.to_crs) std::tie(x, y) = f.to_crs(x, y);
+  return List({Number(x), Number(y)});
+}
 
 Value Object(std::vector<std::pair<std::string, Value>> fields) {
   Value out;
@@ -58,9 +64,10 @@ Value Feature(const char* name, Value geometry, std::vector<std::pair<std::strin
 
 // A ring closed and oriented by RFC 7946's right-hand rule: exteriors
 // counter-clockwise, holes clockwise.
-Value Ring(const v1::Ring& ring, bool exterior) {
+Value Ring(const ExportFrame& f, const v1::Ring& ring, bool exterior) {
   std::vector<std::pair<double, double>> points;
-  for (const v1::Point2& p : ring.points()) points.emplace_back(p.x(), p.y());
+  for (const v1::Point2& p : ring.points())
+    points.push_back(f.to_crs ? f.to_crs(p.x(), p.y()) : std::pair{p.x(), p.y()});
   if (!points.empty() && points.front() != points.back()) points.push_back(points.front());
   double twice_area = 0.0;
   for (size_t i = 0; i + 1 < points.size(); ++i) {
@@ -68,20 +75,20 @@ Value Ring(const v1::Ring& ring, bool exterior) {
   }
   if ((twice_area > 0.0) != exterior) std::reverse(points.begin(), points.end());
   std::vector<Value> positions;
-  for (const auto& [x, y] : points) positions.push_back(Position(x, y));
+  for (const auto& [x, y] : points) positions.push_back(Position(ExportFrame(), x, y));
   return List(std::move(positions));
 }
 
-Value PolygonGeometry(const v1::Polygon& polygon) {
-  std::vector<Value> rings{Ring(polygon.outer(), true)};
-  for (const v1::Ring& hole : polygon.holes()) rings.push_back(Ring(hole, false));
+Value PolygonGeometry(const ExportFrame& f, const v1::Polygon& polygon) {
+  std::vector<Value> rings{Ring(f, polygon.outer(), true)};
+  for (const v1::Ring& hole : polygon.holes()) rings.push_back(Ring(f, hole, false));
   return Geometry("Polygon", List(std::move(rings)));
 }
 
-Value PathFeature(const v1::PlanResponse& plan) {
+Value PathFeature(const ExportFrame& f, const v1::PlanResponse& plan) {
   std::vector<Value> positions, times, headings, kinds, ranks;
   for (const v1::Waypoint& w : plan.path()) {
-    positions.push_back(Position(w.x(), w.y()));
+    positions.push_back(Position(f, w.x(), w.y()));
     times.push_back(Number(w.time_s()));
     headings.push_back(Number(w.theta()));
     kinds.push_back(Text(v1::SegmentKind_Name(w.kind())));
@@ -97,18 +104,19 @@ Value PathFeature(const v1::PlanResponse& plan) {
                   {"ranks", List(std::move(ranks))}});
 }
 
-Value CellCentre(const v1::Grid& grid, const v1::CellRef& cell) {
-  return Position(grid.origin_x_m() + (cell.col() + 0.5) * grid.cell_size_m(),
+Value CellCentre(const ExportFrame& f, const v1::Grid& grid, const v1::CellRef& cell) {
+  return Position(f, grid.origin_x_m() + (cell.col() + 0.5) * grid.cell_size_m(),
                   grid.origin_y_m() + (cell.row() + 0.5) * grid.cell_size_m());
 }
 
-void AddUnitsAndCycles(const v1::PlanResponse& plan, std::vector<Value>* features) {
+void AddUnitsAndCycles(const ExportFrame& f, const v1::PlanResponse& plan,
+                       std::vector<Value>* features) {
   for (int i = 0; i < plan.ranks_size(); ++i) {
     const v1::Rank& rank = plan.ranks(i);
     features->push_back(Feature(
         "rank",
-        Geometry("LineString", List({CellCentre(plan.grid(), rank.first_cell()),
-                                     CellCentre(plan.grid(), rank.last_cell())})),
+        Geometry("LineString", List({CellCentre(f, plan.grid(), rank.first_cell()),
+                                     CellCentre(f, plan.grid(), rank.last_cell())})),
         {{"index", Number(i)}, {"orientation", Text(v1::Orientation_Name(rank.orientation()))}}));
   }
   for (int c = 0; c < plan.cycles_size(); ++c) {
@@ -116,7 +124,7 @@ void AddUnitsAndCycles(const v1::PlanResponse& plan, std::vector<Value>* feature
     std::vector<Value> positions;
     for (int w = std::max(0, cycle.first_waypoint());
          w <= cycle.last_waypoint() && w < plan.path_size(); ++w) {
-      positions.push_back(Position(plan.path(w).x(), plan.path(w).y()));
+      positions.push_back(Position(f, plan.path(w).x(), plan.path(w).y()));
     }
     if (positions.size() < 2) continue;
     features->push_back(Feature("cycle", Geometry("LineString", List(std::move(positions))),
@@ -143,23 +151,30 @@ Value Stamp(double unix_s) {
 
 }  // namespace
 
-absl::StatusOr<std::string> PlanToGeoJson(const v1::PlanResponse& plan) {
-  std::vector<Value> features{PathFeature(plan)};
-  AddUnitsAndCycles(plan, &features);
+absl::StatusOr<std::string> PlanToGeoJson(const v1::PlanResponse& plan, const ExportFrame& frame) {
+  std::vector<Value> features{PathFeature(frame, plan)};
+  AddUnitsAndCycles(frame, plan, &features);
   for (const v1::Polygon& zone : plan.regions())
-    features.push_back(Feature("region", PolygonGeometry(zone), {}));
+    features.push_back(Feature("region", PolygonGeometry(frame, zone), {}));
   for (const v1::Polygon& zone : plan.no_go())
-    features.push_back(Feature("no_go", PolygonGeometry(zone), {}));
-  const Value collection =
-      Object({{"type", Text("FeatureCollection")}, {"features", List(std::move(features))}});
-  return Print(collection.struct_value());
+    features.push_back(Feature("no_go", PolygonGeometry(frame, zone), {}));
+  std::vector<std::pair<std::string, Value>> members = {{"type", Text("FeatureCollection")},
+                                                        {"features", List(std::move(features))}};
+  if (!frame.crs.empty() && frame.crs != "EPSG:4326" && frame.crs != "OGC:CRS84") {
+    // RFC 7946 has no CRS member; GeoJSON 2008's "named CRS" tells readers that know it.
+    members.emplace_back("crs", Object({{"type", Text("name")},
+                                        {"properties", Object({{"name", Text(frame.crs)}})}}));
+  }
+  return Print(Object(std::move(members)).struct_value());
 }
 
-std::string PlanToCsv(const v1::PlanResponse& plan) {
-  std::string out = "x,y,heading_rad,time_s,kind,rank\n";
+std::string PlanToCsv(const v1::PlanResponse& plan, const ExportFrame& frame) {
+  std::string out = frame.geographic ? "lon,lat" : "x,y";
+  out += ",heading_rad,time_s,kind,rank\n";
   for (const v1::Waypoint& w : plan.path()) {
-    absl::StrAppendFormat(&out, "%.17g,%.17g,%.17g,%.17g,%s,%d\n", w.x(), w.y(), w.theta(),
-                          w.time_s(), v1::SegmentKind_Name(w.kind()), w.rank());
+    auto [x, y] = frame.to_crs ? frame.to_crs(w.x(), w.y()) : std::pair{w.x(), w.y()};
+    absl::StrAppendFormat(&out, "%.17g,%.17g,%.17g,%.17g,%s,%d\n", x, y, w.theta(), w.time_s(),
+                          v1::SegmentKind_Name(w.kind()), w.rank());
   }
   return out;
 }

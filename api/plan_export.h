@@ -1,7 +1,7 @@
 // A plan in the formats robot stacks read, written from its PlanResponse (what
 // the server answers, plan.json holds and GetPlan returns):
 //
-//   ASSIGN_OR_RETURN(std::string geojson, PlanToGeoJson(response));
+//   ASSIGN_OR_RETURN(std::string geojson, PlanToGeoJson(response));  // or (response, frame)
 //   std::string csv = PlanToCsv(response);
 //   ASSIGN_OR_RETURN(std::string path, PlanToNavPath(response, {.frame_id = "map"}));
 //
@@ -24,16 +24,28 @@
 #ifndef COVPLAN_API_PLAN_EXPORT_H_
 #define COVPLAN_API_PLAN_EXPORT_H_
 
+#include <functional>
 #include <string>
+#include <utility>
 
 #include "absl/status/statusor.h"
 #include "covplan/v1/covplan.pb.h"
 
 namespace covplan {
 
-absl::StatusOr<std::string> PlanToGeoJson(const v1::PlanResponse& plan);
+// Where exported positions go: by default the map frame as planned; for a
+// site given in a CRS (api/geo_frame.h), back into it. Headings stay the
+// plan's (radians, counter-clockwise from the frame's x axis).
+struct ExportFrame {
+  std::string crs;          // "" = the map frame; else written into the GeoJSON (unless EPSG:4326)
+  bool geographic = false;  // positions are longitude, latitude (CSV columns lon,lat)
+  std::function<std::pair<double, double>(double, double)> to_crs;  // unset: identity
+};
 
-std::string PlanToCsv(const v1::PlanResponse& plan);
+absl::StatusOr<std::string> PlanToGeoJson(const v1::PlanResponse& plan,
+                                          const ExportFrame& frame = {});
+
+std::string PlanToCsv(const v1::PlanResponse& plan, const ExportFrame& frame = {});
 
 struct NavPathOptions {
   std::string frame_id = "map";

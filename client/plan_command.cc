@@ -19,6 +19,7 @@
 #include "api/geojson.h"
 #include "client/args.h"
 #include "client/fleet_plan.h"
+#include "client/geo_site.h"
 #include "client/local_engine.h"
 #include "client/map_flags.h"
 #include "client/plan_exports.h"
@@ -67,6 +68,7 @@ constexpr char kUsage[] =
     "                    [--division makespan|equal_area] [--clearance M]\n"
     "                    [--out-geojson FILE] [--out-csv FILE]\n"
     "                    [--out-nav-path FILE [--frame-id ID] [--nav-stamp UNIX_S]]\n"
+    "                    [--crs CRS]   (a .geojson map in EPSG:4326 lon/lat, a UTM zone...)\n"
     "--algorithm is another name for --planner. The --stc-* flags and --sweep-direction\n"
     "set the stc planner's options (--sweep-direction: the prim tree only).\n"
     "FILE is a map_server .yaml (with the image it names), a bare .pgm/.png (needs\n"
@@ -92,7 +94,11 @@ constexpr char kUsage[] =
     "FeatureCollection in the map frame (the path with per-vertex times_s and\n"
     "headings_rad, ranks, charge cycles, zones); --out-csv x,y,heading_rad,time_s,kind,rank\n"
     "per waypoint; --out-nav-path a nav_msgs/Path as JSON (--frame-id, default map;\n"
-    "--nav-stamp, the start stamp in Unix seconds, default 0).\n";
+    "--nav-stamp, the start stamp in Unix seconds, default 0).\n"
+    "--crs CRS: the .geojson map and every coordinate flag are in CRS (EPSG:4326 for\n"
+    "longitude/latitude as RFC 7946 has them, or e.g. EPSG:32632); PROJ projects them onto\n"
+    "a transverse Mercator centred on the site, where the plan is made (plan.json, the SVG\n"
+    "and the nav path are in it); the GeoJSON and CSV exports are written back in CRS.\n";
 
 // "X,Y" or "X,Y,THETA" (finite numbers) into `pose`.
 absl::Status ParsePose(const std::string& flag, const std::string& text, v1::Pose* pose) {
@@ -154,6 +160,7 @@ struct PlanCommand {
   std::optional<GtspEffort> tour_effort;  // --local only
   std::optional<FleetFlags> fleet;        // --robot / --robots: a fleet plan
   PlanExports exports;                    // --out-geojson, --out-csv, --out-nav-path
+  std::optional<std::string> crs;         // --crs: the map and coordinates in a CRS
 };
 
 // The value flags `covplan plan` accepts, besides the connection flags.
@@ -191,7 +198,8 @@ std::set<std::string> PlanValueFlags() {
           "sweep-direction",
           "stc-partial",
           "threads",
-          "tour-effort"};
+          "tour-effort",
+          "crs"};
 }
 
 // --threads and --tour-effort: knobs of the in-process engine, so --local only.
@@ -369,6 +377,7 @@ absl::StatusOr<PlanCommand> ParsePlanCommand(const std::vector<std::string>& arg
   RETURN_IF_ERROR(ParseLocalEngineFlags(a, &c));
   RETURN_IF_ERROR(ParseFleetPlanFlags(a, &c));
   ASSIGN_OR_RETURN(c.exports, PlanExportsFromFlags(a));
+  c.crs = a.Get("crs");
   if (c.fleet && c.exports.any()) {
     return absl::InvalidArgumentError(
         "--out-geojson, --out-csv and --out-nav-path export one robot's plan; for a fleet, "
@@ -438,9 +447,15 @@ absl::Status Run(const std::vector<std::string>& args) {
     return absl::InvalidArgumentError(
         absl::StrCat(parsed.status().message(), " (see covplan plan --help)"));
   }
-  const PlanCommand& c = *parsed;
+  PlanCommand c = *std::move(parsed);  // --crs projects its request
   EngineLimits limits;
   ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(c.map_path, c.overrides, limits));
+  ASSIGN_OR_RETURN(std::optional<GeoFrame> frame,
+                   ProjectIntoSite(c.crs, &map, &c.request, c.fleet ? &c.fleet->robots : nullptr));
+  if (frame) {
+    std::printf("frame      %s projected onto a transverse Mercator at %.7f, %.7f (lon, lat)\n",
+                frame->crs().c_str(), frame->lon0(), frame->lat0());
+  }
   if (c.fleet) {
     v1::PlanRequest request = c.request;
     *request.mutable_map() = map;
@@ -465,7 +480,7 @@ absl::Status Run(const std::vector<std::string>& args) {
     zones.no_go = PolygonsFromProto(response.no_go());
     RETURN_IF_ERROR(WriteTextFile(*c.svg, RenderPlanSvg(plan, site.raster.get(), zones)));
   }
-  return WritePlanExports(c.exports, response);
+  return WritePlanExports(c.exports, response, ExportFrameOf(frame));
 }
 
 }  // namespace

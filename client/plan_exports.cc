@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
+#include "api/convert.h"
+#include "client/geo_site.h"
 #include "planner/common/status_macros.h"
 
 namespace covplan {
@@ -36,12 +38,13 @@ absl::StatusOr<PlanExports> PlanExportsFromFlags(const ParsedArgs& a) {
   return e;
 }
 
-absl::Status WritePlanExports(const PlanExports& exports, const v1::PlanResponse& plan) {
+absl::Status WritePlanExports(const PlanExports& exports, const v1::PlanResponse& plan,
+                              const ExportFrame& frame) {
   if (exports.geojson) {
-    ASSIGN_OR_RETURN(std::string text, PlanToGeoJson(plan));
+    ASSIGN_OR_RETURN(std::string text, PlanToGeoJson(plan, frame));
     RETURN_IF_ERROR(WriteTextFile(*exports.geojson, text));
   }
-  if (exports.csv) RETURN_IF_ERROR(WriteTextFile(*exports.csv, PlanToCsv(plan)));
+  if (exports.csv) RETURN_IF_ERROR(WriteTextFile(*exports.csv, PlanToCsv(plan, frame)));
   if (exports.nav_path) {
     ASSIGN_OR_RETURN(std::string text, PlanToNavPath(plan, exports.nav));
     RETURN_IF_ERROR(WriteTextFile(*exports.nav_path, text));
@@ -54,8 +57,11 @@ namespace {
 constexpr char kExportUsage[] =
     "usage: covplan export --plan FILE [--robot ID] [--out-geojson FILE] [--out-csv FILE]\n"
     "                      [--out-nav-path FILE [--frame-id ID] [--nav-stamp UNIX_S]]\n"
+    "                      [--map MAP.geojson --crs CRS]\n"
     "FILE is a plan.json (covplan plan --out, a GetPlan reply) or a fleet's JSON\n"
-    "(covplan plan --robot ... --out), then --robot names the robot whose plan to export.\n";
+    "(covplan plan --robot ... --out), then --robot names the robot whose plan to export.\n"
+    "--map and --crs: the plan was made with covplan plan --crs CRS on that map; the\n"
+    "GeoJSON and CSV are then written in CRS.\n";
 
 absl::StatusOr<std::string> ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -77,7 +83,8 @@ absl::StatusOr<v1::PlanResponse> PlanFromJsonText(const std::string& text,
   std::string plan_json = text;
   const auto robots = document.fields().find("robots");
   if (robots != document.fields().end()) {
-    if (!robot) return absl::InvalidArgumentError(source + " is a fleet: name a robot with --robot");
+    if (!robot)
+      return absl::InvalidArgumentError(source + " is a fleet: name a robot with --robot");
     const google::protobuf::Value* found = nullptr;
     for (const google::protobuf::Value& r : robots->second.list_value().values()) {
       const auto& fields = r.struct_value().fields();
@@ -107,7 +114,7 @@ absl::StatusOr<v1::PlanResponse> PlanFromJsonText(const std::string& text,
 
 absl::Status RunExport(const std::vector<std::string>& args) {
   std::set<std::string> flags = PlanExportFlags();
-  flags.insert({"plan", "robot"});
+  flags.insert({"plan", "robot", "map", "crs"});
   ASSIGN_OR_RETURN(ParsedArgs a, ParseArgs(args, flags, {}, {}));
   const std::optional<std::string> path = a.Get("plan");
   if (!path) return absl::InvalidArgumentError("--plan FILE is required");
@@ -117,7 +124,15 @@ absl::Status RunExport(const std::vector<std::string>& args) {
   }
   ASSIGN_OR_RETURN(std::string text, ReadText(*path));
   ASSIGN_OR_RETURN(v1::PlanResponse plan, PlanFromJsonText(text, a.Get("robot"), *path));
-  return WritePlanExports(exports, plan);
+  if (a.Get("crs").has_value() != a.Get("map").has_value())
+    return absl::InvalidArgumentError("--crs and --map go together (the site's frame)");
+  std::optional<GeoFrame> frame;
+  if (auto map_path = a.Get("map")) {
+    ASSIGN_OR_RETURN(v1::Map map, MapProtoFromFile(*map_path, {}, EngineLimits()));
+    v1::PlanRequest unused;
+    ASSIGN_OR_RETURN(frame, ProjectIntoSite(a.Get("crs"), &map, &unused));
+  }
+  return WritePlanExports(exports, plan, ExportFrameOf(frame));
 }
 
 }  // namespace

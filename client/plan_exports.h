@@ -30,11 +30,15 @@ struct PlanExports {
 // The value flags read here (for the command's flag set and help).
 std::set<std::string> PlanExportFlags();
 absl::StatusOr<PlanExports> PlanExportsFromFlags(const ParsedArgs& a);
-absl::Status WritePlanExports(const PlanExports& exports, const v1::PlanResponse& plan);
+// The nav path is always in the plan's frame; `frame` takes the GeoJSON and
+// CSV positions back into the site's CRS (client/geo_site.h).
+absl::Status WritePlanExports(const PlanExports& exports, const v1::PlanResponse& plan,
+                              const ExportFrame& frame = {});
 
-// `covplan export --plan FILE [--robot ID] <export flags>`: the exports of a
-// plan.json (covplan plan --out, a GetPlan reply), or of one robot's plan in
-// a fleet JSON (covplan plan --robot ... --out).
+// `covplan export --plan FILE [--robot ID] [--map F --crs CRS] <export flags>`:
+// the exports of a plan.json (covplan plan --out, a GetPlan reply), or of one
+// robot's plan in a fleet JSON (covplan plan --robot ... --out); with --crs,
+// in the CRS of the geographic map the plan was made on.
 int RunExportCommand(const std::vector<std::string>& args);
 
 }  // namespace covplan

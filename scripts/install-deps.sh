@@ -16,7 +16,7 @@ PKGS=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libabsl-dev libglpk-dev glpk-utils libeigen3-dev libboost-graph-dev
   libyaml-cpp-dev libpng-dev libgtest-dev libgmock-dev libbenchmark-dev
-  prometheus-cpp-dev libcivetweb-dev libpq-dev curl python3
+  prometheus-cpp-dev libcivetweb-dev libpq-dev libproj-dev curl python3
   openssl  # test certificates for server_tls_test
 )
 # Tools of the checks CI runs (scripts/test.sh with CI=true): clang + the libFuzzer runtime for

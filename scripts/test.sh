@@ -17,7 +17,8 @@ if [ "${CI:-}" = true ] || [ "${FULL:-0}" = 1 ]; then full=1; fi
 # browser test (tests/console; it skips without them outside CI); pip, venv, the gRPC and protobuf
 # runtime, numpy and pytest for the Python client's tests (tests/python). build.sh installs the rest.
 bash scripts/install-deps.sh --only chromium chromium-driver python3-selenium python3-venv python3-pip \
-  python3-grpcio python3-protobuf python3-numpy python3-pytest python3-pyflakes python3-shapely
+  python3-grpcio python3-protobuf python3-numpy python3-pytest python3-pyflakes python3-shapely \
+  python3-pyproj
 
 # suite DIR [cmake args...]: builds into DIR and runs every test there.
 suite() {

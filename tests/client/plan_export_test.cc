@@ -51,8 +51,10 @@ double TwiceSignedArea(const Value& ring) {
   const auto& p = ring.list_value().values();
   double sum = 0.0;
   for (int i = 0; i + 1 < p.size(); ++i) {
-    sum += p[i].list_value().values(0).number_value() * p[i + 1].list_value().values(1).number_value() -
-           p[i + 1].list_value().values(0).number_value() * p[i].list_value().values(1).number_value();
+    sum +=
+        p[i].list_value().values(0).number_value() *
+            p[i + 1].list_value().values(1).number_value() -
+        p[i + 1].list_value().values(0).number_value() * p[i].list_value().values(1).number_value();
   }
   return sum;
 }
@@ -68,10 +70,21 @@ class PlanExportTest : public ::testing::Test {
   std::string Path(const std::string& name) const { return dir_ + "/" + name; }
   // The shipped yard with a clockwise no-go ring and a battery, planned locally.
   v1::PlanResponse PlanYard(const std::vector<std::string>& extra) {
-    std::vector<std::string> args = {
-        "--map", absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_yard.geojson"), "--local",
-        "--tool-width", "0.6", "--tour", "greedy", "--no-go", "10,5 10,6.5 12,6.5 12,5",
-        "--battery-capacity", "400", "--station", "1,1", "--out", Path("plan.json")};
+    std::vector<std::string> args = {"--map",
+                                     absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/sample_yard.geojson"),
+                                     "--local",
+                                     "--tool-width",
+                                     "0.6",
+                                     "--tour",
+                                     "greedy",
+                                     "--no-go",
+                                     "10,5 10,6.5 12,6.5 12,5",
+                                     "--battery-capacity",
+                                     "400",
+                                     "--station",
+                                     "1,1",
+                                     "--out",
+                                     Path("plan.json")};
     args.insert(args.end(), extra.begin(), extra.end());
     EXPECT_EQ(RunPlanCommand(args), 0);
     v1::PlanResponse plan;
@@ -172,7 +185,8 @@ TEST_F(PlanExportTest, NavPathHasUnitQuaternionsOfTheHeadingsAndTimedStamps) {
     const Value& position = Field(Field(poses[i], "pose"), "position");
     EXPECT_EQ(Field(position, "x").number_value(), plan.path(i).x());
     const Value& stamp = Field(Field(poses[i], "header"), "stamp");
-    const double t = Field(stamp, "sec").number_value() + 1e-9 * Field(stamp, "nanosec").number_value();
+    const double t =
+        Field(stamp, "sec").number_value() + 1e-9 * Field(stamp, "nanosec").number_value();
     EXPECT_NEAR(t, 1700000000.25 + plan.path(i).time_s(), 2e-6);
     EXPECT_LT(Field(stamp, "nanosec").number_value(), 1e9);
   }
@@ -188,8 +202,8 @@ TEST_F(PlanExportTest, ExportCommandReadsPlansAndFleetsAndRefusesBadUse) {
                             "0.3", "--robot", "west=1.5,1.5", "--robot", "east=20,1.5", "--out",
                             Path("fleet.json")}),
             0);
-  ASSERT_EQ(RunExportCommand({"--plan", Path("fleet.json"), "--robot", "east", "--out-csv",
-                              Path("east.csv")}),
+  ASSERT_EQ(RunExportCommand(
+                {"--plan", Path("fleet.json"), "--robot", "east", "--out-csv", Path("east.csv")}),
             0);
   EXPECT_GT(Read(Path("east.csv")).size(), 100u);
   // A fleet needs --robot; unknown robots, missing exports, bad files are errors.
@@ -201,8 +215,8 @@ TEST_F(PlanExportTest, ExportCommandReadsPlansAndFleetsAndRefusesBadUse) {
   EXPECT_NE(RunExportCommand({"--plan", Path("direct.csv"), "--out-csv", Path("x.csv")}), 0);
   EXPECT_NE(RunExportCommand({"--plan", Path("plan.json"), "--frame-id", "map"}), 0);
   // Exports of a fleet plan must go through covplan export.
-  EXPECT_NE(RunPlanCommand({"--map", office, "--local", "--robot", "a=1.5,1.5", "--out-csv",
-                            Path("x.csv")}),
+  EXPECT_NE(RunPlanCommand(
+                {"--map", office, "--local", "--robot", "a=1.5,1.5", "--out-csv", Path("x.csv")}),
             0);
   EXPECT_FALSE(std::filesystem::exists(Path("x.csv")));
 }
