@@ -90,12 +90,11 @@ absl::StatusOr<GeoFrame> GeoFrame::ForSite(
   Owned ellipsoid{proj_get_ellipsoid(p.ctx, source.pj)};
   double a = 0.0, b = 0.0, inverse_flattening = 0.0;
   int computed = 0;
-  Owned op{geodetic.pj == nullptr ? nullptr
-                                  : proj_create_crs_to_crs_from_pj(p.ctx, source.pj, geodetic.pj,
-                                                                   nullptr, nullptr)};
+  Owned op{geodetic.pj == nullptr
+               ? nullptr
+               : proj_create_crs_to_crs_from_pj(p.ctx, source.pj, geodetic.pj, nullptr, nullptr)};
   if (op.pj == nullptr || ellipsoid.pj == nullptr ||
-      !proj_ellipsoid_get_parameters(p.ctx, ellipsoid.pj, &a, &b, &computed,
-                                     &inverse_flattening)) {
+      !proj_ellipsoid_get_parameters(p.ctx, ellipsoid.pj, &a, &b, &computed, &inverse_flattening)) {
     return absl::InvalidArgumentError(
         absl::StrCat("crs '", crs, "': PROJ cannot relate it to its geographic coordinates (",
                      ProjError(p.ctx), ")"));
@@ -140,9 +139,9 @@ absl::StatusOr<Point2> GeoFrame::Geographic(Point2 q, absl::string_view name) co
           absl::StrCat(name, ": longitude ", q.x, " is outside [-180, 180]"));
     }
     if (q.y < -90.0 || q.y > 90.0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(name, ": latitude ", q.y, " is outside [-90, 90] (GeoJSON positions are "
-                             "[longitude, latitude])"));
+      return absl::InvalidArgumentError(absl::StrCat(name, ": latitude ", q.y,
+                                                     " is outside [-90, 90] (GeoJSON positions are "
+                                                     "[longitude, latitude])"));
     }
   }
   const PJ_COORD g = proj_trans(proj_->to_geographic, PJ_FWD, proj_coord(q.x, q.y, 0, 0));

@@ -2,7 +2,7 @@
 // the server answers, plan.json holds and GetPlan returns):
 //
 //   ASSIGN_OR_RETURN(std::string geojson, PlanToGeoJson(response));  // or (response, frame)
-//   std::string csv = PlanToCsv(response);
+//   ASSIGN_OR_RETURN(std::string csv, PlanToCsv(response));
 //   ASSIGN_OR_RETURN(std::string path, PlanToNavPath(response, {.frame_id = "map"}));
 //
 // - GeoJSON: a FeatureCollection (RFC 7946 structure: closed rings, exteriors
@@ -15,10 +15,14 @@
 //   "no_go": Polygons).
 // - CSV: a header, then one line per waypoint: x,y,heading_rad,time_s,kind,rank
 //   (numbers printed to round-trip exactly).
+// Each is InvalidArgument for a plan without a path, or whose waypoints carry
+// no times (a plan.json from before they did). A path of one waypoint (an
+// idle fleet robot) is a GeoJSON Point.
 // - nav_msgs/Path as JSON (the ROS 2 message's fields, as rosbridge and
 //   rclpy's message converters take them): header (frame_id, stamp) and one
 //   PoseStamped per waypoint, its stamp the start stamp plus the waypoint's
-//   time_s, its orientation the quaternion of a yaw of theta.
+//   time_s (all 0 without a start stamp), its orientation the quaternion of a
+//   yaw of theta.
 //
 // Thread-safety: stateless functions.
 #ifndef COVPLAN_API_PLAN_EXPORT_H_
@@ -45,11 +49,13 @@ struct ExportFrame {
 absl::StatusOr<std::string> PlanToGeoJson(const v1::PlanResponse& plan,
                                           const ExportFrame& frame = {});
 
-std::string PlanToCsv(const v1::PlanResponse& plan, const ExportFrame& frame = {});
+absl::StatusOr<std::string> PlanToCsv(const v1::PlanResponse& plan, const ExportFrame& frame = {});
 
 struct NavPathOptions {
   std::string frame_id = "map";
-  double start_stamp_s = 0.0;  // Unix seconds of the path's start (0: unset, as ROS reads it)
+  // Unix seconds of the path's start: each pose is stamped start + its time_s.
+  // 0: every stamp 0 ("unset", which ROS reads as "the latest").
+  double start_stamp_s = 0.0;
 };
 absl::StatusOr<std::string> PlanToNavPath(const v1::PlanResponse& plan,
                                           const NavPathOptions& options);

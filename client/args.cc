@@ -115,21 +115,6 @@ absl::Status WriteTextFile(const std::string& path, const std::string& contents)
   return absl::OkStatus();
 }
 
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    const unsigned char c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\', out += ch;
-    } else if (c < 0x20) {
-      absl::StrAppendFormat(&out, "\\u%04x", c);
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
 std::optional<Pose2> ParseXyTheta(const std::string& text) {
   std::vector<double> v;
   size_t begin = 0;

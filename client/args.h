@@ -19,6 +19,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "planner/common/json_text.h"
 #include "planner/tour/robot_model.h"
 
 namespace covplan {
@@ -68,9 +69,6 @@ absl::Status WriteTextFile(const std::string& path, const std::string& contents)
 // "X,Y" or "X,Y,THETA", finite numbers (theta 0 when absent); nullopt
 // otherwise. The pose flags (--start, --end, --robot) read poses with it.
 std::optional<Pose2> ParseXyTheta(const std::string& text);
-
-// `s` as a JSON string literal (quotes, backslashes and control characters escaped).
-std::string JsonString(const std::string& s);
 
 // Shared main of a subcommand: prints `usage` for --help/-h, else runs
 // `run(args)` and maps its status to an exit code (errors on stderr, prefixed

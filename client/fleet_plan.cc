@@ -25,10 +25,6 @@ namespace {
 constexpr char kRobotSyntax[] = "[ID=]X,Y[,THETA] (metres, radians)";
 
 // Non-finite numbers (the closest approach of a single robot) are null.
-std::string JsonNumber(double v) {
-  return std::isfinite(v) ? absl::StrFormat("%.10g", v) : std::string("null");
-}
-
 // "converged" or "limit: time (detail)".
 std::string TerminationText(const Termination& t) {
   if (!t.limit_reached()) return "converged";

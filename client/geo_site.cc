@@ -34,8 +34,7 @@ absl::StatusOr<std::optional<GeoFrame>> ProjectIntoSite(const std::optional<std:
   if (robot->has_start()) RETURN_IF_ERROR(ProjectPose(frame, "--start", robot->mutable_start()));
   if (robot->has_end()) RETURN_IF_ERROR(ProjectPose(frame, "--end", robot->mutable_end()));
   if (request->has_battery() && request->battery().has_station()) {
-    RETURN_IF_ERROR(
-        ProjectPose(frame, "--station", request->mutable_battery()->mutable_station()));
+    RETURN_IF_ERROR(ProjectPose(frame, "--station", request->mutable_battery()->mutable_station()));
   }
   if (fleet != nullptr) {
     for (FleetRobot& r : *fleet) {

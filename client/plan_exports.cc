@@ -44,7 +44,10 @@ absl::Status WritePlanExports(const PlanExports& exports, const v1::PlanResponse
     ASSIGN_OR_RETURN(std::string text, PlanToGeoJson(plan, frame));
     RETURN_IF_ERROR(WriteTextFile(*exports.geojson, text));
   }
-  if (exports.csv) RETURN_IF_ERROR(WriteTextFile(*exports.csv, PlanToCsv(plan, frame)));
+  if (exports.csv) {
+    ASSIGN_OR_RETURN(std::string text, PlanToCsv(plan, frame));
+    RETURN_IF_ERROR(WriteTextFile(*exports.csv, text));
+  }
   if (exports.nav_path) {
     ASSIGN_OR_RETURN(std::string text, PlanToNavPath(plan, exports.nav));
     RETURN_IF_ERROR(WriteTextFile(*exports.nav_path, text));

@@ -13,6 +13,9 @@ bash scripts/install-deps.sh --only python3-venv python3-pip python3-grpcio pyth
 if [ ! -x "$VENV/bin/python" ]; then
   /usr/bin/python3 -m venv --system-site-packages "$VENV" >&2
 fi
+# pip reads a "no-" option from a config file inverted: "no-build-isolation = false" turns
+# build isolation OFF. no-index: only Debian's packages and local directories are installable
+# here (PyPI is not reachable); drop it from the venv's pip.conf where PyPI is.
 printf '[global]\nno-build-isolation = false\nno-index = true\ndisable-pip-version-check = true\n' \
   > "$VENV/pip.conf"
 # A build directory of its own, so concurrent installs (two test trees) never share one.

@@ -142,6 +142,10 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   // gRPC 1.51 sets SO_REUSEPORT by default, which would let two servers
   // share a port silently; we want the second one to fail.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  // Clients of long Drive streams over flaky links (the Python client) send
+  // keepalive pings every 20 s during a call to notice a dead link; gRPC's
+  // default (a ping per 5 minutes, two strikes) would answer them with GOAWAY.
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 10000);
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
   builder.SetMaxSendMessageSize(config.max_message_bytes);
   const std::string address = absl::StrCat(config.address, ":", config.port);

@@ -84,6 +84,11 @@ ABSL_FLAG(std::string, token_file, "",
           "File of \"<sha256 hex of a bearer token> <tenant>\" lines; every call then needs "
           "\"authorization: Bearer <token>\" and sees only its tenant's maps and plans (health and "
           "reflection stay open). Reread on SIGHUP. Empty = no tokens");
+ABSL_FLAG(int, max_sessions, 64, "Drive sessions open at once; beyond: RESOURCE_EXHAUSTED");
+ABSL_FLAG(double, session_idle_s, 120.0,
+          "A Drive session without a message for this long ends with DEADLINE_EXCEEDED");
+ABSL_FLAG(int, max_live_streams, 4,
+          "Live event streams (GET /v1/events) open at once (<= 32 of the 48 HTTP threads)");
 ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
@@ -138,6 +143,9 @@ std::vector<std::string> ValidateFlags() {
   CheckRange("max_request_s", absl::GetFlag(FLAGS_max_request_s), 1e-3, 24 * 3600.0, &errors);
   CheckRange("drain_grace_s", absl::GetFlag(FLAGS_drain_grace_s), 0.0, 3600.0, &errors);
   CheckRange("drain_notice_s", absl::GetFlag(FLAGS_drain_notice_s), 0.0, 3600.0, &errors);
+  CheckRange("max_sessions", absl::GetFlag(FLAGS_max_sessions), 1, 100000, &errors);
+  CheckRange("session_idle_s", absl::GetFlag(FLAGS_session_idle_s), 0.1, 24 * 3600.0, &errors);
+  CheckRange("max_live_streams", absl::GetFlag(FLAGS_max_live_streams), 1, 32, &errors);
   if (absl::GetFlag(FLAGS_tls_cert).empty() != absl::GetFlag(FLAGS_tls_key).empty()) {
     errors.push_back("--tls_cert and --tls_key: give both or neither");
   }
@@ -182,6 +190,9 @@ covplan::ServerConfig ConfigFromFlags() {
   service.limits.max_transition_bytes = absl::GetFlag(FLAGS_max_transition_mb) << 20;
   service.limits.dense_transition_bytes = absl::GetFlag(FLAGS_dense_transition_mb) << 20;
   service.max_request_time = absl::Seconds(absl::GetFlag(FLAGS_max_request_s));
+  service.max_sessions = absl::GetFlag(FLAGS_max_sessions);
+  service.session_idle = absl::Seconds(absl::GetFlag(FLAGS_session_idle_s));
+  service.max_live_streams = absl::GetFlag(FLAGS_max_live_streams);
   // Room for the image plus YAML and the rest of the request.
   config.max_message_bytes =
       static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));

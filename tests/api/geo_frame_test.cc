@@ -15,12 +15,11 @@ namespace {
 
 using ::testing::HasSubstr;
 
-google::protobuf::RepeatedPtrField<v1::Polygon> Square(double x0, double y0, double dx,
-                                                       double dy) {
+google::protobuf::RepeatedPtrField<v1::Polygon> Square(double x0, double y0, double dx, double dy) {
   google::protobuf::RepeatedPtrField<v1::Polygon> out;
   v1::Ring* ring = out.Add()->mutable_outer();
-  for (auto [x, y] : {std::pair{x0, y0}, {x0 + dx, y0}, {x0 + dx, y0 + dy}, {x0, y0 + dy},
-                      {x0, y0}}) {
+  for (auto [x, y] :
+       {std::pair{x0, y0}, {x0 + dx, y0}, {x0 + dx, y0 + dy}, {x0, y0 + dy}, {x0, y0}}) {
     v1::Point2* p = ring->add_points();
     p->set_x(x);
     p->set_y(y);
@@ -32,8 +31,9 @@ google::protobuf::RepeatedPtrField<v1::Polygon> Square(double x0, double y0, dou
 // 0.5 % over a few km, enough to check the projection's scale).
 double HaversineM(double lon1, double lat1, double lon2, double lat2) {
   const double r = 6371008.8, k = M_PI / 180.0;
-  const double a = std::pow(std::sin((lat2 - lat1) * k / 2), 2) +
-                   std::cos(lat1 * k) * std::cos(lat2 * k) * std::pow(std::sin((lon2 - lon1) * k / 2), 2);
+  const double a =
+      std::pow(std::sin((lat2 - lat1) * k / 2), 2) +
+      std::cos(lat1 * k) * std::cos(lat2 * k) * std::pow(std::sin((lon2 - lon1) * k / 2), 2);
   return 2 * r * std::asin(std::sqrt(a));
 }
 
@@ -117,8 +117,7 @@ TEST(GeoFrame, UnknownOrUnfitCrsIsInvalidArgument) {
     EXPECT_THAT(status.message(), HasSubstr(crs));
   }
   auto wide = Square(-170.0, 10.0, 340.0, 1.0);
-  EXPECT_THAT(GeoFrame::ForSite("EPSG:4326", wide).status().message(),
-              HasSubstr("antimeridian"));
+  EXPECT_THAT(GeoFrame::ForSite("EPSG:4326", wide).status().message(), HasSubstr("antimeridian"));
 }
 
 }  // namespace

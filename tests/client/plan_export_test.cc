@@ -192,6 +192,16 @@ TEST_F(PlanExportTest, NavPathHasUnitQuaternionsOfTheHeadingsAndTimedStamps) {
   }
 }
 
+TEST_F(PlanExportTest, NavPathWithoutAStartStampLeavesEveryStampUnset) {
+  PlanYard({"--out-nav-path", Path("path.json")});
+  const Value doc = ParseJson(Read(Path("path.json")));
+  for (const Value& pose : Field(doc, "poses").list_value().values()) {
+    const Value& stamp = Field(Field(pose, "header"), "stamp");
+    EXPECT_EQ(Field(stamp, "sec").number_value(), 0);
+    EXPECT_EQ(Field(stamp, "nanosec").number_value(), 0);
+  }
+}
+
 TEST_F(PlanExportTest, ExportCommandReadsPlansAndFleetsAndRefusesBadUse) {
   PlanYard({"--out-csv", Path("direct.csv")});
   ASSERT_EQ(RunExportCommand({"--plan", Path("plan.json"), "--out-csv", Path("again.csv")}), 0);
@@ -205,7 +215,10 @@ TEST_F(PlanExportTest, ExportCommandReadsPlansAndFleetsAndRefusesBadUse) {
   ASSERT_EQ(RunExportCommand(
                 {"--plan", Path("fleet.json"), "--robot", "east", "--out-csv", Path("east.csv")}),
             0);
-  EXPECT_GT(Read(Path("east.csv")).size(), 100u);
+  // The file holds east's own plan: it starts where east starts.
+  const std::vector<std::string> east = absl::StrSplit(Read(Path("east.csv")), '\n');
+  ASSERT_GT(east.size(), 2u);
+  EXPECT_THAT(east[1], ::testing::StartsWith("20,1.5,")) << east[1];
   // A fleet needs --robot; unknown robots, missing exports, bad files are errors.
   EXPECT_NE(RunExportCommand({"--plan", Path("fleet.json"), "--out-csv", Path("x.csv")}), 0);
   EXPECT_NE(RunExportCommand(
@@ -214,6 +227,15 @@ TEST_F(PlanExportTest, ExportCommandReadsPlansAndFleetsAndRefusesBadUse) {
   EXPECT_NE(RunExportCommand({"--plan", Path("plan.json")}), 0);
   EXPECT_NE(RunExportCommand({"--plan", Path("direct.csv"), "--out-csv", Path("x.csv")}), 0);
   EXPECT_NE(RunExportCommand({"--plan", Path("plan.json"), "--frame-id", "map"}), 0);
+  // A plan whose waypoints carry no times (written before they did) is refused, not
+  // exported with zeros.
+  v1::PlanResponse untimed;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(Read(Path("plan.json")), &untimed).ok());
+  for (v1::Waypoint& w : *untimed.mutable_path()) w.clear_time_s();
+  std::string text;
+  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(untimed, &text).ok());
+  std::ofstream(Path("untimed.json")) << text;
+  EXPECT_NE(RunExportCommand({"--plan", Path("untimed.json"), "--out-csv", Path("x.csv")}), 0);
   // Exports of a fleet plan must go through covplan export.
   EXPECT_NE(RunPlanCommand(
                 {"--map", office, "--local", "--robot", "a=1.5,1.5", "--out-csv", Path("x.csv")}),

@@ -26,7 +26,11 @@ class Client:
     def __init__(self, address="127.0.0.1:50051", *, token=None, tls=False,
                  root_certificates=None, timeout=60.0):
         options = [("grpc.max_receive_message_length", _MAX_MESSAGE),
-                   ("grpc.max_send_message_length", _MAX_MESSAGE)]
+                   ("grpc.max_send_message_length", _MAX_MESSAGE),
+                   # A Drive stream over a dead link fails within ~30 s instead of hanging
+                   # (covplan-server accepts pings every 10 s during calls).
+                   ("grpc.keepalive_time_ms", 20000), ("grpc.keepalive_timeout_ms", 10000),
+                   ("grpc.keepalive_permit_without_calls", 0)]
         if tls or root_certificates is not None:
             if isinstance(root_certificates, (str, os.PathLike)):
                 with open(root_certificates, "rb") as f:
@@ -95,7 +99,7 @@ class Client:
     def plan_request(self, map, *, tool_width, planner="", options=None, max_speed=None,
                      acceleration=None, turn_rate_deg_s=None, start=None, end=None,
                      regions=None, no_go=None, battery=None, time_limit_s=0.0, seed=0,
-                     min_free_fraction=0.0, improve_remembered=False):
+                     min_free_fraction=0.0, improve_remembered=False, map_options=None):
         """The covplan.v1.PlanRequest that plan() sends (see there)."""
         request = pb.PlanRequest(
             robot=messages.robot_model(tool_width, max_speed, acceleration, turn_rate_deg_s,
@@ -105,12 +109,12 @@ class Client:
             no_go=maps.polygons(no_go), improve_remembered=improve_remembered)
         if isinstance(map, pb.Map):
             request.map.CopyFrom(map)
-        elif isinstance(map, os.PathLike):
-            request.map.CopyFrom(maps.load_map(map))
+        elif isinstance(map, os.PathLike) or (isinstance(map, str) and os.path.isfile(map)):
+            request.map.CopyFrom(maps.load_map(map, **(map_options or {})))
         elif isinstance(map, str):
             request.map_id = map
         else:
-            raise TypeError("map: a map_id (str), a covplan.v1.Map or a pathlib.Path")
+            raise TypeError("map: a map_id (str), a map file's path, or a covplan.v1.Map")
         messages.set_planner_options(request, planner, options)
         if battery is not None:
             request.battery.CopyFrom(messages.from_dict(battery, pb.Battery))
@@ -119,7 +123,9 @@ class Client:
     def plan(self, map, *, tool_width, timeout=None, **kwargs):
         """Plans a coverage path; returns a covplan.Plan.
 
-        map: a map_id (str, from put_map), a covplan.v1.Map (load_map) or a pathlib.Path.
+        map: a map_id (str, from put_map), a map file's path (str or pathlib.Path, sent
+        inline; map_options: covplan.load_map's keywords, e.g. {"resolution": 0.05}) or a
+        covplan.v1.Map.
         tool_width (m, also the grid's cell size); max_speed (m/s), acceleration (m/s²),
         turn_rate_deg_s; start, end: (x, y[, theta]). planner: "oarp" (default),
         "boustrophedon" or "stc", and options: its OarpOptions / BoustrophedonOptions /
@@ -156,12 +162,13 @@ class Client:
         _observe(request, progress, obstacles)
         return Replan(self._call("Resume", request, timeout))
 
-    def drive(self, plan, *, method=None, seed=0, timeout=None):
+    def drive(self, plan, *, method=None, seed=0, timeout=None, open_timeout=30.0):
         """Opens a Drive session on a plan (a plan_id or a Plan); use it as a context
         manager (covplan.drive.DriveSession). timeout: the whole session's deadline (None:
-        none; the server ends idle sessions)."""
+        none; the server ends idle sessions); open_timeout: how long to wait for it to
+        open (DeadlineExceeded beyond)."""
         return DriveSession(self._stub.Drive, _plan_id(plan), self._metadata, method, seed,
-                            timeout)
+                            timeout, open_timeout)
 
     # ------------------------------------------------------------------ fleets
 
@@ -171,12 +178,21 @@ class Client:
 
         robots: covplan.v1.FleetRobot messages or dicts in their JSON form, e.g.
         {"id": "west", "robot": {"toolWidthM": 0.5, "start": {"x": 1, "y": 1}}}.
-        division: "makespan" or "equal_area". **kwargs: what the robots share, as plan()
-        takes it (tool_width included: the request's robot field is ignored otherwise)."""
-        kwargs.setdefault("tool_width", _first_tool_width(robots))
-        shared = self.plan_request(map, **kwargs)
+        division: "makespan" or "equal_area". **kwargs: what plan() takes for the site
+        (planner, options, regions, no_go, time_limit_s, seed, ...) and the robot model
+        every robot shares unless it sets its own (tool_width, max_speed, acceleration,
+        turn_rate_deg_s, end, battery). Each robot's start is its own."""
+        if "start" in kwargs:
+            raise TypeError("plan_fleet: each robot brings its own start")
+        shared_robot = {k: kwargs.pop(k) for k in ("tool_width", "max_speed", "acceleration",
+                                                   "turn_rate_deg_s", "end") if k in kwargs}
+        battery = kwargs.pop("battery", None)
+        fleet = [_with_shared(messages.from_dict(r, pb.FleetRobot), shared_robot, battery)
+                 for r in robots]
         request = pb.PlanFleetRequest(
-            plan=shared, robots=[messages.from_dict(r, pb.FleetRobot) for r in robots],
+            plan=self.plan_request(map, tool_width=fleet[0].robot.tool_width_m if fleet else 0,
+                                   **kwargs),
+            robots=fleet,
             division=messages.enum_value(pb.FleetDivision, division, ("FLEET_DIVISION_", "")),
             clearance_m=float(clearance_m))
         return FleetPlan(self._call("PlanFleet", request, timeout))
@@ -206,9 +222,19 @@ def _plan_id(plan):
     return plan if isinstance(plan, str) else plan.plan_id
 
 
-def _first_tool_width(robots):
-    for robot in robots:
-        robot = messages.from_dict(robot, pb.FleetRobot)
-        if robot.robot.tool_width_m > 0:
-            return robot.robot.tool_width_m
-    raise ValueError("plan_fleet: give tool_width= or each robot's robot.toolWidthM")
+def _with_shared(robot, shared, battery):
+    """A FleetRobot (a copy) with the fleet's shared model fields where it sets none."""
+    out = pb.FleetRobot()
+    out.CopyFrom(robot)
+    model = out.robot
+    if "tool_width" in shared and model.tool_width_m == 0:
+        model.tool_width_m = float(shared["tool_width"])
+    for name, field in (("max_speed", "max_speed_mps"), ("acceleration", "acceleration_mps2"),
+                        ("turn_rate_deg_s", "turn_rate_deg_s")):
+        if name in shared and not model.HasField(field):
+            setattr(model, field, float(shared[name]))
+    if "end" in shared and not model.HasField("end"):
+        model.end.CopyFrom(messages.pose(shared["end"]))
+    if battery is not None and not out.HasField("battery"):
+        out.battery.CopyFrom(messages.from_dict(battery, pb.Battery))
+    return out

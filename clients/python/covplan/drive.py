@@ -10,8 +10,10 @@ plan whenever one is ready (its own replans, or a fleet mission's).
                 break
 
 Messages are sent in order by gRPC's request iterator; events are read by a thread into a
-queue, so the caller never blocks the stream. Leaving the `with` block half-closes the
-stream and waits (bounded) for the server to end the session.
+queue, so the caller never blocks the stream. A session may be shared by threads (reports
+are numbered and queued under a lock). Once the server ends the session (an error, or
+idle past its --session_idle_s), report() raises that error and `ended` is true. Leaving
+the `with` block half-closes the stream and waits (bounded) for the server to end it.
 """
 import queue
 import threading
@@ -57,7 +59,8 @@ def _status(number):
 class DriveSession:
     """An open Drive stream. Use as a context manager (or call close())."""
 
-    def __init__(self, stub_method, plan_ref, metadata, method=None, seed=0, timeout=None):
+    def __init__(self, stub_method, plan_ref, metadata, method=None, seed=0, timeout=None,
+                 open_timeout=30.0):
         first = pb.DriveRequest(method=messages.enum_value(pb.ReplanMethod, method),
                                 seed=int(seed))
         if isinstance(plan_ref, pb.InlinePlan):
@@ -66,22 +69,41 @@ class DriveSession:
             first.plan_id = plan_ref
         self._requests = queue.Queue()
         self._events = queue.Queue()
+        self._lock = threading.Lock()  # the sequence, and closing against reporting
         self._sequence = 0
         self._closed = False
+        self._error = None    # the status the server ended the session with, if not OK
+        self._ended = threading.Event()
         self._requests.put(first)
         self._call = stub_method(iter(self._requests.get, _END), metadata=metadata,
                                  timeout=timeout)
         self._reader = threading.Thread(target=self._read, name="covplan-drive", daemon=True)
         self._reader.start()
-        ready = self._next(timeout=30.0)
+        if timeout is not None:
+            open_timeout = min(open_timeout, timeout)
+        try:
+            ready = self._next(timeout=open_timeout)
+        except BaseException:
+            self.cancel()
+            raise
         if ready is None or ready.response.WhichOneof("event") != "ready":
             self.cancel()
-            raise errors.CovplanError(grpc.StatusCode.UNKNOWN, "the session did not open",
-                                      "Drive")
+            raise errors.error_for(grpc.StatusCode.DEADLINE_EXCEEDED,
+                                   f"the session did not open within {open_timeout} s", "Drive")
         self.ready = ready.response.ready
         self.plan_id = self.ready.plan_id
 
     session_id = property(lambda self: self.ready.session_id)
+
+    @property
+    def ended(self):
+        """Whether the server ended the session (see `error` for how)."""
+        return self._ended.is_set()
+
+    @property
+    def error(self):
+        """The CovplanError the server ended the session with (None: open, or ended OK)."""
+        return self._error
 
     def _read(self):
         try:
@@ -89,27 +111,33 @@ class DriveSession:
                 self._events.put(DriveEvent(event))
             self._events.put(_END)
         except grpc.RpcError as e:
-            self._events.put(errors.from_rpc_error(e, "Drive"))
+            self._error = errors.from_rpc_error(e, "Drive")
+            self._events.put(self._error)
+        finally:
+            self._ended.set()
 
     def report(self, progress=None, obstacles=None, plan_id=None, method=None):
         """Sends where the robot is (covplan.progress(...)) and what it newly sees
         (covplan.obstacles(...)); returns the report's sequence number, which the events
         answering it carry. Without obstacles it is a progress report only (no event).
-        `plan_id`: the plan `progress` refers to (default: the session's newest)."""
-        if self._closed:
-            raise errors.CovplanError(grpc.StatusCode.FAILED_PRECONDITION,
-                                      "the session is closed", "Drive")
-        self._sequence += 1
-        request = pb.DriveRequest(sequence=self._sequence,
-                                  method=messages.enum_value(pb.ReplanMethod, method))
-        if plan_id:
-            request.plan_id = plan_id
-        if progress is not None:
-            request.progress.CopyFrom(messages.progress(progress))
-        if obstacles is not None:
-            request.obstacles.CopyFrom(obstacles)
-        self._requests.put(request)
-        return self._sequence
+        `plan_id`: the plan `progress` refers to (default: the newest plan this session
+        handed out, `self.plan_id`). Raises the server's error once it ended the session,
+        FailedPrecondition once closed here."""
+        with self._lock:
+            if self._error is not None:
+                raise self._error
+            if self._closed or self._ended.is_set():
+                raise errors.error_for(grpc.StatusCode.FAILED_PRECONDITION,
+                                       "the session is closed", "Drive")
+            self._sequence += 1
+            request = pb.DriveRequest(sequence=self._sequence, plan_id=plan_id or self.plan_id,
+                                      method=messages.enum_value(pb.ReplanMethod, method))
+            if progress is not None:
+                request.progress.CopyFrom(messages.progress(progress))
+            if obstacles is not None:
+                request.obstacles.CopyFrom(obstacles)
+            self._requests.put(request)
+            return self._sequence
 
     def _next(self, timeout):
         try:
@@ -143,17 +171,19 @@ class DriveSession:
 
     def close(self, timeout=10.0):
         """Ends the session: half-closes the stream and waits for the server's end."""
-        if not self._closed:
-            self._closed = True
-            self._requests.put(_END)
+        with self._lock:
+            if not self._closed:
+                self._closed = True
+                self._requests.put(_END)
         self._reader.join(timeout)
         if self._reader.is_alive():
             self.cancel()
 
     def cancel(self):
         """Drops the session at once (the server frees it)."""
-        self._closed = True
-        self._requests.put(_END)
+        with self._lock:
+            self._closed = True
+            self._requests.put(_END)
         self._call.cancel()
 
     def __enter__(self):

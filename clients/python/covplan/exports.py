@@ -42,13 +42,26 @@ def _cell_centre(grid, cell):
             grid.origin_y_m + (cell.row + 0.5) * grid.cell_size_m]
 
 
+def _check(r):
+    """Refuses what cannot be exported honestly (as api/plan_export.cc does)."""
+    if not r.path:
+        raise ValueError("the plan has no path")
+    if len(r.path) > 1 and r.path[-1].time_s <= 0 and r.stats.estimated_duration_s > 0:
+        raise ValueError("the plan's waypoints carry no times (time_s): it was written before "
+                         "they did; fetch it again with get_plan or plan again")
+
+
 def to_geojson(plan):
     """The plan as a GeoJSON FeatureCollection (a dict; json.dump it): the path with per-vertex
-    times_s, headings_rad, kinds and ranks; each OARP rank; each charge cycle; the zones."""
+    times_s, headings_rad, kinds and ranks (a Point for a one-waypoint path: an idle fleet
+    robot); each OARP rank; each charge cycle; the zones."""
     r = _response(plan)
+    _check(r)
     path = r.path
+    geometry = ({"type": "Point", "coordinates": [path[0].x, path[0].y]} if len(path) == 1 else
+                {"type": "LineString", "coordinates": [[w.x, w.y] for w in path]})
     features = [_feature(
-        "path", {"type": "LineString", "coordinates": [[w.x, w.y] for w in path]},
+        "path", geometry,
         plan_id=r.plan_id, planner=r.planner, duration_s=r.stats.estimated_duration_s,
         times_s=[w.time_s for w in path], headings_rad=[w.theta for w in path],
         kinds=[pb.SegmentKind.Name(w.kind) for w in path], ranks=[w.rank for w in path])]
@@ -70,33 +83,44 @@ def to_geojson(plan):
 def to_csv(plan):
     """One line per waypoint after a header: x,y,heading_rad,time_s,kind,rank (repr floats:
     they read back exactly)."""
+    r = _response(plan)
+    _check(r)
     lines = ["x,y,heading_rad,time_s,kind,rank"]
-    for w in _response(plan).path:
+    for w in r.path:
         lines.append(f"{w.x!r},{w.y!r},{w.theta!r},{w.time_s!r},"
                      f"{pb.SegmentKind.Name(w.kind)},{w.rank}")
     return "\n".join(lines) + "\n"
 
 
-def _stamp(t):
-    sec = math.floor(t)
-    nanosec = round((t - sec) * 1e9)
-    if nanosec >= 1_000_000_000:
-        sec, nanosec = sec + 1, nanosec - 1_000_000_000
-    return {"sec": int(sec), "nanosec": int(nanosec)}
+def _stamp(start_s, offset_s):
+    """start + offset as a ROS stamp, each split into whole seconds and nanoseconds first
+    (no precision lost adding large doubles); all 0 without a start."""
+    if start_s == 0:
+        return {"sec": 0, "nanosec": 0}
+    start_sec, offset_sec = math.floor(start_s), math.floor(offset_s)
+    nanosec = (math.floor((start_s - start_sec) * 1e9 + 0.5) +
+               math.floor((offset_s - offset_sec) * 1e9 + 0.5))
+    return {"sec": int(start_sec + offset_sec + nanosec // 1_000_000_000),
+            "nanosec": int(nanosec % 1_000_000_000)}
 
 
 def to_nav_path(plan, frame_id="map", start_stamp_s=0.0):
     """The plan as a nav_msgs/Path in the ROS 2 message's JSON form (a dict): each pose
-    stamped start_stamp_s + its waypoint's time_s, its orientation the yaw quaternion."""
+    stamped start_stamp_s + its waypoint's time_s (all stamps 0 without a start: "unset"),
+    its orientation the yaw quaternion."""
     if not frame_id:
         raise ValueError("frame_id must not be empty")
+    if not math.isfinite(start_stamp_s) or start_stamp_s < 0:
+        raise ValueError("start_stamp_s must be Unix seconds >= 0")
+    r = _response(plan)
+    _check(r)
 
     def header(t):
-        return {"frame_id": frame_id, "stamp": _stamp(t)}
+        return {"frame_id": frame_id, "stamp": _stamp(start_stamp_s, t)}
 
-    poses = [{"header": header(start_stamp_s + w.time_s),
+    poses = [{"header": header(w.time_s),
               "pose": {"position": {"x": w.x, "y": w.y, "z": 0.0},
                        "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(w.theta / 2),
                                        "w": math.cos(w.theta / 2)}}}
-             for w in _response(plan).path]
-    return {"header": header(start_stamp_s), "poses": poses}
+             for w in r.path]
+    return {"header": header(0.0), "poses": poses}

@@ -1,6 +1,7 @@
 """What the planning calls return: thin, read-only views over the response messages with
 the figures and the path in Python form. `.response` is always the message itself."""
 import collections
+import functools
 
 from google.protobuf import json_format
 
@@ -12,11 +13,19 @@ try:
 except ImportError:  # numpy is optional: path_array() says so
     numpy = None
 
-Waypoint = collections.namedtuple("Waypoint", "x y theta kind rank time_s")
+Waypoint = collections.namedtuple("Waypoint", "x y theta time_s kind rank")
 Waypoint.__doc__ = ("One path vertex: position (m), heading (rad), the kind of the segment "
+                    "when the robot reaches it (s from the plan's start), the kind of the segment "
                     "ending here (\"START\", \"COVERAGE\", \"TRANSITION\", \"TO_STATION\", "
-                    "\"FROM_STATION\"), the rank (or cell) it sweeps, else -1, and when the "
-                    "robot reaches it (s from the plan's start).")
+                    "\"FROM_STATION\") and the rank (or cell) it sweeps, else -1.")
+
+
+def _kind_name(number):
+    """A SegmentKind's name; the number as text for a kind newer than this client."""
+    try:
+        return pb.SegmentKind.Name(number)
+    except ValueError:
+        return str(number)
 
 
 class Plan:
@@ -35,10 +44,10 @@ class Plan:
     duration_s = property(lambda self: self.response.stats.estimated_duration_s)
     cut_short = property(lambda self: self.response.stats.tour_cut_short)
 
-    @property
+    @functools.cached_property
     def path(self):
-        """The path as a list of Waypoint(x, y, theta, kind, rank, time_s)."""
-        return [Waypoint(w.x, w.y, w.theta, pb.SegmentKind.Name(w.kind), w.rank, w.time_s)
+        """The path as a list of Waypoint(x, y, theta, time_s, kind, rank)."""
+        return [Waypoint(w.x, w.y, w.theta, w.time_s, _kind_name(w.kind), w.rank)
                 for w in self.response.path]
 
     def path_array(self):
@@ -52,7 +61,7 @@ class Plan:
         """Length of the path's segments (of one kind, e.g. "COVERAGE", when given)."""
         total, path = 0.0, self.response.path
         for a, b in zip(path, path[1:]):
-            if kind is None or pb.SegmentKind.Name(b.kind) == kind:
+            if kind is None or _kind_name(b.kind) == kind:
                 total += ((b.x - a.x) ** 2 + (b.y - a.y) ** 2) ** 0.5
         return total
 
@@ -74,8 +83,10 @@ class Plan:
         return exports.to_nav_path(self, frame_id, start_stamp_s)
 
     def to_json(self):
-        """The plan in the proto's JSON form (as the CLI's plan.json)."""
-        return json_format.MessageToJson(self.response)
+        """The plan in the proto's JSON form, as the CLI's plan.json (snake_case names,
+        defaults printed)."""
+        return json_format.MessageToJson(self.response, preserving_proto_field_name=True,
+                                         including_default_value_fields=True)
 
     def __repr__(self):
         return (f"Plan({self.plan_id!r}, planner={self.planner!r}, ranks={self.num_ranks}, "

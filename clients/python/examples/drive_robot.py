@@ -53,7 +53,10 @@ def run(client, plan):
                     sequence = session.report(covplan.progress(waypoint, (here.x, here.y)),
                                               covplan.obstacles(points=[point]))
                     print(f"obstacle at ({point[0]:.2f}, {point[1]:.2f}) on waypoint {index}")
-                    event = next(e for e in session.events(timeout=30) if e.sequence == sequence)
+                    event = next((e for e in session.events(timeout=30)
+                                  if e.sequence == sequence), None)
+                    if event is None:
+                        sys.exit("covplan: no replan within 30 s")
                     if event.error:
                         raise event.error
                     plan, waypoint = event.replan, 1

@@ -42,13 +42,11 @@ def main():
           f"{stats.coverage_length_m:.1f} m coverage + {stats.transition_length_m:.1f} m "
           f"transitions, {plan.duration_s:.1f} s, {stats.covered_cells}/{stats.free_cells} "
           f"cells swept, planned in {stats.planning_ms:.0f} ms")
-    out = pathlib.Path(args.out)
-    out.with_suffix(".json").write_text(plan.to_json())
-    out.with_suffix(".svg").write_text(plan.to_svg())
-    out.with_suffix(".geojson").write_text(json.dumps(plan.to_geojson()))
-    out.with_suffix(".csv").write_text(plan.to_csv())
-    out.with_suffix(".nav_path.json").write_text(json.dumps(plan.to_nav_path(frame_id="map")))
-    print(f"wrote {out}.json, .svg, .geojson, .csv and .nav_path.json")
+    for suffix, text in ((".json", plan.to_json()), (".svg", plan.to_svg()),
+                         (".geojson", json.dumps(plan.to_geojson())), (".csv", plan.to_csv()),
+                         (".nav_path.json", json.dumps(plan.to_nav_path(frame_id="map")))):
+        pathlib.Path(args.out + suffix).write_text(text)
+    print(f"wrote {args.out}.json, .svg, .geojson, .csv and .nav_path.json")
 
 
 if __name__ == "__main__":

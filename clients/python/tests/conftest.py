@@ -1,6 +1,7 @@
 """A covplan-server for the Python client's tests: started once per run on a free port with
 a store of its own (COVPLAN_SERVER names the binary; default build/bin/covplan-server), and
-a second one with TLS and bearer tokens when openssl can make certificates."""
+a second one with TLS and bearer tokens when openssl can make certificates. Sessions idle
+for 3 s end (--session_idle_s), so a test can see one end."""
 import hashlib
 import os
 import shutil
@@ -19,6 +20,9 @@ MAPS = os.path.join(ROOT, "maps")
 TOKEN = "py-client-test-token"
 
 
+SERVER_BINARY = os.environ.get("COVPLAN_SERVER", os.path.join(ROOT, "build/bin/covplan-server"))
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -27,7 +31,7 @@ def free_port():
 
 class Server:
     def __init__(self, *flags):
-        binary = os.environ.get("COVPLAN_SERVER", os.path.join(ROOT, "build/bin/covplan-server"))
+        binary = SERVER_BINARY
         if not os.access(binary, os.X_OK):
             pytest.fail(f"no covplan-server at {binary} (set COVPLAN_SERVER)")
         self.dir = tempfile.mkdtemp(prefix="covplan-py-")
@@ -36,7 +40,8 @@ class Server:
         self.log = open(os.path.join(self.dir, "server.log"), "w+")
         self.proc = subprocess.Popen(
             [binary, f"--port={self.port}", "--metrics_port=-1", f"--store_dir={self.dir}/maps",
-             "--threads=2", *flags], stdout=self.log, stderr=subprocess.STDOUT)
+             "--threads=2", "--session_idle_s=3", *flags], stdout=self.log,
+            stderr=subprocess.STDOUT)
 
     def wait(self, client):
         deadline = time.monotonic() + 60

@@ -21,7 +21,7 @@ def test_plan_map_writes_json_and_svg(server, tmp_path):
     text = run("plan_map.py", "--server", server.address, "--map",
                os.path.join(MAPS, "sample_office.yaml"), "--out", str(out))
     plan = json.loads(out.with_suffix(".json").read_text())
-    assert plan["planId"] in text
+    assert plan["plan_id"] in text
     assert out.with_suffix(".svg").read_text().startswith("<svg")
     geojson = json.loads(out.with_suffix(".geojson").read_text())
     assert len(geojson["features"][0]["geometry"]["coordinates"]) == len(plan["path"])

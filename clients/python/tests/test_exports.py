@@ -12,7 +12,14 @@ import subprocess
 import pytest
 
 import covplan
-from conftest import MAPS
+import covplan.exports
+from conftest import MAPS, SERVER_BINARY
+
+# A clockwise no-go square with a clockwise hole: the exports must turn the outer ring
+# counter-clockwise and the hole clockwise (RFC 7946).
+ZONE = {"type": "Polygon", "coordinates": [
+    [[19.0, 2.0], [19.0, 5.0], [22.6, 5.0], [22.6, 2.0], [19.0, 2.0]],
+    [[20.0, 3.0], [20.0, 4.0], [21.0, 4.0], [21.0, 3.0], [20.0, 3.0]]]}
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +27,7 @@ def yard_plan(server):
     battery = {"capacity": 400.0, "station": {"x": 1.0, "y": 1.0}}
     with covplan.Client(server.address) as client:
         return client.plan(pathlib.Path(MAPS) / "sample_yard.geojson", tool_width=0.5,
-                           no_go=os.path.join(MAPS, "sample_yard_no_go.geojson"),
+                           no_go=ZONE,
                            battery=battery, time_limit_s=0.5)
 
 
@@ -41,9 +48,10 @@ def test_geojson_follows_rfc7946_and_lies_inside_the_lawn(yard_plan):
     assert yard.buffer(1e-6).contains(line)
     [zone] = by_kind["no_go"]
     polygon = shapely.shape(zone["geometry"])
-    assert line.distance(polygon) > 0  # never entered, not even touched
-    ring = zone["geometry"]["coordinates"][0]
-    assert ring[0] == ring[-1] and shapely.LinearRing(ring).is_ccw
+    assert line.distance(shapely.Polygon(polygon.exterior)) > 0  # never entered nor touched
+    outer, hole = zone["geometry"]["coordinates"]
+    assert outer[0] == outer[-1] and shapely.LinearRing(outer).is_ccw
+    assert hole[0] == hole[-1] and not shapely.LinearRing(hole).is_ccw
     assert len(by_kind["rank"]) == yard_plan.num_ranks
     assert len(by_kind.get("cycle", [])) == len(yard_plan.response.cycles) > 1
 
@@ -73,8 +81,22 @@ def test_nav_path_quaternions_are_unit_and_match_the_headings(yard_plan):
         yard_plan.to_nav_path(frame_id="")
 
 
+def test_plans_without_times_are_refused_and_a_lone_waypoint_is_a_point(yard_plan):
+    untimed = covplan.v1.covplan_pb2.PlanResponse()
+    untimed.CopyFrom(yard_plan.response)
+    for w in untimed.path:
+        w.time_s = 0.0
+    for export in (covplan.exports.to_geojson, covplan.exports.to_csv,
+                   covplan.exports.to_nav_path):
+        with pytest.raises(ValueError, match="no times"):
+            export(untimed)
+    del untimed.path[1:]
+    geometry = covplan.exports.to_geojson(untimed)["features"][0]["geometry"]
+    assert geometry == {"type": "Point", "coordinates": [untimed.path[0].x, untimed.path[0].y]}
+
+
 def test_the_cli_writes_the_same_exports(yard_plan, tmp_path):
-    cli = os.path.join(os.path.dirname(os.environ.get("COVPLAN_SERVER", "")), "covplan")
+    cli = os.path.join(os.path.dirname(SERVER_BINARY), "covplan")
     if not os.access(cli, os.X_OK):
         pytest.fail(f"no covplan CLI beside the server ({cli})")
     plan_json = tmp_path / "plan.json"
@@ -88,6 +110,7 @@ def test_the_cli_writes_the_same_exports(yard_plan, tmp_path):
         start_stamp_s=12.5)
     cli_rows = list(csv.reader(open(tmp_path / "plan.csv")))
     py_rows = list(csv.reader(io.StringIO(yard_plan.to_csv())))
+    assert len(cli_rows) == len(py_rows) == len(yard_plan.path) + 1
     assert cli_rows[0] == py_rows[0]
     for a, b in zip(cli_rows[1:], py_rows[1:]):
         assert [float(v) for v in a[:4]] == [float(v) for v in b[:4]] and a[4:] == b[4:]

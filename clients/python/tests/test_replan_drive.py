@@ -84,8 +84,23 @@ def test_drive_session_reports_an_obstacle_and_receives_a_replan(client, office_
         assert session.plan_id == event.replan.plan_id
         assert not covers_cell(event.replan, cell_of(plan, point))
         assert session.next_event(timeout=0.5) is None  # nothing more was asked
-    with pytest.raises(covplan.CovplanError, match="closed"):
+    with pytest.raises(covplan.FailedPrecondition, match="closed"):
         session.report(covplan.progress(1, (here.x, here.y)))
+
+
+def test_a_session_the_server_ended_raises_on_the_next_report(client, office_id):
+    import time
+    plan = client.plan(office_id, tool_width=0.5, seed=4, time_limit_s=0.5)
+    w = plan.path[0]
+    with client.drive(plan) as session:
+        session.report(covplan.progress(1, (w.x, w.y)))
+        time.sleep(4.5)  # past the test server's --session_idle_s=3
+        assert session.ended
+        assert isinstance(session.error, covplan.DeadlineExceeded)
+        with pytest.raises(covplan.DeadlineExceeded, match="idle"):
+            session.report(covplan.progress(1, (w.x, w.y)))
+    with pytest.raises(covplan.DeadlineExceeded):  # how it ended, still after closing
+        session.report(covplan.progress(1, (w.x, w.y)))
 
 
 def test_drive_on_an_unknown_plan_raises_not_found(client):
