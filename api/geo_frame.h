@@ -3,7 +3,9 @@
 // longitude/latitude as RFC 7946 GeoJSON has them; or e.g. a UTM zone,
 // "EPSG:32632") go through the CRS's own geographic coordinates onto a
 // transverse Mercator on its ellipsoid, centred on the site (k = 1, x east
-// and y north in metres), where covplan grids and plans; Inverse brings plan
+// and y north in metres) and shifted so the corner of the site's extent is
+// (0, 0) (the grid then meets the site's edges as it meets a site drawn in
+// metres from its corner), where covplan grids and plans; Inverse brings plan
 // coordinates back. Positions are in GeoJSON's order (x = longitude or
 // easting, y = latitude or northing), whatever the CRS's official axis order.
 //
@@ -30,13 +32,15 @@ namespace covplan {
 
 class GeoFrame {
  public:
-  // The frame of a site whose polygons are in `crs`: centred on the middle of
-  // their extent in the CRS's geographic coordinates.
+  // The frame of a site whose polygons are in `crs`: its central meridian and
+  // latitude the middle of their extent in the CRS's geographic coordinates,
+  // its origin the lower-left corner of their projected extent.
   static absl::StatusOr<GeoFrame> ForSite(
       absl::string_view crs, const google::protobuf::RepeatedPtrField<v1::Polygon>& site,
       absl::string_view what = "map.polygons");
 
-  // Every point of `polygons` from the CRS into the local frame, in place.
+  // Every point of `polygons` from the CRS into the local frame, in place,
+  // rounded to the millimetre (edges shared in the CRS stay shared).
   absl::Status Project(google::protobuf::RepeatedPtrField<v1::Polygon>* polygons,
                        absl::string_view what) const;
   // One point (or pose position) from the CRS into the local frame.

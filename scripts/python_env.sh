@@ -9,7 +9,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${1:-.venv}
 bash scripts/install-deps.sh --only python3-venv python3-pip python3-grpcio python3-protobuf \
-  python3-numpy python3-pytest protobuf-compiler protobuf-compiler-grpc >&2
+  python3-numpy python3-pytest python3-pyproj python3-shapely protobuf-compiler \
+  protobuf-compiler-grpc >&2
 if [ ! -x "$VENV/bin/python" ]; then
   /usr/bin/python3 -m venv --system-site-packages "$VENV" >&2
 fi

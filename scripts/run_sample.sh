@@ -3,11 +3,14 @@
 # embedded defaults (on-disk map store under ./covplan-data, no external
 # services), plan the shipped sample map through the server, print the
 # figures and write plan.json and plan.svg; then plan the shipped office for
-# a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg;
+# a fleet of three robots (PlanFleet) and write fleet.json and fleet.svg; plan
+# a lawn drawn in longitude/latitude (--crs EPSG:4326) and write its route
+# back in longitude/latitude (lawn.geojson, lawn.csv, lawn_path.json);
 # list the stored maps over the JSON API (--http_port); last, install the Python
 # client into .venv and run its examples (plan_py.json, plan_py.svg; a robot
-# driven through a Drive session). With WATCH=1 it then drives a simulated robot through the server at 10x real time (covplan
-# simulate --watch) to watch live in the web console, and stops when it ends.
+# driven through a Drive session). With WATCH=1 it then drives a simulated
+# robot through the server at 10x real time (covplan simulate --watch) to
+# watch live in the web console, and stops when it ends.
 #   scripts/run_sample.sh [MAP] [extra `covplan plan` flags...]
 #   WATCH=1 scripts/run_sample.sh
 set -euo pipefail
@@ -52,6 +55,15 @@ if [ "${FLEET:-1}" = 1 ]; then
     --out "$OUT_DIR/fleet.json" --svg "$OUT_DIR/fleet.svg"
   echo "wrote $OUT_DIR/fleet.json and $OUT_DIR/fleet.svg"
 fi
+
+# A lawn drawn on a web map (longitude/latitude, RFC 7946) planned through the same
+# server: --crs EPSG:4326 projects it onto a local metric frame with PROJ; the route comes
+# back in longitude/latitude (lawn.geojson) and as CSV waypoints and a nav_msgs/Path.
+./build/bin/covplan plan --map maps/sample_lawn_lonlat.geojson --crs EPSG:4326 \
+  --no-go maps/sample_lawn_lonlat_no_go.geojson --server "127.0.0.1:$PORT" \
+  --out-geojson "$OUT_DIR/lawn.geojson" --out-csv "$OUT_DIR/lawn.csv" \
+  --out-nav-path "$OUT_DIR/lawn_path.json" | grep -E '^(frame|ranks|duration)'
+echo "wrote $OUT_DIR/lawn.geojson (lon/lat), lawn.csv and lawn_path.json"
 
 # The same server over its JSON API: the maps stored so far.
 echo "curl -X POST http://127.0.0.1:$HTTP_PORT/v1/ListMaps -d '{}':"

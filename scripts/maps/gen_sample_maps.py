@@ -277,6 +277,20 @@ def write_geojson(path, polygons):
         f.write("\n")
 
 
+def to_lon_lat(polygons, lon0=11.5874, lat0=48.1557):
+    """The polygons placed on the globe (a park in Munich), longitude/latitude in
+    degrees as a web map draws them (RFC 7946 GeoJSON): a local equirectangular
+    approximation on the WGS84 ellipsoid's radii, good to millimetres over 25 m."""
+    a, e2 = 6378137.0, 6.69437999014e-3
+    s = math.sin(math.radians(lat0))
+    n = a / math.sqrt(1 - e2 * s * s)                   # prime vertical radius
+    m = a * (1 - e2) / (1 - e2 * s * s) ** 1.5          # meridian radius
+    def ll(p):
+        return (round(lon0 + math.degrees(p[0] / (n * math.cos(math.radians(lat0)))), 9),
+                round(lat0 + math.degrees(p[1] / m), 9))
+    return [[[ll(p) for p in ring] for ring in poly] for poly in polygons]
+
+
 def write_yaml(path, image, origin):
     with open(path, "w") as f:
         f.write("image: %s\nresolution: %g\norigin: [%g, %g, 0.0]\nnegate: 0\n"
@@ -305,6 +319,8 @@ def main():
     yard, zones = yard_polygons()
     write_geojson(os.path.join(args.out, "sample_yard.geojson"), yard)
     write_geojson(os.path.join(args.out, "sample_yard_no_go.geojson"), zones)
+    write_geojson(os.path.join(args.out, "sample_lawn_lonlat.geojson"), to_lon_lat(yard))
+    write_geojson(os.path.join(args.out, "sample_lawn_lonlat_no_go.geojson"), to_lon_lat(zones))
     if args.preview:
         os.makedirs(args.preview, exist_ok=True)
         for name, canvas in outputs:

@@ -17,8 +17,13 @@ def _response(plan):
     return getattr(plan, "response", plan)
 
 
-def _ring(ring, exterior):
-    points = [[p.x, p.y] for p in ring.points]
+def _xy(frame, x, y):
+    """A map-frame position in the export's CRS (a covplan.geo.GeoFrame), or as it is."""
+    return list(frame.inverse(x, y)) if frame is not None else [x, y]
+
+
+def _ring(ring, exterior, frame=None):
+    points = [_xy(frame, p.x, p.y) for p in ring.points]
     if points and points[0] != points[-1]:
         points.append(list(points[0]))
     twice_area = sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(points, points[1:]))
@@ -27,9 +32,10 @@ def _ring(ring, exterior):
     return points
 
 
-def _polygon(polygon):
+def _polygon(polygon, frame=None):
     return {"type": "Polygon",
-            "coordinates": [_ring(polygon.outer, True)] + [_ring(h, False) for h in polygon.holes]}
+            "coordinates": [_ring(polygon.outer, True, frame)] +
+                           [_ring(h, False, frame) for h in polygon.holes]}
 
 
 def _feature(name, geometry, **properties):
@@ -37,9 +43,9 @@ def _feature(name, geometry, **properties):
     return {"type": "Feature", "geometry": geometry, "properties": properties}
 
 
-def _cell_centre(grid, cell):
-    return [grid.origin_x_m + (cell.col + 0.5) * grid.cell_size_m,
-            grid.origin_y_m + (cell.row + 0.5) * grid.cell_size_m]
+def _cell_centre(grid, cell, frame=None):
+    return _xy(frame, grid.origin_x_m + (cell.col + 0.5) * grid.cell_size_m,
+               grid.origin_y_m + (cell.row + 0.5) * grid.cell_size_m)
 
 
 def _check(r):
@@ -51,15 +57,17 @@ def _check(r):
                          "they did; fetch it again with get_plan or plan again")
 
 
-def to_geojson(plan):
+def to_geojson(plan, frame=None):
     """The plan as a GeoJSON FeatureCollection (a dict; json.dump it): the path with per-vertex
     times_s, headings_rad, kinds and ranks (a Point for a one-waypoint path: an idle fleet
-    robot); each OARP rank; each charge cycle; the zones."""
+    robot); each OARP rank; each charge cycle; the zones. `frame` (covplan.geo.GeoFrame):
+    positions back in the site's CRS."""
     r = _response(plan)
     _check(r)
     path = r.path
-    geometry = ({"type": "Point", "coordinates": [path[0].x, path[0].y]} if len(path) == 1 else
-                {"type": "LineString", "coordinates": [[w.x, w.y] for w in path]})
+    geometry = ({"type": "Point", "coordinates": _xy(frame, path[0].x, path[0].y)}
+                if len(path) == 1 else
+                {"type": "LineString", "coordinates": [_xy(frame, w.x, w.y) for w in path]})
     features = [_feature(
         "path", geometry,
         plan_id=r.plan_id, planner=r.planner, duration_s=r.stats.estimated_duration_s,
@@ -67,27 +75,34 @@ def to_geojson(plan):
         kinds=[pb.SegmentKind.Name(w.kind) for w in path], ranks=[w.rank for w in path])]
     for i, rank in enumerate(r.ranks):
         features.append(_feature(
-            "rank", {"type": "LineString", "coordinates": [_cell_centre(r.grid, rank.first_cell),
-                                                           _cell_centre(r.grid, rank.last_cell)]},
+            "rank", {"type": "LineString",
+                     "coordinates": [_cell_centre(r.grid, rank.first_cell, frame),
+                                     _cell_centre(r.grid, rank.last_cell, frame)]},
             index=i, orientation=pb.Orientation.Name(rank.orientation)))
     for i, cycle in enumerate(r.cycles):
-        points = [[w.x, w.y] for w in path[max(0, cycle.first_waypoint):cycle.last_waypoint + 1]]
+        points = [_xy(frame, w.x, w.y)
+                  for w in path[max(0, cycle.first_waypoint):cycle.last_waypoint + 1]]
         if len(points) >= 2:
             features.append(_feature("cycle", {"type": "LineString", "coordinates": points},
                                      index=i, energy=cycle.energy))
-    features += [_feature("region", _polygon(z)) for z in r.regions]
-    features += [_feature("no_go", _polygon(z)) for z in r.no_go]
-    return {"type": "FeatureCollection", "features": features}
+    features += [_feature("region", _polygon(z, frame)) for z in r.regions]
+    features += [_feature("no_go", _polygon(z, frame)) for z in r.no_go]
+    collection = {"type": "FeatureCollection", "features": features}
+    if frame is not None and frame.crs not in ("EPSG:4326", "OGC:CRS84"):
+        collection["crs"] = {"type": "name", "properties": {"name": frame.crs}}
+    return collection
 
 
-def to_csv(plan):
+def to_csv(plan, frame=None):
     """One line per waypoint after a header: x,y,heading_rad,time_s,kind,rank (repr floats:
-    they read back exactly)."""
+    they read back exactly); with a geographic `frame`, lon,lat in its CRS."""
     r = _response(plan)
     _check(r)
-    lines = ["x,y,heading_rad,time_s,kind,rank"]
+    lines = [("lon,lat" if frame is not None and frame.geographic else "x,y") +
+             ",heading_rad,time_s,kind,rank"]
     for w in r.path:
-        lines.append(f"{w.x!r},{w.y!r},{w.theta!r},{w.time_s!r},"
+        x, y = _xy(frame, w.x, w.y)
+        lines.append(f"{x!r},{y!r},{w.theta!r},{w.time_s!r},"
                      f"{pb.SegmentKind.Name(w.kind)},{w.rank}")
     return "\n".join(lines) + "\n"
 

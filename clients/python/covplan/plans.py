@@ -70,13 +70,14 @@ class Plan:
         from covplan.svg import plan_svg
         return plan_svg(self, width)
 
-    def to_geojson(self):
-        """The plan as a GeoJSON FeatureCollection dict (covplan.exports.to_geojson)."""
-        return exports.to_geojson(self)
+    def to_geojson(self, frame=None):
+        """The plan as a GeoJSON FeatureCollection dict (covplan.exports.to_geojson); with a
+        covplan.geo.GeoFrame, in its site's CRS."""
+        return exports.to_geojson(self, frame)
 
-    def to_csv(self):
+    def to_csv(self, frame=None):
         """CSV waypoints: x,y,heading_rad,time_s,kind,rank (covplan.exports.to_csv)."""
-        return exports.to_csv(self)
+        return exports.to_csv(self, frame)
 
     def to_nav_path(self, frame_id="map", start_stamp_s=0.0):
         """A nav_msgs/Path as a dict in the ROS 2 message's form (covplan.exports)."""
