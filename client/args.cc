@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -113,6 +114,15 @@ absl::Status WriteTextFile(const std::string& path, const std::string& contents)
   out.close();
   if (!out) return absl::InternalError(absl::StrCat("cannot write ", path));
   return absl::OkStatus();
+}
+
+absl::StatusOr<std::string> ReadFlagFile(const std::string& flag, const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in)
+    return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", path, ": cannot read it"));
+  return text.str();
 }
 
 std::optional<Pose2> ParseXyTheta(const std::string& text) {

@@ -62,6 +62,9 @@ absl::StatusOr<T> ParseChoice(const char* flag, const std::string& text,
       absl::StrCat("--", flag, " must be ", names, ", got '", text, "'"));
 }
 
+// The whole file a flag names; InvalidArgument "--FLAG PATH: cannot read it".
+absl::StatusOr<std::string> ReadFlagFile(const std::string& flag, const std::string& path);
+
 // Writes `contents` to `path` (replacing it); InvalidArgument when it cannot
 // be opened, Internal when the write fails.
 absl::Status WriteTextFile(const std::string& path, const std::string& contents);

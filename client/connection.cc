@@ -1,23 +1,11 @@
 #include "client/connection.h"
 
-#include <fstream>
-#include <sstream>
-
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 
 namespace covplan {
 namespace {
-
-absl::StatusOr<std::string> ReadFlagFile(const std::string& flag, const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in)
-    return absl::InvalidArgumentError(absl::StrCat("--", flag, " ", path, ": cannot read it"));
-  return text.str();
-}
 
 absl::StatusOr<std::string> ReadPem(const ParsedArgs& args, const std::string& flag) {
   const std::string path = *args.Get(flag);

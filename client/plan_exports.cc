@@ -4,8 +4,6 @@
 #include <google/protobuf/util/json_util.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "api/convert.h"
@@ -66,14 +64,6 @@ constexpr char kExportUsage[] =
     "--map and --crs: the plan was made with covplan plan --crs CRS on that map; the\n"
     "GeoJSON and CSV are then written in CRS.\n";
 
-absl::StatusOr<std::string> ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::InvalidArgumentError(absl::StrCat("cannot open ", path));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 // The plan in `text`: a PlanResponse, or robot `robot`'s plan of a fleet JSON.
 absl::StatusOr<v1::PlanResponse> PlanFromJsonText(const std::string& text,
                                                   const std::optional<std::string>& robot,
@@ -125,7 +115,7 @@ absl::Status RunExport(const std::vector<std::string>& args) {
   if (!exports.any()) {
     return absl::InvalidArgumentError("name an export: --out-geojson, --out-csv or --out-nav-path");
   }
-  ASSIGN_OR_RETURN(std::string text, ReadText(*path));
+  ASSIGN_OR_RETURN(std::string text, ReadFlagFile("plan", *path));
   ASSIGN_OR_RETURN(v1::PlanResponse plan, PlanFromJsonText(text, a.Get("robot"), *path));
   if (a.Get("crs").has_value() != a.Get("map").has_value())
     return absl::InvalidArgumentError("--crs and --map go together (the site's frame)");
