@@ -1,6 +1,7 @@
 #include "planner/tour/robot_model.h"
 
 #include <cmath>
+#include <vector>
 
 #include "gtest/gtest.h"
 #include "planner/tour/path_timing.h"
@@ -88,6 +89,44 @@ TEST(PathTiming, UTurnAndZeroLengthSegments) {
   PolylineTiming t = TimePolyline(robot, {{0, 0}, {0, 0}, {-2, 0}}, 0.0, std::nullopt);
   EXPECT_EQ(t.turns, 1);
   EXPECT_NEAR(t.time_s, 6.0 + 4.0, 1e-9);  // 180 deg turn + 2 m ramp-only segment
+}
+
+// Waypoints as plans carry them: each holds the heading of the segment
+// that ends there.
+std::vector<Waypoint> Path(const std::vector<Pose2>& poses) {
+  std::vector<Waypoint> path;
+  for (const Pose2& p : poses) {
+    Waypoint w;
+    w.x = p.x, w.y = p.y, w.theta = p.theta;
+    w.kind = path.empty() ? SegmentKind::kStart : SegmentKind::kCoverage;
+    path.push_back(w);
+  }
+  return path;
+}
+
+TEST(ArrivalTimes, HandWorkedPathWithTurnsAndARecharge) {
+  RobotModel robot;  // 1 m/s, 0.5 m/s^2, 30 deg/s
+  const std::vector<Waypoint> path =
+      Path({{0, 0, 0}, {10, 0, 0}, {10, 1, M_PI / 2}, {0, 1, M_PI}, {0, 1, M_PI}});
+  std::vector<double> t = ArrivalTimes(robot, path);
+  ASSERT_EQ(t.size(), 5u);
+  EXPECT_EQ(t[0], 0.0);
+  EXPECT_NEAR(t[1], 12.0, 1e-9);                               // 10 m
+  EXPECT_NEAR(t[2], 12.0 + 3.0 + 2.0 * std::sqrt(2.0), 1e-9);  // turn 90 deg, 1 m
+  EXPECT_NEAR(t[3], t[2] + 3.0 + 12.0, 1e-9);                  // turn 90 deg, 10 m
+  EXPECT_NEAR(t[4], t[3], 1e-12);                              // no move, no turn
+  // The last entry is the polyline's drive time from the first heading.
+  EXPECT_NEAR(t[4], TimePolyline(robot, {{0, 0}, {10, 0}, {10, 1}, {0, 1}}, 0.0, M_PI).time_s,
+              1e-9);
+  // Two cycles: the robot waits at the station after the first (waypoint
+  // 1) and not after the last.
+  std::vector<ChargeCycle> cycles(2);
+  cycles[0].last_waypoint = 1;
+  cycles[1].first_waypoint = 1;
+  cycles[1].last_waypoint = 4;
+  const std::vector<double> charged = ArrivalTimes(robot, path, cycles, /*recharge_s=*/100.0);
+  EXPECT_NEAR(charged[1], t[1], 1e-12);
+  for (size_t i = 2; i < t.size(); ++i) EXPECT_NEAR(charged[i], t[i] + 100.0, 1e-9) << i;
 }
 
 }  // namespace
