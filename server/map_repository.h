@@ -18,13 +18,32 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/match.h"
 #include "absl/strings/string_view.h"
 #include "covplan/v1/covplan.pb.h"
 
 namespace covplan {
+
+// The names a store accepts: state names are [a-z0-9_]+ with a ".txt"
+// suffix; plan ids are [a-z0-9-]{1,64}.
+inline bool IsStateName(absl::string_view name) {
+  if (name.size() < 5 || !absl::EndsWith(name, ".txt")) return false;
+  for (char c : name.substr(0, name.size() - 4)) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  }
+  return true;
+}
+inline bool IsPlanId(absl::string_view id) {
+  if (id.empty() || id.size() > 64) return false;
+  for (char c : id) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
+  }
+  return true;
+}
 
 class MapRepository {
  public:
@@ -43,16 +62,25 @@ class MapRepository {
   // Maps stored (the last known count while a remote store is unreachable).
   virtual int64_t size() const = 0;
 
-  // Small server state (e.g. the replan estimator): `name` is [a-z_]+.txt.
+  // Small server state (e.g. the replan estimator): IsStateName(name).
   virtual absl::Status PutState(const std::string& name, absl::string_view contents) = 0;
   virtual absl::StatusOr<std::string> GetState(const std::string& name) const = 0;
 
-  // Retained plans, so a mission survives a restart. `plan_id` is
-  // [a-z0-9-]{1,64}. TrimPlans keeps the newest `keep` and returns how many
-  // it removed.
+  // Retained plans, so a mission survives a restart. IsPlanId(plan_id). TrimPlans keeps the newest
+  // `keep` and returns how many it removed.
   virtual absl::Status PutPlan(const std::string& plan_id, absl::string_view contents) = 0;
+  // Several small records at once (a store may sync them together); the
+  // first error, after trying them all.
+  virtual absl::Status PutPlans(const std::vector<std::pair<std::string, std::string>>& plans) {
+    absl::Status first;
+    for (const auto& [id, contents] : plans) first.Update(PutPlan(id, contents));
+    return first;
+  }
   virtual absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const = 0;
   virtual int64_t TrimPlans(int64_t keep) = 0;
+  // Makes a stored plan the newest for TrimPlans (a plan that newer records
+  // name, such as a repeated hit's alias, is trimmed after them).
+  virtual absl::Status TouchPlan(const std::string& plan_id) = 0;
 
   // OK when the store can serve now; Unavailable with the reason otherwise.
   virtual absl::Status Available() const { return absl::OkStatus(); }

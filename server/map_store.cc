@@ -6,11 +6,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -372,16 +376,6 @@ int64_t MapStore::size() const {
   return static_cast<int64_t>(index_.size());
 }
 
-namespace {
-bool IsStateName(const std::string& name) {
-  if (name.size() < 5 || name.compare(name.size() - 4, 4, ".txt") != 0) return false;
-  for (size_t i = 0; i + 4 < name.size(); ++i) {
-    if (!((name[i] >= 'a' && name[i] <= 'z') || name[i] == '_')) return false;
-  }
-  return true;
-}
-}  // namespace
-
 absl::Status MapStore::PutState(const std::string& name, absl::string_view contents) {
   if (!IsStateName(name))
     return absl::InvalidArgumentError(absl::StrCat("bad state file name ", name));
@@ -399,16 +393,6 @@ absl::StatusOr<std::string> MapStore::GetState(const std::string& name) const {
   return buffer.str();
 }
 
-namespace {
-bool IsPlanId(const std::string& id) {
-  if (id.empty() || id.size() > 64) return false;
-  for (char c : id) {
-    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
-  }
-  return true;
-}
-}  // namespace
-
 absl::Status MapStore::PutPlan(const std::string& plan_id, absl::string_view contents) {
   if (!IsPlanId(plan_id)) return absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id));
   const std::string dir = dir_ + "/plans";
@@ -416,6 +400,52 @@ absl::Status MapStore::PutPlan(const std::string& plan_id, absl::string_view con
   std::filesystem::create_directories(dir, ec);
   if (ec) return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", ec.message()));
   return AtomicWrite(dir, dir + "/" + plan_id + ".plan", contents);
+}
+
+absl::Status MapStore::PutPlans(const std::vector<std::pair<std::string, std::string>>& plans) {
+  const std::string dir = dir_ + "/plans";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", ec.message()));
+  static std::atomic<uint64_t> counter{0};
+  absl::Status first;
+  std::vector<std::pair<std::string, std::string>> written;  // temp file, final path
+  for (const auto& [plan_id, contents] : plans) {
+    if (!IsPlanId(plan_id)) {
+      first.Update(absl::InvalidArgumentError(absl::StrCat("bad plan id ", plan_id.substr(0, 80))));
+      continue;
+    }
+    const std::string path = dir + "/" + plan_id + ".plan";
+    const std::string tmp = absl::StrCat(path, ".tmp.", ::getpid(), ".b",
+                                         counter.fetch_add(1, std::memory_order_relaxed));
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      first.Update(ErrnoError("cannot create", tmp));
+      continue;
+    }
+    absl::Status status = WriteAll(fd, contents, tmp);
+    if (::close(fd) != 0 && status.ok()) status = ErrnoError("cannot close", tmp);
+    if (status.ok()) {
+      written.emplace_back(tmp, path);
+    } else {
+      ::unlink(tmp.c_str());
+      first.Update(status);
+    }
+  }
+  if (written.empty()) return first;
+  // The contents reach the disk before any rename makes them visible.
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  const bool synced = dir_fd >= 0 && ::syncfs(dir_fd) == 0;
+  if (!synced) first.Update(ErrnoError("cannot sync", dir));
+  if (dir_fd >= 0) ::close(dir_fd);
+  for (const auto& [tmp, path] : written) {
+    if (!synced || ::rename(tmp.c_str(), path.c_str()) != 0) {
+      if (synced) first.Update(ErrnoError("cannot rename", tmp));
+      ::unlink(tmp.c_str());
+    }
+  }
+  if (synced) first.Update(FsyncDir(dir));
+  return first;
 }
 
 absl::StatusOr<std::string> MapStore::GetPlan(const std::string& plan_id) const {
@@ -448,13 +478,29 @@ absl::StatusOr<std::string> MapStore::GetProgress(const std::string& plan_id) co
   return buffer.str();
 }
 
+absl::Status MapStore::TouchPlan(const std::string& plan_id) {
+  if (!IsPlanId(plan_id))
+    return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
+  std::error_code ec;
+  std::filesystem::last_write_time(dir_ + "/plans/" + plan_id + ".plan",
+                                   std::filesystem::file_time_type::clock::now(), ec);
+  if (ec) return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id, ": ", ec.message()));
+  return absl::OkStatus();
+}
+
 int64_t MapStore::TrimPlans(int64_t keep) {
   std::error_code ec;
   std::vector<std::pair<std::filesystem::file_time_type, std::filesystem::path>> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir_ + "/plans", ec)) {
     const std::string name = entry.path().filename().string();
-    if (name.find(".tmp.") != std::string::npos) {  // a write that a crash interrupted
-      std::filesystem::remove(entry.path(), ec);
+    if (name.find(".tmp.") != std::string::npos) {
+      // A write that a crash interrupted; a younger one may be another
+      // thread's write in progress.
+      const auto written = entry.last_write_time(ec);
+      if (!ec &&
+          std::filesystem::file_time_type::clock::now() - written > std::chrono::minutes(1)) {
+        std::filesystem::remove(entry.path(), ec);
+      }
       continue;
     }
     files.emplace_back(entry.last_write_time(ec), entry.path());

@@ -89,7 +89,7 @@ class MapStore : public MapRepository {
   const std::string& dir() const { return dir_; }
 
   // Small server state beside the maps (e.g. the replan estimator), written
-  // atomically. `name` is [a-z_]+ with a ".txt" suffix. NotFound if absent.
+  // atomically. IsStateName(name). NotFound if absent.
   absl::Status PutState(const std::string& name, absl::string_view contents) override;
   absl::StatusOr<std::string> GetState(const std::string& name) const override;
 
@@ -97,8 +97,12 @@ class MapStore : public MapRepository {
   // under plans/, written atomically. `plan_id` is [a-z0-9-]{1,64}.
   // NotFound when absent. TrimPlans keeps the newest `keep` files.
   absl::Status PutPlan(const std::string& plan_id, absl::string_view contents) override;
+  // Each written to a temporary file, one syncfs, the renames, one
+  // directory fsync: two syncs for the lot instead of two per record.
+  absl::Status PutPlans(const std::vector<std::pair<std::string, std::string>>& plans) override;
   absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const override;
   int64_t TrimPlans(int64_t keep) override;
+  absl::Status TouchPlan(const std::string& plan_id) override;
   // The robot's last reported progress on a plan (plans/<plan_id>.progress),
   // written atomically; NotFound when none was recorded.
   absl::Status PutProgress(const std::string& plan_id, absl::string_view contents) override;

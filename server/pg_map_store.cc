@@ -29,22 +29,6 @@ constexpr char kSchema[] =
     "CREATE INDEX IF NOT EXISTS covplan_plans_created ON covplan_plans (created);"
     "COMMIT;";
 
-bool IsStateName(const std::string& name) {
-  if (name.size() < 5 || name.compare(name.size() - 4, 4, ".txt") != 0) return false;
-  for (size_t i = 0; i + 4 < name.size(); ++i) {
-    if (!((name[i] >= 'a' && name[i] <= 'z') || name[i] == '_')) return false;
-  }
-  return true;
-}
-
-bool IsPlanId(const std::string& id) {
-  if (id.empty() || id.size() > 64) return false;
-  for (char c : id) {
-    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
-  }
-  return true;
-}
-
 struct ResultDeleter {
   void operator()(PGresult* r) const { PQclear(r); }
 };
@@ -368,6 +352,19 @@ absl::StatusOr<std::string> PgMapStore::GetPlan(const std::string& plan_id) cons
   if (PQntuples(r->get()) == 0)
     return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id));
   return Field(r->get(), 0, 0);
+}
+
+absl::Status PgMapStore::TouchPlan(const std::string& plan_id) {
+  if (!IsPlanId(plan_id))
+    return absl::NotFoundError(absl::StrCat("no plan ", plan_id.substr(0, 80)));
+  absl::StatusOr<Lease> c = Acquire();
+  if (!c.ok()) return c.status();
+  absl::StatusOr<Result> r = (*c)->Exec(
+      "UPDATE covplan_plans SET created = clock_timestamp() WHERE plan_id = $1", {{plan_id}}, true);
+  if (!r.ok()) return r.status();
+  if (std::string(PQcmdTuples(r->get())) == "0")
+    return absl::NotFoundError(absl::StrCat("no stored plan ", plan_id));
+  return absl::OkStatus();
 }
 
 int64_t PgMapStore::TrimPlans(int64_t keep) {

@@ -64,6 +64,7 @@ class PgMapStore : public MapRepository {
   absl::Status PutPlan(const std::string& plan_id, absl::string_view contents) override;
   absl::StatusOr<std::string> GetPlan(const std::string& plan_id) const override;
   int64_t TrimPlans(int64_t keep) override;
+  absl::Status TouchPlan(const std::string& plan_id) override;
   absl::Status Available() const override;
 
  private:

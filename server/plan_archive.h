@@ -9,6 +9,7 @@
 //   PlanArchive archive(options, store, metrics, &engine, &io_pool);
 //   archive.Put(plan);
 //   archive.Persist(origin, reply);  // plans on stored maps only
+//   archive.PutAlias(fresh_id, retained->plan_id);  // a repeated hit's own id
 //   std::shared_ptr<const RetainedPlan> p = archive.Find(plan_id, stop, &origin);
 //
 // Thread-safety: all methods are thread-safe.
@@ -19,10 +20,13 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/base/thread_annotations.h"
+#include "absl/container/flat_hash_map.h"
 #include "absl/synchronization/mutex.h"
 #include "covplan/v1/covplan.pb.h"
 #include "planner/common/stop_token.h"
@@ -47,16 +51,29 @@ class PlanArchive {
   PlanArchive(const ServiceOptions& options, MapRepository* store, ServerMetrics* metrics,
               const PlanningEngine* engine, WorkerPool* io_pool);
 
-  // The retained plan, or null once it expired.
-  std::shared_ptr<const RetainedPlan> Get(const std::string& plan_id) {
-    return plans_.Get(plan_id);
-  }
+  // The retained plan, or null once it expired (an alias used for the
+  // first time is stored then: see PutAlias).
+  std::shared_ptr<const RetainedPlan> Get(const std::string& plan_id);
   void Put(std::shared_ptr<const RetainedPlan> plan) { plans_.Put(std::move(plan)); }
   // The plans-retained gauge.
   void PublishRetainedCount();
 
   // Writes the plan (with the original request it continues) to the store.
   void Persist(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
+  // Names `original_id`'s plan `alias_id` too, a mission of its own (a
+  // repeated Plan answered from memory), retained as an alias that starts
+  // from the original's origin. When the alias is first used (Get, Find),
+  // a plan the store keeps is stored for it too, as a small record naming
+  // the original ("the plan of <original>"), written coalesced off the
+  // caller's path (at most kMaxPendingAliases wait; the rest are logged);
+  // the original's record is touched after its aliases', so the store trims
+  // it after them. Aliases never used are stored when the service shuts
+  // down (StoreUnusedAliases), not one by one: a flood of repeats neither
+  // loads the disk nor pushes stored missions out. A SIGKILL loses the
+  // unused ones (their robots plan again).
+  void PutAlias(const std::string& alias_id, const std::string& original_id);
+  // Stores every live alias never used (a drain's last step), at once.
+  void StoreUnusedAliases();
   // A retained plan from memory, or else from the store (after a restart,
   // rebuilt on its stored map and retained again), with its origin.
   std::shared_ptr<const RetainedPlan> Find(const std::string& plan_id, const StopToken& stop,
@@ -71,6 +88,28 @@ class PlanArchive {
   void SaveEstimator();
 
  private:
+  static constexpr size_t kMaxPendingAliases = 4096;
+  struct PendingAlias {
+    std::string alias_id;
+    std::string original_id;
+    std::string record;  // a serialised v1::InlinePlan
+  };
+  void RememberOrigin(const std::string& plan_id, std::shared_ptr<const v1::PlanRequest> origin);
+  // The origin of `plan_id`, or of the original it is an alias of; false
+  // when none is known.
+  bool OriginOf(const std::string& plan_id, v1::PlanRequest* origin);
+  // An alias's first use: stored if its original was (its origin is known).
+  void AliasUsed(const std::string& alias_id, const std::string& original_id);
+  // Stores `records` (alias id, record) and touches their originals.
+  void StoreAliases(const std::vector<std::pair<std::string, std::string>>& records,
+                    const std::set<std::string>& originals);
+  // Writes the pending aliases (on the I/O pool).
+  void FlushAliases();
+  // A stored plan rebuilt on its stored map and retained; an alias record
+  // (`depth` 0 only) rebuilds its original under the alias's id.
+  std::shared_ptr<const RetainedPlan> Load(const std::string& plan_id, const StopToken& stop,
+                                           v1::PlanRequest* origin, int depth);
+
   const ServiceOptions& options_;
   MapRepository* const store_;
   ServerMetrics* const metrics_;
@@ -83,8 +122,15 @@ class PlanArchive {
   // The Plan request each retained plan's mission started with (for
   // persisting its replans without waiting for the disk), newest last.
   absl::Mutex origins_mu_;
-  std::deque<std::pair<std::string, std::shared_ptr<const v1::PlanRequest>>> origins_
+  // Bounded by count: four per retained plan (its replans') and one per
+  // alias (PlanRegistry keeps 16 per retained plan).
+  absl::flat_hash_map<std::string, std::shared_ptr<const v1::PlanRequest>> origins_
       ABSL_GUARDED_BY(origins_mu_);
+  std::deque<std::string> origin_order_ ABSL_GUARDED_BY(origins_mu_);  // oldest first
+  absl::Mutex aliases_mu_;
+  std::deque<PendingAlias> pending_aliases_ ABSL_GUARDED_BY(aliases_mu_);
+  bool alias_flush_queued_ ABSL_GUARDED_BY(aliases_mu_) = false;
+  std::atomic<uint64_t> aliases_not_stored_{0};  // for the log
 };
 
 }  // namespace covplan

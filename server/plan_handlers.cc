@@ -73,11 +73,18 @@ absl::StatusOr<MapSource> PlanHandlers::PlanMapSource(const CallInfo& call,
 }
 
 std::shared_ptr<const ServedBody> PlanHandlers::ServedReply(
-    const std::string& tenant_tag, const std::shared_ptr<const RememberedPlan>& entry) {
-  std::optional<ServedReplies::Served> served = served_->Find(tenant_tag, entry);
+    const CallInfo& call, const std::shared_ptr<const RememberedPlan>& entry,
+    v1::PlanResponse* response) {
+  std::optional<ServedReplies::Served> served = served_->Find(call.tenant_tag, entry);
   if (!served.has_value()) return nullptr;
-  // Expired from the retained plans (GetPlan would not find it): a new id.
-  if (archive_->Get(served->plan_id) == nullptr) return nullptr;
+  // Expired from the retained plans (GetPlan would not find it): planned
+  // as a first hit again.
+  std::shared_ptr<const RetainedPlan> original = archive_->Get(served->plan_id);
+  if (original == nullptr) return nullptr;
+  // The same content, a mission of its own.
+  const std::string plan_id = NewPlanId(call.tenant_tag);
+  archive_->PutAlias(plan_id, original->plan_id);
+  response->set_plan_id(plan_id);
   return served->reply;
 }
 
@@ -106,7 +113,7 @@ absl::Status PlanHandlers::RunPlan(const CallInfo& call, const v1::PlanRequest& 
   }
   if (result->answered_by != nullptr) {
     if (std::shared_ptr<const ServedBody> reply =
-            ServedReply(call.tenant_tag, result->answered_by)) {
+            ServedReply(call, result->answered_by, response)) {
       *served = std::move(reply);
       response->mutable_stats()->set_planning_ms(result->plan.stats.planning_ms);
       response->mutable_stats()->set_decomposition_cached(result->plan.stats.decomposition_cached);
@@ -130,8 +137,9 @@ absl::Status PlanHandlers::RunPlan(const CallInfo& call, const v1::PlanRequest& 
   RecordPlanSolve(start, retained->plan.stats);
   archive_->Put(std::move(retained));
   archive_->PublishRetainedCount();
-  // Only plans the store keeps too: a repeated hit is neither retained nor
-  // persisted again, so its id must stay resolvable (inline maps are not).
+  // Only plans the store keeps too: a repeated hit is an alias of this plan
+  // (its stored record names this one), so this plan must stay resolvable
+  // after a restart (plans of inline maps are not stored).
   if (result->answered_by != nullptr && request.map_ref_case() == v1::PlanRequest::kMapId) {
     served_->Remember(call.tenant_tag, *result, *response);
   }
@@ -148,10 +156,11 @@ bool PlanHandlers::ServeRecalledHit(grpc::ServerUnaryReactor* reactor, const Cal
   if (!source.ok()) return false;
   absl::StatusOr<std::optional<Recalled>> recalled = engine_->Recall(*source, *plan_request);
   if (!recalled.ok() || !recalled->has_value()) return false;
-  std::shared_ptr<const ServedBody> served = ServedReply(call.tenant_tag, (*recalled)->entry);
-  if (served == nullptr) return false;
-  // As RunPlan answers a repeated hit: the served bytes, then this call's stats.
+  // As RunPlan answers a repeated hit: the served bytes, then this call's
+  // plan id and stats.
   v1::PlanResponse response;
+  std::shared_ptr<const ServedBody> served = ServedReply(call, (*recalled)->entry, &response);
+  if (served == nullptr) return false;
   response.mutable_stats()->set_planning_ms((*recalled)->lookup_ms);
   response.mutable_stats()->set_decomposition_cached(true);
   PlanStats solve;  // what the solve metrics read
@@ -159,7 +168,8 @@ bool PlanHandlers::ServeRecalledHit(grpc::ServerUnaryReactor* reactor, const Cal
   solve.tour_cut_short = (*recalled)->entry->plan.stats.tour_cut_short;
   RecordPlanSolve(start, solve, /*queued=*/false);
   metrics_->hits_without_worker().Increment();
-  const std::string detail = absl::StrCat(served->detail, " cached=1");
+  const std::string detail =
+      absl::StrCat("plan=", response.plan_id(), " ", served->detail, " cached=1");
   gate_->Finish(reactor, call, SerializePlanReply(response, std::move(served), response_bytes),
                 detail);
   return true;
@@ -239,9 +249,10 @@ void PlanHandlers::ReplyPlan(CancellableReactor* reactor, const CallInfo& call,
   }
   std::string detail;
   if (status.ok()) {
-    detail =
-        absl::StrCat(outcome->served != nullptr ? outcome->served->detail : PlanDetail(response),
-                     " cached=", response.stats().decomposition_cached() ? 1 : 0);
+    detail = absl::StrCat(outcome->served != nullptr ? absl::StrCat("plan=", response.plan_id(),
+                                                                    " ", outcome->served->detail)
+                                                     : PlanDetail(response),
+                          " cached=", response.stats().decomposition_cached() ? 1 : 0);
     status = SerializePlanReply(response, std::move(outcome->served), response_bytes);
   }
   gate_->Finish(reactor, call, status, detail);

@@ -91,9 +91,11 @@ class PlanHandlers {
                         const v1::PlanRequest& request, const StopToken& cancel,
                         grpc::ByteBuffer* response_bytes);
   // The reply already sent for the remembered `entry` to this tenant, if
-  // that plan is still retained; else null.
-  std::shared_ptr<const ServedBody> ServedReply(const std::string& tenant_tag,
-                                                const std::shared_ptr<const RememberedPlan>& entry);
+  // that plan is still retained, with the fresh plan id of this call's
+  // mission (an alias of that plan) set in `*response`; else null.
+  std::shared_ptr<const ServedBody> ServedReply(const CallInfo& call,
+                                                const std::shared_ptr<const RememberedPlan>& entry,
+                                                v1::PlanResponse* response);
   // A Plan's solve metrics and, for a call that went through the worker
   // queue (`queued`), the mean solve times the admission prices queued
   // calls with (a hit answered on the gRPC thread would pull them down).

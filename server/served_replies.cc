@@ -6,27 +6,34 @@
 #include <grpcpp/support/slice.h>
 
 #include "absl/hash/hash.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 
 namespace covplan {
 
-std::string PlanDetail(const v1::PlanResponse& response) {
-  return absl::StrFormat("plan=%s planner=%s ranks=%d termination=%s/%s source=%s",
-                         response.plan_id(), response.planner(), response.stats().num_ranks(),
+std::string PlanSummary(const v1::PlanResponse& response) {
+  return absl::StrFormat("planner=%s ranks=%d termination=%s/%s source=%s", response.planner(),
+                         response.stats().num_ranks(),
                          v1::TerminationReason_Name(response.termination().reason()),
                          v1::TerminationLimit_Name(response.termination().limit()),
                          v1::PlanSource_Name(response.stats().plan_source()));
 }
 
+std::string PlanDetail(const v1::PlanResponse& response) {
+  return absl::StrCat("plan=", response.plan_id(), " ", PlanSummary(response));
+}
+
 std::shared_ptr<const ServedBody> ServedBodyFor(const v1::PlanResponse& reply) {
   // The per-call fields are cleared: proto3 does not write a zero, so a
   // zero in the call's appended stats would not override a stored value.
+  // Every call has its own plan id, in the appended part.
   v1::PlanResponse stored = reply;
+  stored.clear_plan_id();
   stored.mutable_stats()->clear_planning_ms();
   stored.mutable_stats()->clear_decomposition_cached();
   auto body = std::make_shared<ServedBody>();
   if (!stored.SerializeToString(&body->bytes)) return nullptr;
-  body->detail = PlanDetail(stored);
+  body->detail = PlanSummary(stored);
   return body;
 }
 

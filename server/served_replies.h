@@ -1,12 +1,14 @@
 // The replies of repeated identical Plan hits. Identical requests answered
-// from memory get the first hit's plan: its plan id (plan ids name
-// immutable plans) and its reply, so a repeated hit sends stored bytes
-// instead of a conversion, a new retained plan (which would push other
-// clients' plans out of the retained ones) and a disk write. Plan is a raw
-// gRPC method: such a hit is sent as the first hit's serialised bytes
-// (ServedBody), followed by a short PlanResponse holding only this call's
-// per-call stats; protobuf merges concatenated messages, so every client
-// reads one reply, and no protobuf message is copied per hit.
+// from memory after the first such answer share its content, not its
+// identity: each call is a mission of its own under a fresh plan id (an
+// alias of the first hit's retained plan, PlanArchive::PutAlias), and its
+// reply is the first hit's stored bytes, so a repeated hit sends stored
+// bytes instead of a conversion, and neither copies the plan nor pushes
+// other clients' plans out of the retained ones. Plan is a raw gRPC method:
+// such a hit is sent as the first hit's serialised bytes (ServedBody, plan
+// id cleared), followed by a short PlanResponse holding only this call's
+// plan id and per-call stats; protobuf merges concatenated messages, so
+// every client reads one reply, and no protobuf message is copied per hit.
 //
 // Beside them, the keys (a hash of the tenant and the request bytes) of the
 // requests answered from memory last time: a repeat of one is expected to
@@ -15,7 +17,7 @@
 //
 //   if (std::optional<ServedReplies::Served> s = served.Find(tenant, entry)) ...
 //   served.Remember(tenant, result, reply);
-//   SerializePlanReply(call_stats, s->reply, &bytes);
+//   SerializePlanReply(call_reply, s->reply, &bytes);
 //
 // Thread-safety: all methods are thread-safe.
 #ifndef COVPLAN_SERVER_SERVED_REPLIES_H_
@@ -42,20 +44,22 @@
 
 namespace covplan {
 
-// A repeated hit's reply, serialised once: the reply with planning_ms and
-// decomposition_cached cleared, and its log summary.
+// A repeated hit's reply, serialised once: the reply with plan_id,
+// planning_ms and decomposition_cached cleared, and its log summary.
 struct ServedBody {
   std::string bytes;
-  std::string detail;  // PlanDetail of the reply, without the per-call fields
+  std::string detail;  // PlanSummary of the reply
 };
 
-// A Plan reply's log summary, without the per-call decomposition_cached.
+// A Plan reply's log summary: "plan=<id> " and its PlanSummary.
 std::string PlanDetail(const v1::PlanResponse& response);
+// The summary without the plan id and the per-call decomposition_cached.
+std::string PlanSummary(const v1::PlanResponse& response);
 
-// A repeated hit's stored reply: `reply` serialised with the per-call stats
-// fields (planning_ms, decomposition_cached) cleared, so that the call's own
-// values, written after it by SerializePlanReply, win even when they are
-// zero or false; null if it cannot be serialised.
+// A repeated hit's stored reply: `reply` serialised with its plan id and the
+// per-call stats fields (planning_ms, decomposition_cached) cleared, so that
+// the call's own values, written after it by SerializePlanReply, win even
+// when they are zero or false; null if it cannot be serialised.
 std::shared_ptr<const ServedBody> ServedBodyFor(const v1::PlanResponse& reply);
 
 // A Plan reply's bytes: `response`'s, after those of `served` if set (a
@@ -67,7 +71,7 @@ class ServedReplies {
  public:
   struct Served {
     std::shared_ptr<const ServedBody> reply;
-    std::string plan_id;  // valid while that plan is retained
+    std::string plan_id;  // the first hit's, valid while that plan is retained
   };
   // The reply already sent for the remembered `entry` to this tenant, if any.
   std::optional<Served> Find(const std::string& tenant_tag,

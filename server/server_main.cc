@@ -89,6 +89,9 @@ ABSL_FLAG(double, session_idle_s, 120.0,
           "A Drive session without a message for this long ends with DEADLINE_EXCEEDED");
 ABSL_FLAG(int, max_live_streams, 4,
           "Live event streams (GET /v1/events) open at once (<= 32 of the 48 HTTP threads)");
+ABSL_FLAG(std::string, replica, "",
+          "This replica's name among replicas sharing one --map_store (at most 32 of [a-z0-9_]): "
+          "what it learns is stored under it");
 ABSL_FLAG(double, drain_notice_s, 1.0,
           "On SIGTERM, time health reports NOT_SERVING before the port closes (within the grace)");
 
@@ -146,6 +149,11 @@ std::vector<std::string> ValidateFlags() {
   CheckRange("max_sessions", absl::GetFlag(FLAGS_max_sessions), 1, 100000, &errors);
   CheckRange("session_idle_s", absl::GetFlag(FLAGS_session_idle_s), 0.1, 24 * 3600.0, &errors);
   CheckRange("max_live_streams", absl::GetFlag(FLAGS_max_live_streams), 1, 32, &errors);
+  {
+    covplan::ServiceOptions replica;
+    replica.replica = absl::GetFlag(FLAGS_replica);
+    if (!replica.Validate().ok()) errors.push_back("--replica: at most 32 of [a-z0-9_]");
+  }
   if (absl::GetFlag(FLAGS_tls_cert).empty() != absl::GetFlag(FLAGS_tls_key).empty()) {
     errors.push_back("--tls_cert and --tls_key: give both or neither");
   }
@@ -193,6 +201,7 @@ covplan::ServerConfig ConfigFromFlags() {
   service.max_sessions = absl::GetFlag(FLAGS_max_sessions);
   service.session_idle = absl::Seconds(absl::GetFlag(FLAGS_session_idle_s));
   service.max_live_streams = absl::GetFlag(FLAGS_max_live_streams);
+  service.replica = absl::GetFlag(FLAGS_replica);
   // Room for the image plus YAML and the rest of the request.
   config.max_message_bytes =
       static_cast<int>(std::min<int64_t>(service.limits.max_image_bytes + (4 << 20), INT32_MAX));

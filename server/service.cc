@@ -50,6 +50,8 @@ void CoveragePlannerService::Shutdown() {
   background_stop_.Cancel();
   warm_pool_.Shutdown();
   pool_.Shutdown();
+  // No solve runs any more: the repeated hits never used are stored now.
+  archive_.StoreUnusedAliases();
   io_pool_.Shutdown();
   read_pool_.Shutdown();
 }

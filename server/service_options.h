@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "absl/status/status.h"
 #include "absl/time/time.h"
@@ -48,6 +49,11 @@ struct ServiceOptions {
   // Live event streams (GET /v1/events on the JSON API) open at once; each
   // holds one of the HTTP server's threads.
   int max_live_streams = 4;
+  // This replica's name among replicas that share one store ([a-z0-9_],
+  // at most 32; "" for a server alone): what it learns (the replan
+  // estimator) is kept under its own name, so no replica overwrites
+  // another's.
+  std::string replica;
 
   absl::Status Validate() const;
 };

@@ -98,7 +98,7 @@ replica_up() {
   fi
   mkdir -p "$DIR/replica$n"
   "$BIN/covplan-server" --port "$(grpc_port "$n")" --metrics_port "$(metrics_port "$n")" \
-    --threads "$THREADS" --cache_mb "$CACHE_MB" --drain_notice_s 1 --drain_grace_s 5 \
+    --threads "$THREADS" --cache_mb "$CACHE_MB" --drain_notice_s 1 --drain_grace_s 5 --replica "r$n" \
     "${store_flags[@]}" >>"$DIR/replica$n.log" 2>&1 &
   echo $! >"$pidfile"
   wait_port "$(grpc_port "$n")" "replica$n" "$pidfile"

@@ -10,7 +10,9 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "api/convert.h"
@@ -19,6 +21,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "tests/server/plan_checks.h"
 
 namespace covplan {
 namespace {
@@ -157,6 +160,7 @@ TEST_F(DriveSessionTest, PushesAPlanAfterAnObservation) {
   const v1::ReplanResponse r = event.replan();
   EXPECT_GT(r.replan().newly_blocked_cells(), 0);
   EXPECT_EQ(Swept(r.plan()), r.replan().remaining_cells());
+  testing::ExpectArrivalTimes(r.plan());  // a plan the session pushed
   EXPECT_NEAR(r.plan().path(0).x(), seen.progress().position().x(), 1e-9);
   EXPECT_FALSE(CellFree(r.plan(), 9.6, 9.6));
   // The pushed plan is retained and named in the next message.
@@ -392,6 +396,7 @@ TEST_F(DriveSessionTest, ResumeContinuesFromWhereTheRobotStopped) {
   EXPECT_GT(given.replan().covered_cells_before(), 0);
   EXPECT_EQ(Swept(given.plan()), given.replan().remaining_cells());
   EXPECT_EQ(given.replan().covered_cells_before() + given.replan().remaining_cells(), Swept(plan));
+  testing::ExpectArrivalTimes(given.plan());
   // A session's progress report is recorded, and survives a restart.
   request.clear_progress();
   {
@@ -436,6 +441,77 @@ TEST_F(DriveSessionTest, ResumeContinuesFromWhereTheRobotStopped) {
   bad.set_plan_id("p-nope");
   status = resume(bad, &out);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+// Identical Plan calls are missions of their own, also when the second and
+// later ones are answered from memory: each gets its own plan id, and the
+// progress one robot reports is not what Resume reads for another, also
+// after a restart (a repeated hit's id is stored, as a record naming the
+// first hit's plan, when it is first used or else by the drain, and is
+// rebuilt from it).
+TEST_F(DriveSessionTest, IdenticalPlanCallsAreMissionsOfTheirOwn) {
+  Start();
+  std::vector<v1::PlanResponse> plans;
+  for (int i = 0; i < 5; ++i) plans.push_back(PlanOffice());
+  ASSERT_EQ(plans[1].stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);  // the first hit
+  ASSERT_EQ(plans[2].stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  ASSERT_EQ(plans[3].stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  std::set<std::string> ids;
+  for (const v1::PlanResponse& p : plans) ids.insert(p.plan_id());
+  EXPECT_EQ(ids.size(), 5u);
+  const v1::PlanResponse& driven = plans[2];
+  const int k = driven.path_size() / 2;
+  {
+    grpc::ClientContext context;
+    std::unique_ptr<Stream> stream = Open(&context, driven.plan_id());
+    v1::DriveRequest report;
+    report.set_sequence(2);
+    *report.mutable_progress() = At(driven, k);
+    ASSERT_TRUE(stream->Write(report));
+    stream->WritesDone();
+    EXPECT_TRUE(stream->Finish().ok());
+  }
+  const auto resume = [&](const std::string& plan_id) {
+    v1::ResumeRequest request;
+    request.set_plan_id(plan_id);
+    request.mutable_pose()->set_x(driven.path(0).x());
+    request.mutable_pose()->set_y(driven.path(0).y());
+    v1::ReplanResponse out;
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    const grpc::Status status = stub_->Resume(&context, request, &out);
+    EXPECT_TRUE(status.ok()) << plan_id << ": " << status.error_message();
+    return std::pair{out.replan().progress_source(), out.replan().covered_cells_before()};
+  };
+  const auto [source, covered] = resume(driven.plan_id());
+  EXPECT_EQ(source, "recorded");
+  EXPECT_GT(covered, 1);
+  // Nothing covered but the cell the robot starts in.
+  const int at_start = resume(plans[1].plan_id()).second;
+  EXPECT_LE(at_start, 1);
+  EXPECT_EQ(resume(plans[3].plan_id()), std::pair(std::string("plan_start"), at_start));
+  // (Resume records where it resumed from: the start, for 1 and 3.)
+  server_.reset();  // the drain flushes the I/O pool
+  Start();
+  EXPECT_EQ(resume(driven.plan_id()), std::pair(std::string("recorded"), covered));
+  EXPECT_EQ(resume(plans[0].plan_id()), std::pair(std::string("plan_start"), at_start));
+  for (int i : {1, 3}) {
+    EXPECT_EQ(resume(plans[i].plan_id()), std::pair(std::string("recorded"), at_start)) << i;
+  }
+  // Never used before the restart: stored by the drain.
+  EXPECT_EQ(resume(plans[4].plan_id()), std::pair(std::string("plan_start"), at_start));
+  // Rebuilt by the Resume above: the first hit's plan under its own id.
+  v1::GetPlanRequest get;
+  get.set_plan_id(plans[3].plan_id());
+  v1::PlanResponse again;
+  grpc::ClientContext context;
+  ASSERT_TRUE(stub_->GetPlan(&context, get, &again).ok());
+  EXPECT_EQ(again.plan_id(), plans[3].plan_id());
+  ASSERT_EQ(again.path_size(), plans[1].path_size());
+  for (int i = 0; i < again.path_size(); ++i) {
+    EXPECT_EQ(again.path(i).x(), plans[1].path(i).x());
+    EXPECT_EQ(again.path(i).y(), plans[1].path(i).y());
+  }
 }
 
 // `covplan simulate --server`: the whole run through one Drive session.

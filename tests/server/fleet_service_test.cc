@@ -24,6 +24,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "tests/server/plan_checks.h"
 #include "tests/testing/test_maps.h"
 
 namespace covplan {
@@ -167,6 +168,7 @@ TEST_F(FleetServiceTest, TwoRobotsGetRetainedPlansThatCoverWhatOnePlanCovers) {
     status = GetPlan(robot.plan().plan_id(), &retained);
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_EQ(retained.SerializeAsString(), robot.plan().SerializeAsString());
+    testing::ExpectArrivalTimes(robot.plan());
   }
 
   // Together the robots sweep every cell the single-robot plan sweeps.
@@ -188,6 +190,7 @@ TEST_F(FleetServiceTest, TwoRobotsGetRetainedPlansThatCoverWhatOnePlanCovers) {
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_GT(replanned.replan().newly_blocked_cells(), 0);
   EXPECT_NE(replanned.plan().plan_id(), b.plan_id());
+  testing::ExpectArrivalTimes(replanned.plan());
   EXPECT_EQ(static_cast<int>(SweptCells(replanned.plan()).size()),
             replanned.replan().remaining_cells());
   // Nothing of the other robot's share was added to it.

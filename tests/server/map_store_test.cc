@@ -2,10 +2,14 @@
 // checksum verification of damaged files, deletion.
 #include "server/map_store.h"
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <thread>
 
+#include "absl/strings/str_cat.h"
 #include "api/convert.h"
 #include "gtest/gtest.h"
 #include "tests/testing/test_maps.h"
@@ -95,6 +99,26 @@ TEST_F(MapStoreTest, DamagedFileIsDetectedAndNotServed) {
   ASSERT_TRUE(created.ok());
   EXPECT_TRUE(*created);
   EXPECT_TRUE((*reopened)->Get(info_.map_id()).ok());
+}
+
+// Plans: TrimPlans keeps the newest, TouchPlan makes a plan the newest.
+TEST_F(MapStoreTest, PlansRoundTripAndTrimKeepsTheNewest) {
+  absl::StatusOr<std::unique_ptr<MapStore>> store = MapStore::Open(dir_);
+  ASSERT_TRUE(store.ok());
+  const std::string binary("\0\x01\xffplan", 7);
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE((*store)->PutPlan(absl::StrCat("p-", i), binary).ok());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // distinct times
+  }
+  EXPECT_EQ(*(*store)->GetPlan("p-3"), binary);
+  ASSERT_TRUE((*store)->TouchPlan("p-1").ok());  // the newest now
+  EXPECT_EQ((*store)->TouchPlan("p-9").code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ((*store)->TouchPlan("../x").code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ((*store)->TrimPlans(2), 3);
+  EXPECT_EQ((*store)->GetPlan("p-0").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ((*store)->GetPlan("p-3").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_TRUE((*store)->GetPlan("p-4").ok());
+  EXPECT_TRUE((*store)->GetPlan("p-1").ok());
 }
 
 TEST_F(MapStoreTest, TruncatedFileIsDetected) {

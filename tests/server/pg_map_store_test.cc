@@ -102,10 +102,13 @@ TEST_F(PgMapStoreTest, StateAndPlansRoundTripAndTrimKeepsTheNewest) {
   const std::string binary("\0\x01\xffplan", 7);
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(store->PutPlan(absl::StrCat("p-", i), binary).ok());
   EXPECT_EQ(*store->GetPlan("p-3"), binary);
+  ASSERT_TRUE(store->TouchPlan("p-1").ok());  // the newest now
+  EXPECT_EQ(store->TouchPlan("p-9").code(), absl::StatusCode::kNotFound);
   EXPECT_EQ(store->TrimPlans(2), 3);
   EXPECT_EQ(store->GetPlan("p-0").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store->GetPlan("p-3").status().code(), absl::StatusCode::kNotFound);
   EXPECT_TRUE(store->GetPlan("p-4").ok());
-  EXPECT_TRUE(store->GetPlan("p-3").ok());
+  EXPECT_TRUE(store->GetPlan("p-1").ok());
   EXPECT_EQ(store->GetPlan("P/../1").status().code(), absl::StatusCode::kNotFound);
 }
 

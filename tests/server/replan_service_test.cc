@@ -17,6 +17,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
+#include "tests/server/plan_checks.h"
 #include "tests/testing/timing.h"
 
 namespace covplan {
@@ -40,11 +41,12 @@ class ReplanServiceTest : public ::testing::Test {
     server_.reset();
     std::filesystem::remove_all(dir_);
   }
-  void Start() {
+  void Start(const std::string& replica = "") {
     ServerConfig config;
     config.port = 0;
     config.metrics_port = -1;
     config.store_dir = dir_ + "/maps";
+    config.service.replica = replica;
     absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
     ASSERT_TRUE(server.ok()) << server.status();
     server_ = std::move(*server);
@@ -112,6 +114,7 @@ TEST_F(ReplanServiceTest, ReplansByPlanIdAndInlineAndChains) {
   EXPECT_EQ(by_id.plan().stats().covered_cells(), s.remaining_cells());
   EXPECT_EQ(s.complete(), s.newly_unreachable_cells() == 0);
   EXPECT_NE(by_id.plan().plan_id(), plan.plan_id());
+  testing::ExpectArrivalTimes(by_id.plan());
   EXPECT_NEAR(by_id.plan().path(0).x(), request.progress().position().x(), 1e-9);
   EXPECT_NEAR(by_id.plan().path(by_id.plan().path_size() - 1).x(),
               plan.path(plan.path_size() - 1).x(), 1e-9);
@@ -256,6 +259,41 @@ TEST_F(ReplanServiceTest, TheEstimatorIsKeptAcrossRestarts) {
   server_.reset();
   Start();
   EXPECT_EQ(server_->service().estimator().num_samples(), samples);
+}
+
+// Replicas sharing a store keep their estimators apart: each saves under
+// its own name (a replica's first run starts from what a server alone
+// learned), so none overwrites another's.
+TEST_F(ReplanServiceTest, EachReplicaKeepsItsOwnEstimator) {
+  v1::PlanRequest request = PlanRequestForOffice();
+  request.set_tour_solver(v1::GREEDY);
+  const auto learn = [&] {
+    v1::PlanResponse plan;
+    ASSERT_TRUE(Plan(request, &plan).ok());
+    v1::ReplanResponse out;
+    ASSERT_TRUE(Replan(RequestFor(plan), &out).ok());
+    ASSERT_GT(out.replan().new_ranks(), 0) << out.replan().method();
+  };
+  learn();
+  const int64_t alone = server_->service().estimator().num_samples();
+  ASSERT_GE(alone, 1);
+  server_.reset();
+  Start("r1");
+  EXPECT_EQ(server_->service().estimator().num_samples(), alone);  // seeded
+  learn();
+  learn();
+  const int64_t r1 = server_->service().estimator().num_samples();
+  EXPECT_GT(r1, alone);
+  server_.reset();
+  Start("r2");
+  EXPECT_EQ(server_->service().estimator().num_samples(), alone);  // not r1's
+  learn();
+  server_.reset();
+  Start("r1");
+  EXPECT_EQ(server_->service().estimator().num_samples(), r1);  // not overwritten by r2
+  server_.reset();
+  Start();
+  EXPECT_EQ(server_->service().estimator().num_samples(), alone);
 }
 
 TEST_F(ReplanServiceTest, TheReplanCommandTalksToTheServer) {

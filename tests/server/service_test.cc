@@ -11,6 +11,8 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -440,26 +442,34 @@ TEST_F(ServiceTest, HealthIsServingAndReflectionListsTheService) {
   EXPECT_THAT(*services, Contains("grpc.health.v1.Health"));
 }
 
-// Identical requests answered from memory are one plan: every hit after the
-// first gets the first hit's plan id and reply (with this call's timings),
-// and that id stays resolvable by GetPlan. A request that differs (here the
-// seed) is another plan with another id.
-TEST_F(ServiceTest, RepeatedHitsAreOnePlanUnderOneId) {
+// Identical requests answered from memory share one plan's content, each
+// under a plan id of its own (each call is a mission of its own): every hit
+// after the first gets the first hit's reply with its own id and timings,
+// and every id is resolvable by GetPlan. A request that differs (here the
+// seed) is another plan.
+TEST_F(ServiceTest, RepeatedHitsShareOnePlanUnderIdsOfTheirOwn) {
   const std::string map_id = PutTwoRooms();
   v1::PlanResponse cold, first;
   ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &cold).ok());
   ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &first).ok());
   ASSERT_EQ(first.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
+  std::set<std::string> ids = {cold.plan_id(), first.plan_id()};
   for (int i = 0; i < 4; ++i) {
     v1::PlanResponse hit;
     ASSERT_TRUE(Plan(PlanRequestFor(map_id, 0.4), &hit).ok());
     EXPECT_EQ(hit.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
-    EXPECT_EQ(hit.plan_id(), first.plan_id());
+    EXPECT_TRUE(ids.insert(hit.plan_id()).second) << "plan id handed out twice";
     EXPECT_TRUE(hit.stats().decomposition_cached());
-    // The same plan: everything but this call's planning time.
+    v1::PlanResponse retained;
+    ASSERT_TRUE(GetPlan(hit.plan_id(), &retained).ok());
+    EXPECT_EQ(retained.plan_id(), hit.plan_id());
+    EXPECT_EQ(retained.path_size(), first.path_size());
+    // The same plan: everything but this call's plan id and planning time.
+    hit.set_plan_id(first.plan_id());
     hit.mutable_stats()->set_planning_ms(first.stats().planning_ms());
     EXPECT_EQ(hit.SerializeAsString(), first.SerializeAsString());
   }
+  EXPECT_EQ(ids.size(), 6u);
   v1::PlanResponse retained;
   ASSERT_TRUE(GetPlan(first.plan_id(), &retained).ok());
   EXPECT_EQ(retained.plan_id(), first.plan_id());
@@ -504,9 +514,10 @@ TEST_F(ServiceTest, StatsOnlyDecodeMatchesTheFullReply) {
   EXPECT_TRUE(absl::IsNotFound(missing.status())) << missing.status();
 }
 
-// A repeated hit's reply is the stored bytes and then this call's stats:
-// the call's values win even when they are zero or false (proto3 writes no
-// zero, so the stored copy must not hold the first call's values).
+// A repeated hit's reply is the stored bytes and then this call's plan id
+// and stats: the call's values win even when they are zero or false
+// (proto3 writes no zero, so the stored copy must not hold the first
+// call's values).
 TEST(ServedPlanReplyTest, TheCallsStatsOverrideTheStoredReply) {
   v1::PlanResponse first;
   first.set_plan_id("p-1");
@@ -519,6 +530,7 @@ TEST(ServedPlanReplyTest, TheCallsStatsOverrideTheStoredReply) {
   ASSERT_NE(body, nullptr);
   for (const auto& [ms, cached] : {std::pair{0.0, false}, std::pair{0.25, true}}) {
     v1::PlanResponse call;
+    call.set_plan_id("p-2");
     call.mutable_stats()->set_planning_ms(ms);
     call.mutable_stats()->set_decomposition_cached(cached);
     grpc::ByteBuffer bytes;
@@ -526,6 +538,7 @@ TEST(ServedPlanReplyTest, TheCallsStatsOverrideTheStoredReply) {
     v1::PlanResponse parsed;
     ASSERT_TRUE(parsed.ParseFromString(testing::FromBuffer(bytes)));
     v1::PlanResponse expected = first;
+    expected.set_plan_id("p-2");
     expected.mutable_stats()->set_planning_ms(ms);
     expected.mutable_stats()->set_decomposition_cached(cached);
     EXPECT_EQ(parsed.SerializeAsString(), expected.SerializeAsString()) << ms;
@@ -654,7 +667,8 @@ TEST_F(OneWorkerServiceTest, RepeatedHitsAreAnsweredWhileTheWorkerIsBusy) {
     ASSERT_TRUE(statuses[i].ok()) << statuses[i].error_message();
     const v1::PlanResponse& again = repeats[i];
     EXPECT_EQ(again.stats().plan_source(), v1::PLAN_SOURCE_CACHE_HIT);
-    EXPECT_EQ(again.plan_id(), first.plan_id());
+    EXPECT_NE(again.plan_id(), first.plan_id());
+    for (int j = 0; j < i; ++j) EXPECT_NE(again.plan_id(), repeats[j].plan_id());
     EXPECT_TRUE(again.stats().decomposition_cached());
     ASSERT_EQ(again.path_size(), first.path_size());
     for (int k = 0; k < again.path_size(); ++k) {
