@@ -21,8 +21,7 @@ inline void ExpectArrivalTimes(const v1::PlanResponse& plan) {
     ASSERT_GE(plan.path(i).time_s(), plan.path(i - 1).time_s()) << "waypoint " << i;
   }
   const double duration = plan.stats().estimated_duration_s();
-  EXPECT_NEAR(plan.path(plan.path_size() - 1).time_s(), duration,
-              1e-6 * std::max(1.0, duration));
+  EXPECT_NEAR(plan.path(plan.path_size() - 1).time_s(), duration, 1e-6 * std::max(1.0, duration));
 }
 
 }  // namespace covplan::testing

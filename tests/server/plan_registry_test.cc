@@ -63,7 +63,7 @@ TEST(PlanRegistry, AnAliasWhoseOriginalIsGoneNamesItUntilItsOwnTtl) {
   plans.PutAlias("p-b", "p-a", t0 + absl::Minutes(8));
   const absl::Time t1 = t0 + absl::Minutes(11);
   EXPECT_EQ(plans.Get("p-a", t1), nullptr);
-  EXPECT_EQ(plans.Get("p-b", t1), nullptr);  // no copy: the original is gone
+  EXPECT_EQ(plans.Get("p-b", t1), nullptr);       // no copy: the original is gone
   EXPECT_EQ(plans.OriginalOf("p-b", t1), "p-a");  // the caller rebuilds it
   EXPECT_EQ(plans.OriginalOf("p-b", t0 + absl::Minutes(18)), std::nullopt);
   EXPECT_EQ(plans.aliases(), 0u);

@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "absl/strings/str_join.h"
 #include "gtest/gtest.h"
 #include "planner/sim/clutter.h"
 #include "planner/sim/drive.h"
@@ -58,7 +59,7 @@ TEST(DriveClock, SmallStepsNeverCarryTheClockPastTheirBound) {
   std::printf("%d bounds, %d replans, total %.1f s\n", calls, r.num_replans, r.total_time_s);
   EXPECT_TRUE(r.completed) << r.termination;
   EXPECT_GT(r.num_replans, 0);
-  EXPECT_TRUE(r.problems.empty());
+  EXPECT_TRUE(r.problems.empty()) << absl::StrJoin(r.problems, "\n");
 }
 
 }  // namespace
