@@ -75,21 +75,33 @@ absl::Status FsyncDir(const std::string& dir) {
   return absl::OkStatus();
 }
 
-// Writes `contents` to `path` atomically: temp file, fsync, rename, fsync dir.
-absl::Status AtomicWrite(const std::string& dir, const std::string& path,
-                         absl::string_view contents) {
+// Writes `contents` to a new temporary file beside `path` (fsynced when
+// `sync`) and returns its name; nothing is left behind on failure.
+absl::StatusOr<std::string> WriteTemp(const std::string& path, absl::string_view contents,
+                                      bool sync) {
   static std::atomic<uint64_t> counter{0};
   const std::string tmp =
       absl::StrCat(path, ".tmp.", ::getpid(), ".", counter.fetch_add(1, std::memory_order_relaxed));
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return ErrnoError("cannot create", tmp);
   absl::Status status = WriteAll(fd, contents, tmp);
-  if (status.ok() && ::fsync(fd) != 0) status = ErrnoError("cannot fsync", tmp);
+  if (sync && status.ok() && ::fsync(fd) != 0) status = ErrnoError("cannot fsync", tmp);
   if (::close(fd) != 0 && status.ok()) status = ErrnoError("cannot close", tmp);
-  if (status.ok() && ::rename(tmp.c_str(), path.c_str()) != 0)
-    status = ErrnoError("cannot rename", tmp);
   if (!status.ok()) {
     ::unlink(tmp.c_str());
+    return status;
+  }
+  return tmp;
+}
+
+// Writes `contents` to `path` atomically: temp file, fsync, rename, fsync dir.
+absl::Status AtomicWrite(const std::string& dir, const std::string& path,
+                         absl::string_view contents) {
+  absl::StatusOr<std::string> tmp = WriteTemp(path, contents, /*sync=*/true);
+  if (!tmp.ok()) return tmp.status();
+  if (::rename(tmp->c_str(), path.c_str()) != 0) {
+    const absl::Status status = ErrnoError("cannot rename", *tmp);
+    ::unlink(tmp->c_str());
     return status;
   }
   return FsyncDir(dir);
@@ -407,7 +419,6 @@ absl::Status MapStore::PutPlans(const std::vector<std::pair<std::string, std::st
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return absl::InternalError(absl::StrCat("cannot create ", dir, ": ", ec.message()));
-  static std::atomic<uint64_t> counter{0};
   absl::Status first;
   std::vector<std::pair<std::string, std::string>> written;  // temp file, final path
   for (const auto& [plan_id, contents] : plans) {
@@ -416,20 +427,11 @@ absl::Status MapStore::PutPlans(const std::vector<std::pair<std::string, std::st
       continue;
     }
     const std::string path = dir + "/" + plan_id + ".plan";
-    const std::string tmp = absl::StrCat(path, ".tmp.", ::getpid(), ".b",
-                                         counter.fetch_add(1, std::memory_order_relaxed));
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) {
-      first.Update(ErrnoError("cannot create", tmp));
-      continue;
-    }
-    absl::Status status = WriteAll(fd, contents, tmp);
-    if (::close(fd) != 0 && status.ok()) status = ErrnoError("cannot close", tmp);
-    if (status.ok()) {
-      written.emplace_back(tmp, path);
+    absl::StatusOr<std::string> tmp = WriteTemp(path, contents, /*sync=*/false);
+    if (tmp.ok()) {
+      written.emplace_back(*std::move(tmp), path);
     } else {
-      ::unlink(tmp.c_str());
-      first.Update(status);
+      first.Update(tmp.status());
     }
   }
   if (written.empty()) return first;
