@@ -18,10 +18,11 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: covplan gtsp FILE [--time-limit SECONDS] [--seed N] [--threads N]\n"
-    "                         [--effort fast|default|thorough]\n"
+    "                         [--effort fast|default|thorough] [--search hybrid|lns|memetic]\n"
     "Solves a GTSPLIB instance and prints one JSON object on stdout.\n"
     "With --time-limit the solver keeps improving until the limit (effort\n"
-    "thorough unless --effort is given); without it, it stops on its own.\n";
+    "thorough unless --effort is given); without it, it stops on its own.\n"
+    "--search picks the search that fills a thorough deadline (default hybrid).\n";
 
 int UsageError(const std::string& message) {
   std::cerr << "covplan gtsp: " << message << "\n" << kUsage;
@@ -66,6 +67,7 @@ struct Args {
   uint64_t seed = 1;
   int threads = 1;
   std::optional<GtspEffort> effort;
+  GtspSearch search = GtspSearch::kHybrid;
 };
 
 // Returns an error message, or "" on success; sets `help` for --help.
@@ -113,6 +115,16 @@ std::string ParseArgs(const std::vector<std::string>& args, Args& out, bool& hel
       } else {
         return absl::StrCat("--effort must be fast, default or thorough, got '", value, "'");
       }
+    } else if (arg == "--search") {
+      if (value == "hybrid") {
+        out.search = GtspSearch::kHybrid;
+      } else if (value == "lns") {
+        out.search = GtspSearch::kLns;
+      } else if (value == "memetic") {
+        out.search = GtspSearch::kMemetic;
+      } else {
+        return absl::StrCat("--search must be hybrid, lns or memetic, got '", value, "'");
+      }
     } else {
       return absl::StrCat("unknown flag '", arg, "'");
     }
@@ -139,6 +151,7 @@ int RunGtspCommand(const std::vector<std::string>& args) {
   GtspOptions opt;
   opt.seed = a.seed;
   opt.num_threads = a.threads;
+  opt.search = a.search;
   opt.effort = a.effort.value_or(a.time_limit_s ? GtspEffort::kThorough : GtspEffort::kDefault);
   if (a.time_limit_s) opt.stop = StopToken::WithTimeout(absl::Seconds(*a.time_limit_s));
   absl::StatusOr<GtspResult> r = SolveGtsp(file->instance, opt);

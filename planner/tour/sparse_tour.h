@@ -63,7 +63,8 @@ struct SparseTourOptions {
   bool local_search = true;  // false: nearest-neighbour tour only
   bool until_limit = false;  // true: keep kicking until the budget is spent
   // Kicks without improvement, summed over all threads, after which the
-  // kick phase counts as converged: max(min_kicks, kicks_per_rank * ranks).
+  // kick phase counts as converged: threads * max(min_kicks, kicks_per_rank
+  // * ranks).
   int64_t min_kicks = 500;
   double kicks_per_rank = 1.0;
   int64_t max_cached_pairs = 4'000'000;  // on-demand exact lengths kept

@@ -56,6 +56,18 @@ TEST_F(GtspCommandTest, TimeLimitRunsUntilTheDeadline) {
   EXPECT_THAT(out, HasSubstr("\"stopped_early\":true"));
 }
 
+TEST_F(GtspCommandTest, EverySearchSolvesTheSquare) {
+  for (const char* search : {"hybrid", "lns", "memetic"}) {
+    std::string out, err;
+    ASSERT_EQ(Run({path_, "--time-limit=0.05", "--search", search}, out, err), 0) << err;
+    EXPECT_THAT(out, HasSubstr("\"cost\":40,")) << search;
+  }
+  std::string out, err;
+  EXPECT_EQ(Run({path_, "--search", "genetic"}, out, err), 2);
+  EXPECT_THAT(err, HasSubstr("--search must be hybrid, lns or memetic, got 'genetic'"));
+  EXPECT_TRUE(out.empty());
+}
+
 TEST_F(GtspCommandTest, UsageErrorsExitWithTwo) {
   std::string out, err;
   EXPECT_EQ(Run({}, out, err), 2);

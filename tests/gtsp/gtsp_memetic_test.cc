@@ -110,26 +110,32 @@ TEST(MemeticTest, RunReturnsTheLastTourItReportedAndNeverWorseThanItsStart) {
   EXPECT_GT(out.iterations, 0);
 }
 
-TEST(MemeticTest, ThoroughDeadlineSolveFindsTheHeldKarpOptimum) {
+// Every search that fills a deadline: the hybrid (the default), the LNS
+// trials and the memetic search alone.
+TEST(MemeticTest, EveryDeadlineSearchFindsTheHeldKarpOptimum) {
   for (unsigned seed = 1; seed <= 10; ++seed) {
     // 2 and 3 sets, then 3..10.
     const int num_sets = seed <= 2 ? 1 + static_cast<int>(seed) : 3 + static_cast<int>(seed % 8);
     const GtspInstance inst =
         RandomInstance(seed, num_sets, 3, seed % 2 ? kAsymmetric : kEuclidean, 2);
     const double opt = HeldKarpOptimum(inst);
-    for (int threads : {1, 2}) {
-      GtspOptions options;
-      options.seed = seed;
-      options.num_threads = threads;
-      options.effort = GtspEffort::kThorough;
-      options.stop = StopToken::WithTimeout(absl::Milliseconds(100));
-      absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
-      ASSERT_TRUE(r.ok()) << r.status();
-      ASSERT_TRUE(ValidateTour(inst, r->tour).ok());
-      EXPECT_NEAR(r->cost, opt, 1e-6)
-          << "seed " << seed << ", " << num_sets << " sets, " << threads << " threads";
-      if (num_sets > 2) {
-        EXPECT_GT(r->iterations, 0);  // children were evolved, not only the greedy step
+    for (GtspSearch search : {GtspSearch::kHybrid, GtspSearch::kLns, GtspSearch::kMemetic}) {
+      for (int threads : {1, 2}) {
+        GtspOptions options;
+        options.seed = seed;
+        options.num_threads = threads;
+        options.effort = GtspEffort::kThorough;
+        options.search = search;
+        options.stop = StopToken::WithTimeout(absl::Milliseconds(60));
+        absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
+        ASSERT_TRUE(r.ok()) << r.status();
+        ASSERT_TRUE(ValidateTour(inst, r->tour).ok());
+        EXPECT_NEAR(r->cost, opt, 1e-6)
+            << "seed " << seed << ", " << num_sets << " sets, " << threads << " threads, search "
+            << static_cast<int>(search);
+        if (num_sets > 2) {
+          EXPECT_GT(r->iterations, 0);  // the search ran, not only the greedy step
+        }
       }
     }
   }

@@ -25,6 +25,13 @@ using gtsp_internal::SearchTour;
 using gtsp_internal::SeedFor;
 using gtsp_internal::TrialOutcome;
 
+// The hybrid search: the memetic search's share of the deadline (0.3, 0.5,
+// 0.7 and 0.8 tried, docs/benchmarks.md §4), the warm LNS trials that
+// follow it and the seed range of chained LNS trials.
+constexpr double kMemeticShare = 0.8;
+constexpr int kPolishTrials = 4;
+constexpr uint64_t kChainSeeds = 1 << 20;
+
 struct EffortConfig {
   int trials;       // when neither max_trials nor "until deadline" applies
   int cold_trials;  // trials started from a fresh random tour
@@ -87,15 +94,14 @@ class GtspSolve {
 
   GtspResult Solve() {
     GreedyStart();
-    // kThorough with a deadline (and no trial limit) uses all the time given:
-    // one memetic search per thread, each evolving its own population (seeded
-    // with the tour so far) until the deadline. On GTSPLIB two threads for
-    // 1 s this way beat one thread of LNS trials for 5 s (docs/benchmarks.md,
-    // section 4, "A memetic search for deadlines").
+    // kThorough with a deadline (and no trial limit) uses all the time
+    // given: per thread one memetic search (its own population, seeded with
+    // the tour so far), then, in the hybrid, LNS trials from its best tour
+    // (docs/benchmarks.md, section 4).
     const bool until_deadline = options_.max_trials == 0 && options_.stop.has_deadline() &&
                                 options_.effort == GtspEffort::kThorough;
-    if (until_deadline) {
-      RunMemetic();
+    if (until_deadline && options_.search != GtspSearch::kLns) {
+      RunUntilDeadline();
     } else {
       RunTrials();
     }
@@ -125,73 +131,123 @@ class GtspSolve {
     ReportBest(best_);
   }
 
-  void Take(std::vector<TrialOutcome>& outcomes) {
-    for (TrialOutcome& o : outcomes) {
+  // Folds the threads' outcomes into the result; `completed[j]`, if given,
+  // is how many trials thread j completed (otherwise one unless stopped).
+  void Take(std::vector<TrialOutcome>& outcomes, const std::vector<int>* completed = nullptr) {
+    for (size_t j = 0; j < outcomes.size(); ++j) {
+      TrialOutcome& o = outcomes[j];
       result_.iterations += o.iterations;
-      if (o.stopped) {
-        result_.stopped_early = true;
-      } else {
+      if (o.stopped) result_.stopped_early = true;
+      if (completed != nullptr) {
+        result_.trials_completed += (*completed)[j];
+      } else if (!o.stopped) {
         ++result_.trials_completed;
       }
       if (gtsp_internal::Cheaper(o.best.cost, best_.cost)) best_ = std::move(o.best);
     }
   }
 
-  void RunMemetic() {
+  // One search per thread until the deadline. Thread j's search depends
+  // only on (seed, j) and the clock, and thread 0 runs the one-thread
+  // search, so more threads only add tours to choose from (issue 31: two
+  // threads at equal wall time never worse than one). Odd threads racing
+  // the LNS trials instead did worse at 2 threads (docs/benchmarks.md §4).
+  void RunUntilDeadline() {
     const StopToken& stop = options_.stop;
     if (problem_.m <= 1) return;
     if (stop.ShouldStop()) {
       result_.stopped_early = true;  // stopped before the search began
       return;
     }
+    const absl::Time now = absl::Now();
+    const absl::Time deadline = stop.deadline();
+    const bool hybrid = options_.search == GtspSearch::kHybrid;
     SearchParams memetic_params = params_;
-    memetic_params.time_budget_end = stop.deadline();
+    memetic_params.time_budget_end = hybrid ? now + (deadline - now) * kMemeticShare : deadline;
     const int threads = options_.num_threads;
     std::vector<TrialOutcome> outcomes(threads);
     const SearchTour warm = best_;
     RunParallel(threads, [&](int j) {
       MemeticSearch search(problem_, memetic_params, SeedFor(options_.seed, j));
       outcomes[j] = search.Run(&warm, stop, on_best_);
+      if (hybrid) LnsChain(ChainSeeds(j), deadline, kPolishTrials, 0, /*fill=*/true, outcomes[j]);
     });
     Take(outcomes);
   }
 
-  // The effort's trials, in whole rounds of `num_threads` parallel trials: a
-  // last round with fewer trials than threads would cost a full trial of
-  // wall time with cores idle, so it is dropped (at least one round runs).
-  int TotalTrials() const {
-    const int threads = options_.num_threads;
-    int total_trials = std::max(1, cfg_.trials / threads) * threads;
-    if (options_.max_trials == GtspOptions::kLocalStepOnly) {
-      total_trials = 0;
-    } else if (options_.max_trials > 0) {
-      total_trials = options_.max_trials;
-    }
-    if (problem_.m <= 1) total_trials = 0;  // the greedy step is exact for one set
-    return total_trials;
+  // Seeds of thread j's chained trials (thread 0's are the trial indices, as
+  // in the rounds of RunTrials).
+  static uint64_t ChainSeeds(int thread) {
+    return thread == 0 ? 0 : kChainSeeds + (static_cast<uint64_t>(thread) << 16);
   }
 
+  // LNS trials in a chain from `out.best`, each from the chain's best so far
+  // (the first `cold` from a random tour instead), seeded from `seeds` on:
+  // `trials` of them with the time left to `deadline` spread over them, and
+  // with `fill` more until the deadline (a trial that stalls early leaves
+  // its time to the next). Returns the trials completed.
+  // After the memetic search (the hybrid's second part): the memetic search
+  // converges on the arcs its population shares; the LNS's annealing removes
+  // and re-inserts whole regions of one tour and finds what those arcs hide.
+  int LnsChain(uint64_t seeds, absl::Time deadline, int trials, int cold, bool fill,
+               TrialOutcome& out) {
+    const StopToken& stop = options_.stop;
+    int t = 0, completed = 0;
+    for (; (fill || t < trials) && !stop.ShouldStop(); ++t) {
+      const absl::Time now = absl::Now();
+      if (now >= deadline) break;
+      SearchParams params = params_;
+      params.time_budget_end = now + (deadline - now) / std::max(1, trials - t);
+      LnsTrial lns(problem_, params, SeedFor(options_.seed, seeds + t));
+      TrialOutcome o = lns.Run(t < cold ? nullptr : &out.best, stop, on_best_);
+      out.iterations += o.iterations;
+      if (!o.stopped) ++completed;
+      if (gtsp_internal::Cheaper(o.best.cost, out.best.cost)) out.best = std::move(o.best);
+    }
+    out.stopped = stop.ShouldStop() || (!fill && t < trials);
+    return completed;
+  }
+
+  // The trials of the effort, or max_trials; 0 for none.
+  int EffortTrials() const {
+    if (problem_.m <= 1 || options_.max_trials == GtspOptions::kLocalStepOnly) return 0;
+    return options_.max_trials > 0 ? options_.max_trials : cfg_.trials;
+  }
+
+  // With a deadline, every thread runs the one-thread sequence of trials in
+  // a chain (thread 0 with the one-thread seeds), the time spread over its
+  // trials: two threads are never worse than one (issue 31). Without one,
+  // the trials run in whole rounds of `num_threads` parallel trials, each
+  // round from the best so far (deterministic for a seed and thread count):
+  // a last round with fewer trials than threads would cost a full trial of
+  // wall time with cores idle, so it is dropped (at least one round runs).
   void RunTrials() {
     const StopToken& stop = options_.stop;
     const int threads = options_.num_threads;
-    const int total_trials = TotalTrials();
+    const int trials = EffortTrials();
+    if (trials == 0) return;
+    const int cold = options_.initial_tour.empty() ? cfg_.cold_trials : 0;
+    if (stop.has_deadline()) {
+      std::vector<TrialOutcome> outcomes(threads);
+      std::vector<int> completed(threads, 0);
+      RunParallel(threads, [&](int j) {
+        outcomes[j].best = best_;
+        completed[j] = LnsChain(ChainSeeds(j), stop.deadline(), trials, cold, false, outcomes[j]);
+      });
+      Take(outcomes, &completed);
+      return;
+    }
+    const int total_trials =
+        options_.max_trials > 0 ? trials : std::max(1, trials / threads) * threads;
     int started = 0;
     while (started < total_trials && !stop.ShouldStop()) {
       const int round = std::min(threads, total_trials - started);
-      SearchParams round_params = params_;
-      if (stop.has_deadline()) {
-        // Spread the remaining time over the remaining rounds so that every
-        // trial completes its annealing schedule before the deadline.
-        const int rounds_left = (total_trials - started + threads - 1) / threads;
-        round_params.time_budget_end = absl::Now() + stop.remaining() / rounds_left;
-      }
       std::vector<TrialOutcome> outcomes(round);
       const SearchTour warm = best_;
       RunParallel(round, [&](int j) {
         const int trial = started + j;
-        LnsTrial lns(problem_, round_params, SeedFor(options_.seed, trial));
-        const bool cold = trial < cfg_.cold_trials && options_.initial_tour.empty();
-        outcomes[j] = lns.Run(cold ? nullptr : &warm, stop, on_best_);
+        LnsTrial lns(problem_, params_, SeedFor(options_.seed, trial));
+        outcomes[j] = lns.Run(trial < cold ? nullptr : &warm, stop, on_best_);
       });
       Take(outcomes);
       started += round;

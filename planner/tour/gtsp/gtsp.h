@@ -6,9 +6,10 @@
 // several removal and insertion heuristics with adaptive weights, simulated-
 // annealing acceptance, restarts/trials, and a local step that re-picks the
 // vertex of each set. A thorough solve with a deadline instead evolves one
-// population of local optima per thread until the deadline (the memetic
-// search of gtsp_memetic.h, after Gutin & Karapetyan 2010). Anytime: it always
-// holds a valid tour and returns the best one found when the StopToken fires.
+// population of local optima per thread (the memetic search of
+// gtsp_memetic.h, after Gutin & Karapetyan 2010), then runs LNS trials from
+// its best until the deadline (GtspSearch). Anytime: it always holds a valid
+// tour and returns the best one found when the StopToken fires.
 //
 //   GtspInstance inst = ...;               // costs + sets
 //   GtspOptions opt; opt.seed = 7;
@@ -48,12 +49,21 @@ struct GtspInstance {
 
 enum class GtspEffort { kFast, kDefault, kThorough };
 
+// The search that fills a deadline (thorough effort, a deadline, no trial
+// limit); the other efforts always run LNS trials.
+enum class GtspSearch {
+  kHybrid,   // per thread: the memetic search, then LNS trials from its best
+  kLns,      // the effort's LNS trials, the time spread over them
+  kMemetic,  // per thread: the memetic search until the deadline
+};
+
 struct GtspOptions {
   uint64_t seed = 1;
-  int num_threads = 1;  // trials run in parallel on this many threads; the
-                        // effort's trials run in whole rounds of this many
-                        // (thorough with a deadline: one population each)
+  int num_threads = 1;  // without a deadline, the effort's trials run in
+                        // whole rounds of this many; with one, each thread
+                        // runs its own search (thread 0 the one-thread one)
   GtspEffort effort = GtspEffort::kDefault;
+  GtspSearch search = GtspSearch::kHybrid;   // with a deadline to fill (see GtspSearch)
   int max_trials = 0;                        // 0 = chosen by effort; kLocalStepOnly: no LNS trial
   static constexpr int kLocalStepOnly = -1;  // the initial (or greedy) tour, locally optimised
   StopToken stop;                            // deadline / cancellation
