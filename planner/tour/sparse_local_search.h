@@ -51,8 +51,8 @@ absl::Status AuditTour(int n, const std::vector<int>& t, const std::vector<int>&
 // The best tour of a kick phase shared by several threads: each kicks its
 // copy of it, publishes a better tour, and copies a newer one before its
 // next kick; `stale` counts the kicks of all threads since the last
-// published gain, so the phase converges after as many kicks without gain
-// as one thread's would, reached about threads times sooner.
+// published gain (the driver converges after one thread's count per
+// thread, sparse_tour.cc).
 struct Incumbent {
   std::mutex mu;
   std::vector<int> t, pos, mate;  // guarded by mu, as is cost

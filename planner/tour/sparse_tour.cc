@@ -78,12 +78,15 @@ absl::StatusOr<SearchResult> SearchTour(SparseCostOracle* oracle, const SparseTo
   const StopToken budget = stop.WithEarlierDeadline(began + absl::Seconds(options.time_limit_s));
   const int threads = options.local_search ? std::max(1, options.num_threads) : 1;
   // Kicks without gain, counted over all threads (they kick one shared
-  // incumbent): one thread's count per thread. With one thread's count in
-  // all, two threads converged in 0.83 of one thread's wall time but on
-  // tours 0.5 % longer (lab_a at 0.3 m); with this, as long as one
-  // thread's in the mean, in 0.93 of its wall time (docs/benchmarks.md §14).
+  // incumbent): one thread's count per thread that has a core. With one
+  // thread's count in all, two threads converged in 0.83 of one thread's
+  // wall time but on tours 0.5 % longer (lab_a at 0.3 m); with this, as
+  // long as one thread's in the mean, in 0.93 of its wall time
+  // (docs/benchmarks.md §14). Threads beyond the cores would only stretch
+  // the phase.
+  const int64_t cores = std::max(1u, std::thread::hardware_concurrency());
   const int64_t converge_after =
-      threads *
+      std::min<int64_t>(threads, cores) *
       std::max<int64_t>(options.min_kicks, static_cast<int64_t>(options.kicks_per_rank * n));
   Incumbent incumbent;
   struct Outcome {

@@ -6,8 +6,10 @@ every instance of the given directories, every search, limit, thread count
 and seed, and prints one markdown row per instance and seed: the gap, in %,
 of each run to the instance's reference. The reference is the best known
 value of the directory's best_known.csv when it lists the instance, else the
-cheapest tour any run of this table found (the column says which). Runs are
-kept in a TSV (--raw) and not repeated, so a table can be extended later.
+cheapest tour of any run recorded for the instance in the --raw file (any
+search, limit, thread count or binary: the column says which). Runs are kept
+in that TSV, keyed by the binary's path too, and not repeated, so a table
+can be extended later; a rebuilt binary at the same path needs a new --raw.
 
   /usr/bin/python3 scripts/bench/gtsp_compare.py --bin build/bin/covplan \\
       --data ../shared/data/gtsp --data /tmp/gtsp-gen --only '[0-9]{3,}\\.gtsp$' \\
@@ -35,7 +37,7 @@ def instances(dirs, only):
             if not re.search(only, os.path.basename(f)):
                 continue
             name = os.path.basename(f)[:-5]
-            size = int(re.sub(r"^[0-9]+[a-zA-Z]+", "", name) or 0)
+            size = int(re.search(r"([0-9]*)$", name).group(1) or 0)
             out.append((size, name, f, known.get(name.lower())))
     out.sort()
     return out
@@ -45,8 +47,8 @@ def load_raw(path):
     runs = {}
     if os.path.exists(path):
         for line in open(path):
-            name, search, limit, threads, seed, cost = line.split("\t")[:6]
-            runs[(name, search, float(limit), int(threads), int(seed))] = int(cost)
+            name, search, limit, threads, seed, cost, _, binary = line.rstrip("\n").split("\t")
+            runs[(name, search, float(limit), int(threads), int(seed), binary)] = int(cost)
     return runs
 
 
@@ -65,7 +67,9 @@ def main():
     limits = [float(x) for x in a.limits.split()]
     threads = [int(x) for x in a.threads.split()]
     todo = instances(a.data, a.only)
-    runs = load_raw(a.raw)
+    binary = os.path.realpath(a.bin)
+    recorded = load_raw(a.raw)
+    runs = {k[:5]: c for k, c in recorded.items() if k[5] == binary}
     with open(a.raw, "a") as raw:
         for _, name, path, _ in todo:
             for limit in limits:
@@ -80,7 +84,8 @@ def main():
                             d = json.loads(subprocess.run(cmd, check=True, capture_output=True,
                                                           text=True).stdout)
                             runs[key] = int(d["cost"])
-                            raw.write("\t".join(map(str, [*key, d["cost"], d["time_s"]])) + "\n")
+                            raw.write("\t".join(map(str, [*key, d["cost"], d["time_s"], binary]))
+                                      + "\n")
                             raw.flush()
                             print(f"  {name} {search} {limit:g}s x{t} seed {seed}: {d['cost']}",
                                   file=sys.stderr)
@@ -91,7 +96,7 @@ def main():
     gaps = collections.defaultdict(list)
     worse = collections.Counter()
     for _, name, _, known in todo:
-        seen = [c for k, c in runs.items() if k[0] == name]
+        seen = [c for k, c in list(recorded.items()) + list(runs.items()) if k[0] == name]
         ref = min([known] + seen) if known else min(seen)
         label = f"{ref}" + (" (best known)" if known and ref == known else " (best run)")
         for seed in range(1, a.seeds + 1):

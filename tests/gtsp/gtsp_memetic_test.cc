@@ -135,6 +135,11 @@ TEST(MemeticTest, EveryDeadlineSearchFindsTheHeldKarpOptimum) {
             << static_cast<int>(search);
         if (num_sets > 2) {
           EXPECT_GT(r->iterations, 0);  // the search ran, not only the greedy step
+        } else if (search != GtspSearch::kLns) {
+          // Exact after the local step: returns without waiting for the deadline.
+          EXPECT_FALSE(r->stopped_early)
+              << "seed " << seed << ", search " << static_cast<int>(search);
+          EXPECT_EQ(r->trials_completed, threads);
         }
       }
     }

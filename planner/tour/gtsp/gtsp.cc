@@ -26,7 +26,7 @@ using gtsp_internal::SeedFor;
 using gtsp_internal::TrialOutcome;
 
 // The hybrid search: the memetic search's share of the deadline (0.3, 0.5,
-// 0.7 and 0.8 tried, docs/benchmarks.md §4), the warm LNS trials that
+// 0.7 and 0.8 tried, docs/benchmarks-archive.md §4), the warm LNS trials that
 // follow it and the seed range of chained LNS trials.
 constexpr double kMemeticShare = 0.8;
 constexpr int kPolishTrials = 4;
@@ -74,9 +74,9 @@ void RunParallel(int count, const std::function<void(int)>& run) {
 }
 
 // One SolveGtsp call: the problem, the best tour so far and the tallies of
-// the searches run on it. The searches of one round run in parallel and
-// call ReportBest concurrently (it locks); everything else is called from
-// the solving thread only.
+// the searches run on it. The searches of one round (or the threads' chains
+// and searches) run in parallel, read best_ only and call ReportBest
+// concurrently (it locks); Take and Finish run on the solving thread.
 class GtspSolve {
  public:
   GtspSolve(const GtspInstance& instance, const GtspOptions& options)
@@ -149,9 +149,11 @@ class GtspSolve {
 
   // One search per thread until the deadline. Thread j's search depends
   // only on (seed, j) and the clock, and thread 0 runs the one-thread
-  // search, so more threads only add tours to choose from (issue 31: two
-  // threads at equal wall time never worse than one). Odd threads racing
-  // the LNS trials instead did worse at 2 threads (docs/benchmarks.md §4).
+  // search, so with a core per thread more threads only add tours to choose
+  // from (issue 31: two threads at equal wall time never worse than one;
+  // with fewer cores than threads, thread 0 gets less CPU). Odd threads
+  // racing the LNS trials instead did worse at 2 threads
+  // (docs/benchmarks-archive.md §4).
   void RunUntilDeadline() {
     const StopToken& stop = options_.stop;
     if (problem_.m <= 1) return;
@@ -166,13 +168,21 @@ class GtspSolve {
     memetic_params.time_budget_end = hybrid ? now + (deadline - now) * kMemeticShare : deadline;
     const int threads = options_.num_threads;
     std::vector<TrialOutcome> outcomes(threads);
+    std::vector<int> completed(threads, 0);
     const SearchTour warm = best_;
     RunParallel(threads, [&](int j) {
       MemeticSearch search(problem_, memetic_params, SeedFor(options_.seed, j));
       outcomes[j] = search.Run(&warm, stop, on_best_);
-      if (hybrid) LnsChain(ChainSeeds(j), deadline, kPolishTrials, 0, /*fill=*/true, outcomes[j]);
+      // Up to two sets the memetic search's local step is exact: nothing to
+      // polish, and no reason to wait for the deadline.
+      if (hybrid && problem_.m > 2) {
+        completed[j] =
+            LnsChain(ChainSeeds(j), deadline, kPolishTrials, 0, /*fill=*/true, outcomes[j]);
+      } else {
+        completed[j] = outcomes[j].stopped ? 0 : 1;
+      }
     });
-    Take(outcomes);
+    Take(outcomes, &completed);
   }
 
   // Seeds of thread j's chained trials (thread 0's are the trial indices, as
@@ -193,6 +203,7 @@ class GtspSolve {
                TrialOutcome& out) {
     const StopToken& stop = options_.stop;
     int t = 0, completed = 0;
+    bool cut = false;  // a trial was cut short by the StopToken
     for (; (fill || t < trials) && !stop.ShouldStop(); ++t) {
       const absl::Time now = absl::Now();
       if (now >= deadline) break;
@@ -201,10 +212,15 @@ class GtspSolve {
       LnsTrial lns(problem_, params, SeedFor(options_.seed, seeds + t));
       TrialOutcome o = lns.Run(t < cold ? nullptr : &out.best, stop, on_best_);
       out.iterations += o.iterations;
-      if (!o.stopped) ++completed;
+      if (o.stopped) {
+        cut = true;
+      } else {
+        ++completed;
+      }
       if (gtsp_internal::Cheaper(o.best.cost, out.best.cost)) out.best = std::move(o.best);
     }
-    out.stopped = stop.ShouldStop() || (!fill && t < trials);
+    // Filling until the deadline always ends stopped (as the memetic search).
+    out.stopped = fill ? stop.ShouldStop() : cut || t < trials;
     return completed;
   }
 

@@ -63,8 +63,9 @@ struct GtspOptions {
                         // whole rounds of this many; with one, each thread
                         // runs its own search (thread 0 the one-thread one)
   GtspEffort effort = GtspEffort::kDefault;
-  GtspSearch search = GtspSearch::kHybrid;   // with a deadline to fill (see GtspSearch)
-  int max_trials = 0;                        // 0 = chosen by effort; kLocalStepOnly: no LNS trial
+  GtspSearch search = GtspSearch::kHybrid;  // with a deadline to fill (see GtspSearch)
+  int max_trials = 0;  // 0 = chosen by effort; kLocalStepOnly: no LNS trial; with a
+                       // deadline, per thread (each thread runs its own chain)
   static constexpr int kLocalStepOnly = -1;  // the initial (or greedy) tour, locally optimised
   StopToken stop;                            // deadline / cancellation
   // Optional starting tour (one vertex per set, in visiting order) to improve.
@@ -79,9 +80,10 @@ struct GtspResult {
   std::vector<int> tour;       // one vertex per set, visiting order (cycle)
   double cost = 0.0;           // sum of arc costs including the closing arc
   bool stopped_early = false;  // the StopToken cut the search short
-  int64_t iterations = 0;      // LNS iterations, or children evolved (thorough with a deadline)
-  int trials_completed = 0;    // trials that ended before the StopToken fired (thorough with a
-                             // deadline: 0, or num_threads when m = 2 and the greedy step is exact)
+  int64_t iterations = 0;      // LNS iterations, plus children evolved (thorough with a deadline)
+  int trials_completed = 0;    // LNS trials that ended before the StopToken fired, over all
+                               // threads (thorough with a deadline: the hybrid's, or num_threads
+                               // when m = 2 and the memetic search's local step is exact)
   double elapsed_s = 0.0;
   double time_to_best_s = 0.0;
 };
