@@ -18,6 +18,13 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Time allowed past a deadline or a cancellation: a 50 ms deadline on
+// 1,000 vertices ends after 90-105 ms on an idle 2-vCPU VM (covplan gtsp,
+// every search, before and after issue 31; the greedy start always runs and
+// is not interruptible), and CI is a loaded 2-core machine (a 0.1 s margin
+// was exceeded there by 24 ms). Without the stop: minutes.
+constexpr double kMargin = 0.25 * testing::kTimingSlowdown;
+
 // ~1000 vertices in 200 sets.
 const GtspInstance& LargeInstance() {
   static const GtspInstance* inst = new GtspInstance(RandomInstance(11, 200, 5, kAsymmetric, 5));
@@ -35,8 +42,7 @@ TEST(GtspDeadlineTest, FiftyMillisecondDeadlineOnThousandVertices) {
     absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
     const double wall = SecondsSince(t0);
     ASSERT_TRUE(r.ok()) << r.status();
-    // Generous margin: CI is a loaded 2-core machine.
-    EXPECT_LT(wall, 0.050 + 0.100 * testing::kTimingSlowdown);
+    EXPECT_LT(wall, 0.050 + kMargin);
     EXPECT_TRUE(r->stopped_early);
     EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
     EXPECT_DOUBLE_EQ(r->cost, TourCost(inst, r->tour));
@@ -52,7 +58,7 @@ TEST(GtspDeadlineTest, DeadlineWithTwoThreads) {
   options.stop = StopToken::WithTimeout(absl::Milliseconds(80));
   absl::StatusOr<GtspResult> r = SolveGtsp(inst, options);
   ASSERT_TRUE(r.ok()) << r.status();
-  EXPECT_LT(SecondsSince(t0), 0.080 + 0.100 * testing::kTimingSlowdown);
+  EXPECT_LT(SecondsSince(t0), 0.080 + kMargin);
   EXPECT_TRUE(r->stopped_early);
   EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
 }
@@ -97,7 +103,7 @@ TEST(GtspDeadlineTest, CancellationFromAnotherThread) {
   const double wall = SecondsSince(t0);
   canceller.join();
   ASSERT_TRUE(r.ok()) << r.status();
-  EXPECT_LT(wall, 0.040 + 0.100 * testing::kTimingSlowdown);
+  EXPECT_LT(wall, 0.040 + kMargin);
   EXPECT_TRUE(r->stopped_early);
   EXPECT_TRUE(ValidateTour(inst, r->tour).ok());
 }
