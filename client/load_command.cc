@@ -31,12 +31,14 @@ constexpr char kUsage[] =
     "                    [--deadline-ms D] [--resolution M] [--tool-width M]\n"
     "                    [--time-limit S] [--tour gtsp|greedy] [--backoff-ms B]\n"
     "                    [--zipf S] [--seed N] [--inline] [--random-start]\n"
-    "                    [--full-replies]\n"
+    "                    [--full-replies] [--rate R]\n"
     "--maps: every *.yaml and *.geojson in DIR (sorted), or a comma list; each\n"
     "request picks one, map k (0-based, in that order) with weight 1/(k+1)^S\n"
     "(--zipf 0: uniform). --inline sends the map in every request instead of\n"
     "PutMap once and plan by id (any replica can then serve any map).\n"
     "--requests N stops after N requests (or --duration, whichever is first).\n"
+    "--rate R paces the requests at R per second in all (worker t of N sends its\n"
+    "k-th at (k N + t) / R s); a worker whose reply comes later sends at once.\n"
     "--random-start: each request starts at a free cell drawn uniformly (seeded by\n"
     "--seed) from the cells the robot can reach, heading uniform in [0, 2 pi).\n"
     "Replies are received in full but only their stats are decoded, so that the\n"
@@ -112,6 +114,7 @@ struct LoadFlags {
   std::optional<double> tool;
   std::optional<double> limit;
   std::optional<std::string> tour;
+  std::optional<double> rate;  // requests per second in all
   MapFileOverrides overrides;
   int threads = 4;
   double seconds = 10.0;
@@ -138,6 +141,9 @@ absl::StatusOr<LoadFlags> ParseLoadFlags(const ParsedArgs& a) {
   ASSIGN_OR_RETURN(std::optional<double> duration, a.GetDouble("duration"));
   ASSIGN_OR_RETURN(std::optional<int64_t> deadline_ms, a.GetInt("deadline-ms"));
   ASSIGN_OR_RETURN(f.backoff_ms, a.GetInt("backoff-ms"));
+  ASSIGN_OR_RETURN(f.rate, a.GetDouble("rate"));
+  if (f.rate && !(*f.rate > 0 && *f.rate <= 1e6))
+    return absl::InvalidArgumentError("--rate must be in (0, 1000000] requests per second");
   ASSIGN_OR_RETURN(f.tool, a.GetDouble("tool-width"));
   ASSIGN_OR_RETURN(f.limit, a.GetDouble("time-limit"));
   ASSIGN_OR_RETURN(f.overrides.resolution, a.GetDouble("resolution"));
@@ -273,8 +279,15 @@ class LoadRun {
   void Work(int t) {
     std::mt19937_64 rng(static_cast<uint64_t>(flags_.seed.value_or(1)) * 1000003u + t);
     std::discrete_distribution<size_t> pick(weights_.begin(), weights_.end());
-    while (absl::Now() < end_) {
+    const absl::Time start = absl::Now();
+    for (int64_t k = 0; absl::Now() < end_; ++k) {
       if (!TakeTicket()) break;
+      if (flags_.rate) {
+        const absl::Time due =
+            start + absl::Seconds(static_cast<double>(k * flags_.threads + t) / *flags_.rate);
+        if (due >= end_) break;
+        absl::SleepFor(due - absl::Now());
+      }
       const v1::PlanRequest request = RequestFor(pick(rng), rng);
       const absl::Time sent = absl::Now();
       const absl::StatusOr<v1::PlanStats> reply = Send(request);
@@ -303,7 +316,7 @@ absl::Status Run(const std::vector<std::string>& args) {
       ParseArgs(args,
                 WithConnectionFlags({"server", "map", "maps", "concurrency", "duration",
                                      "deadline-ms", "resolution", "tool-width", "time-limit",
-                                     "tour", "backoff-ms", "zipf", "seed", "requests"}),
+                                     "tour", "backoff-ms", "zipf", "seed", "requests", "rate"}),
                 {"inline", "random-start", "full-replies"}));
   ASSIGN_OR_RETURN(const LoadFlags flags, ParseLoadFlags(a));
   std::vector<std::string> files;

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "server/log.h"
 
 namespace covplan {
@@ -44,16 +46,59 @@ absl::Status WorkQueueFull() {
 }
 
 SolveAdmission::SolveAdmission(const ServiceOptions& options, ServerMetrics* metrics,
-                               WorkerPool* pool)
-    : options_(options), metrics_(metrics), pool_(pool) {}
+                               WorkerPool* pool, const TenantQuotas* quotas)
+    : options_(options), metrics_(metrics), pool_(pool), quotas_(quotas) {}
 
-absl::Status SolveAdmission::Admit() {
+absl::Status SolveAdmission::Admit(const CallInfo& call) {
+  int ahead = 0;
+  return AdmitCounted(call, &ahead);
+}
+
+absl::Status SolveAdmission::AdmitCounted(const CallInfo& call, int* ahead) {
+  const TenantQuota quota = quotas_->For(call.tenant_tag);
+  {
+    absl::MutexLock lock(&tenants_mu_);
+    int& mine = admitted_by_tenant_[call.tenant_tag];
+    if (quota.max_queued > 0 || quota.max_solves > 0) {
+      const int running = quota.max_solves > 0 ? quota.max_solves : options_.worker_threads;
+      const int queued = quota.max_queued > 0 ? quota.max_queued : options_.max_queue;
+      if (mine >= running + queued) {
+        if (mine == 0) admitted_by_tenant_.erase(call.tenant_tag);
+        return OverQuota(call, quota);
+      }
+    }
+    // Tenants take turns: ahead of this call are the tenant's own admitted
+    // calls and, of every other tenant, at most one more than those.
+    *ahead = mine;
+    for (const auto& [tag, count] : admitted_by_tenant_) {
+      if (tag != call.tenant_tag) *ahead += std::min(count, mine + 1);
+    }
+    ++mine;
+  }
   const int capacity = options_.worker_threads + options_.max_queue;
   int admitted = admitted_.load();
   while (admitted < capacity) {
     if (admitted_.compare_exchange_weak(admitted, admitted + 1)) return absl::OkStatus();
   }
+  ReleaseTenant(call.tenant_tag);
   return Full();
+}
+
+absl::Status SolveAdmission::OverQuota(const CallInfo& call, const TenantQuota& quota) const {
+  std::vector<std::string> limits;
+  if (quota.max_solves > 0) limits.push_back(absl::StrCat(quota.max_solves, " running"));
+  if (quota.max_queued > 0) limits.push_back(absl::StrCat(quota.max_queued, " queued"));
+  return absl::ResourceExhaustedError(absl::StrCat(
+      call.tenant.empty() ? std::string("this tenant") : absl::StrCat("tenant ", call.tenant),
+      " is over its quota of ", absl::StrJoin(limits, " and "),
+      " solves (--tenant_max_solves, --tenant_max_queued or its line in --tenant_quota_file); "
+      "retry later"));
+}
+
+void SolveAdmission::ReleaseTenant(const std::string& tenant_tag) {
+  absl::MutexLock lock(&tenants_mu_);
+  const auto it = admitted_by_tenant_.find(tenant_tag);
+  if (it != admitted_by_tenant_.end() && --it->second <= 0) admitted_by_tenant_.erase(it);
 }
 
 absl::Status SolveAdmission::Full() const {
@@ -63,19 +108,20 @@ absl::Status SolveAdmission::Full() const {
 }
 
 absl::Status SolveAdmission::AdmitPlan(const CallInfo& call, bool likely_hit) {
-  if (absl::Status s = Admit(); !s.ok()) return s;
+  int fair_ahead = 0;
+  if (absl::Status s = AdmitCounted(call, &fair_ahead); !s.ok()) return s;
   const int hits_ahead = likely_hit ? admitted_hits_.fetch_add(1) : admitted_hits_.load();
   // Deadline-aware admission: if the expected wait for a worker already
   // reaches the reply-by time, refusing now is more useful to the client
   // than a DEADLINE_EXCEEDED after waiting.
   if (call.deadline == absl::InfiniteFuture()) return absl::OkStatus();
-  const int ahead = admitted_.load() - 1;
+  const int ahead = std::min(fair_ahead, admitted_.load() - 1);
   const absl::Duration wait = ExpectedQueueWait(ahead, hits_ahead, options_.worker_threads,
                                                 absl::Microseconds(mean_solve_us_.load()),
                                                 absl::Microseconds(mean_hit_us_.load()));
   const absl::Time reply_by = call.deadline - options_.deadline_margin;
   if (ahead >= std::max(1, options_.worker_threads) && absl::Now() + wait >= reply_by) {
-    Release(likely_hit);
+    Release(call.tenant_tag, likely_hit);
     return absl::ResourceExhaustedError(absl::StrFormat(
         "server busy: expected queue wait of %d ms exceeds the call's deadline; retry later",
         absl::ToInt64Milliseconds(wait)));
@@ -83,24 +129,28 @@ absl::Status SolveAdmission::AdmitPlan(const CallInfo& call, bool likely_hit) {
   return absl::OkStatus();
 }
 
-void SolveAdmission::Release(bool likely_hit) {
+void SolveAdmission::Release(const std::string& tenant_tag, bool likely_hit) {
   if (likely_hit) admitted_hits_.fetch_sub(1);
   admitted_.fetch_sub(1);
+  ReleaseTenant(tenant_tag);
 }
 
 bool SolveAdmission::Submit(Task task) {
   const bool likely_hit = task.likely_hit;
-  const bool queued = pool_->TrySubmit([this, task = std::move(task)] {
+  const std::string tenant_tag = task.tenant_tag;
+  const int max_running = quotas_->For(tenant_tag).max_solves;
+  auto run = [this, task = std::move(task)] {
     metrics_->in_flight().Set(in_flight_.fetch_add(1) + 1);
     std::optional<uint64_t> tracked;
     if (task.cut_short.has_value()) tracked = Track(*task.cut_short);
     task.solve();
     if (tracked.has_value()) Untrack(*tracked);
     metrics_->in_flight().Set(in_flight_.fetch_sub(1) - 1);
-    Release(task.likely_hit);
+    Release(task.tenant_tag, task.likely_hit);
     if (task.reply) task.reply();
-  });
-  if (!queued) Release(likely_hit);
+  };
+  const bool queued = pool_->TrySubmit(std::move(run), tenant_tag, max_running);
+  if (!queued) Release(tenant_tag, likely_hit);
   return queued;
 }
 

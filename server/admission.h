@@ -1,13 +1,18 @@
 // Admission of solves (Plan, Replan, Resume, a Drive session's replans) to
-// the solve pool: at most worker_threads + max_queue admitted at once, a
+// the solve pool, decided when a call arrives: per tenant at most its
+// max_solves + max_queued admitted at once (server/tenant_quotas.h), in all
+// at most worker_threads + max_queue, a
 // Plan with a deadline refused at once when the expected queue wait already
 // reaches it (queue pricing), the running solves counted (in-flight gauge)
-// and tracked so the end of a drain can cut them short.
+// and tracked so the end of a drain can cut them short. The pool runs at
+// most max_solves of a tenant's solves at once, and tenants take turns for
+// free workers (server/worker_pool.h), so a busy tenant's queue is not in
+// front of another tenant's call.
 //
 //   if (absl::Status s = admission.AdmitPlan(call, likely_hit); !s.ok()) return Refuse(s);
 //   auto outcome = std::make_shared<Outcome>();
 //   if (!admission.Submit({[=] { outcome->status = Solve(); }, [=] { Reply(*outcome); },
-//                          cancel, likely_hit})) {
+//                          cancel, likely_hit, call.tenant_tag})) {
 //     Refuse(...);  // the pool is full; the slot was released
 //   }
 //
@@ -23,6 +28,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <string>
 
 #include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
@@ -32,6 +38,7 @@
 #include "server/call_info.h"
 #include "server/metrics.h"
 #include "server/service_options.h"
+#include "server/tenant_quotas.h"
 #include "server/worker_pool.h"
 
 namespace covplan {
@@ -54,18 +61,22 @@ absl::Status WorkQueueFull();
 
 class SolveAdmission {
  public:
-  // `pool` (outlives this) runs the solves.
-  SolveAdmission(const ServiceOptions& options, ServerMetrics* metrics, WorkerPool* pool);
+  // `pool` and `quotas` (outlive this) run the solves and bound each
+  // tenant's share.
+  SolveAdmission(const ServiceOptions& options, ServerMetrics* metrics, WorkerPool* pool,
+                 const TenantQuotas* quotas);
 
-  // Takes a slot: OK, or RESOURCE_EXHAUSTED when every worker and queue
-  // place is taken.
-  absl::Status Admit();
+  // Takes a slot of the call's tenant: OK, or RESOURCE_EXHAUSTED naming the
+  // quota when the tenant has max_solves + max_queued solves admitted, or
+  // when every worker and queue place is taken.
+  absl::Status Admit(const CallInfo& call);
   // Admit, for a Plan: `likely_hit` counts it among the calls expected to
   // be answered from memory until its Release; with a deadline, refused
   // (slot released) when the expected queue wait leaves no time to plan.
   absl::Status AdmitPlan(const CallInfo& call, bool likely_hit);
-  // Gives the slot back (`likely_hit` as it was admitted).
-  void Release(bool likely_hit = false);
+  // Gives a slot of the tenant with `tenant_tag` back (`likely_hit` as it
+  // was admitted).
+  void Release(const std::string& tenant_tag, bool likely_hit = false);
   // The RESOURCE_EXHAUSTED of a full server (every worker and queue place).
   absl::Status Full() const;
 
@@ -76,6 +87,7 @@ class SolveAdmission {
     // Cancelled when the drain's grace ends (none: not cut short).
     std::optional<StopToken> cut_short;
     bool likely_hit = false;  // as admitted
+    std::string tenant_tag;   // as admitted
   };
   // Queues an admitted task; false (slot released, nothing run) when the
   // pool is full.
@@ -96,12 +108,22 @@ class SolveAdmission {
   void TrimMemoryIfIdle(absl::Duration work);
 
  private:
+  // Admit; `ahead`: the admitted calls expected to start before this one
+  // (its tenant's own and, as tenants take turns, at most one more of each
+  // other tenant's).
+  absl::Status AdmitCounted(const CallInfo& call, int* ahead);
+  absl::Status OverQuota(const CallInfo& call, const TenantQuota& quota) const;
+  void ReleaseTenant(const std::string& tenant_tag);
   uint64_t Track(const StopToken& token);
   void Untrack(uint64_t id);
 
   const ServiceOptions& options_;
   ServerMetrics* const metrics_;
   WorkerPool* const pool_;
+  const TenantQuotas* const quotas_;
+  // Solves admitted per tenant tag (queued or running), for the quotas.
+  absl::Mutex tenants_mu_;
+  std::map<std::string, int> admitted_by_tenant_ ABSL_GUARDED_BY(tenants_mu_);
   std::atomic<int> admitted_{0};
   std::atomic<int> in_flight_{0};
   std::atomic<bool> drain_cut_{false};

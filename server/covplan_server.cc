@@ -117,9 +117,19 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
           {{"address", config.address}});
     }
   }
+  absl::StatusOr<std::unique_ptr<TenantQuotas>> quotas =
+      TenantQuotas::Load(config.service.tenant_quota, config.tenant_quota_file);
+  if (!quotas.ok()) return quotas.status();
+  server->quotas_ = std::move(*quotas);
+  if (!config.tenant_quota_file.empty() && config.token_file.empty()) {
+    LogLine("warn",
+            "--tenant_quota_file without --token_file: every caller is one tenant, "
+            "which gets the --tenant_max_* defaults; the file's lines never apply");
+  }
   server->metrics_ = std::make_unique<ServerMetrics>();
   server->service_ = std::make_unique<CoveragePlannerService>(
-      config.service, server->store_.get(), server->metrics_.get(), server->tokens_.get());
+      config.service, server->store_.get(), server->metrics_.get(), server->tokens_.get(),
+      server->quotas_.get());
 
   if (config.metrics_port >= 0) {
     const std::string bind = absl::StrCat(config.metrics_address, ":", config.metrics_port);
@@ -225,6 +235,18 @@ absl::Status CovplanServer::ReloadTokens() {
     return loaded.status();
   }
   LogLine("info", "token file reloaded", {{"tokens", absl::StrCat(*loaded)}});
+  return absl::OkStatus();
+}
+
+absl::Status CovplanServer::ReloadQuotas() {
+  if (!quotas_->has_file()) return absl::OkStatus();
+  absl::StatusOr<size_t> loaded = quotas_->Reload();
+  if (!loaded.ok()) {
+    LogLine("error", "tenant quota file not reloaded; the previous quotas stay in force",
+            {{"detail", std::string(loaded.status().message())}});
+    return loaded.status();
+  }
+  LogLine("info", "tenant quotas reloaded", {{"tenants", absl::StrCat(*loaded)}});
   return absl::OkStatus();
 }
 

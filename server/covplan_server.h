@@ -65,6 +65,9 @@ struct ServerConfig {
   // CoveragePlanner call needs a token of a tenant (health and reflection
   // stay open) and sees only that tenant's maps and plans. Empty: open.
   std::string token_file;
+  // Per-tenant quota overrides (server/tenant_quotas.h) over
+  // service.tenant_quota; reread on SIGHUP. Empty: the defaults for all.
+  std::string tenant_quota_file;
   // The JSON API (server/http_gateway.h): -1 off (the default), 0 picks a
   // free port.
   std::string http_address = "127.0.0.1";
@@ -100,6 +103,8 @@ class CovplanServer {
   // Rereads the token file (SIGHUP); on error the previous tokens stay and
   // the error is returned. OK and nothing done without a token file.
   absl::Status ReloadTokens();
+  // Rereads the tenant quota file (SIGHUP) the same way.
+  absl::Status ReloadQuotas();
 
  private:
   CovplanServer() = default;
@@ -110,6 +115,7 @@ class CovplanServer {
 
   std::unique_ptr<MapRepository> store_;
   std::unique_ptr<TenantTokens> tokens_;  // null without --token_file
+  std::unique_ptr<TenantQuotas> quotas_;
   std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;

@@ -1,5 +1,7 @@
 #include "server/drive_handler.h"
 
+#include "planner/common/status_macros.h"
+
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -83,11 +85,15 @@ absl::Status DriveHandler::Replan(const std::string& request_id, const std::stri
   return status;
 }
 
-bool DriveHandler::SubmitSolve(std::function<void()> work) {
-  if (gate_->draining() || !admission_->Admit().ok()) return false;
+absl::Status DriveHandler::SubmitSolve(const std::string& tenant_tag, std::function<void()> work) {
+  if (gate_->draining()) return absl::UnavailableError("server draining: no new replans");
+  CallInfo call;
+  call.tenant_tag = tenant_tag;
+  RETURN_IF_ERROR(admission_->Admit(call));
   SolveAdmission::Task task;
   task.solve = std::move(work);
-  return admission_->Submit(std::move(task));
+  task.tenant_tag = tenant_tag;
+  return admission_->Submit(std::move(task)) ? absl::OkStatus() : admission_->Full();
 }
 
 void DriveHandler::RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) {

@@ -54,7 +54,7 @@ class DriveHandler final : public DriveHost {
   absl::Status Replan(const std::string& request_id, const std::string& tenant_tag,
                       const v1::ReplanRequest& request, const StopToken& stop,
                       v1::ReplanResponse* response) override;
-  bool SubmitSolve(std::function<void()> work) override;
+  absl::Status SubmitSolve(const std::string& tenant_tag, std::function<void()> work) override;
   void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) override;
   std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id) override;
   void ShareObstacles(const std::vector<std::string>& plan_ids,

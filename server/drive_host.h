@@ -48,8 +48,10 @@ class DriveHost {
                               const v1::ReplanRequest& request, const StopToken& stop,
                               v1::ReplanResponse* response) = 0;
   // Runs `work` on the solve pool under the same admission bound as unary
-  // solves; false (and `work` dropped) when the server is full or draining.
-  virtual bool SubmitSolve(std::function<void()> work) = 0;
+  // solves, as a solve of the tenant with `tenant_tag` (its quota); non-OK
+  // (and `work` dropped): RESOURCE_EXHAUSTED when the server or the
+  // tenant's quota is full (saying which), UNAVAILABLE when it drains.
+  virtual absl::Status SubmitSolve(const std::string& tenant_tag, std::function<void()> work) = 0;
   // The robot's latest progress on a plan, kept for Resume.
   virtual void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) = 0;
   // The latest progress recorded for a plan (Drive, Replan), if any.

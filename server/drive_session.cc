@@ -421,17 +421,18 @@ void DriveSession::StartJob(Actions* a) {
   v1::DriveRequest first = first_;
   v1::Obstacles seen = seen_;
   Ref();  // held by the worker
-  const bool queued =
-      host_->SubmitSolve([this, job, first = std::move(first), seen = std::move(seen), stop] {
+  const absl::Status queued = host_->SubmitSolve(
+      tenant_tag_, [this, job, first = std::move(first), seen = std::move(seen), stop] {
         RunJob(job, first, seen, stop);
         Unref();
       });
-  if (!queued) {
+  if (!queued.ok()) {
     running_ = false;
     Unref();  // not the last: gRPC holds one until OnDone
-    const absl::Status busy = absl::ResourceExhaustedError(
-        "server busy: no worker free for this session's replan; the obstacles are kept for the "
-        "next one");
+    const absl::Status busy(queued.code(),
+                            absl::StrCat(queued.message(),
+                                         "; no worker for this session's replan, the obstacles are "
+                                         "kept for the next one"));
     if (job.start) {
       EndLocked(ToGrpcUnbounded(busy));
     } else {

@@ -22,13 +22,14 @@ constexpr int kMaxPageSize = 1000;
 
 MapHandlers::MapHandlers(const ServiceOptions& options, MapRepository* store, ArtifactLru* cache,
                          ServerMetrics* metrics, CallGate* gate, SolveAdmission* admission,
-                         WorkerPool* io_pool, WorkerPool* read_pool)
+                         const TenantQuotas* quotas, WorkerPool* io_pool, WorkerPool* read_pool)
     : options_(options),
       store_(store),
       cache_(cache),
       metrics_(metrics),
       gate_(gate),
       admission_(admission),
+      quotas_(quotas),
       io_pool_(io_pool),
       read_pool_(read_pool) {}
 
@@ -45,15 +46,34 @@ void MapHandlers::Serve(WorkerPool* pool, CancellableReactor* reactor, const Cal
   }
 }
 
-absl::Status MapHandlers::RunPutMap(const v1::PutMapRequest& request, const std::string& tenant_tag,
+absl::StatusOr<bool> MapHandlers::PutWithinQuota(const CallInfo& call, const v1::MapInfo& info,
+                                                 const v1::Map& map) {
+  const int64_t max_maps = quotas_->For(call.tenant_tag).max_maps;
+  if (max_maps == 0) return store_->Put(info, map);
+  absl::MutexLock lock(&maps_quota_mu_);
+  int64_t stored = 0;
+  for (const v1::MapInfo& other : store_->List(nullptr)) {
+    if (other.map_id() == info.map_id()) return store_->Put(info, map);  // not a new map
+    stored += OwnsMap(call.tenant_tag, other.map_id()) ? 1 : 0;
+  }
+  if (stored >= max_maps) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        call.tenant.empty() ? std::string("the caller") : absl::StrCat("tenant ", call.tenant),
+        " stores ", stored, " maps, its quota of ", max_maps,
+        " (--tenant_max_maps or its line in --tenant_quota_file); delete one first"));
+  }
+  return store_->Put(info, map);
+}
+
+absl::Status MapHandlers::RunPutMap(const v1::PutMapRequest& request, const CallInfo& call,
                                     v1::PutMapResponse* response) {
   ASSIGN_OR_RETURN(SiteMap site, SiteFromProto(request.map(), options_.limits));
   RETURN_IF_ERROR(CheckSiteGeometry(site));
   // Per tenant: the same content stored by two tenants is two maps.
-  const std::string map_id = ScopedMapId(ComputeMapId(request.map()), tenant_tag);
+  const std::string map_id = ScopedMapId(ComputeMapId(request.map()), call.tenant_tag);
   v1::MapInfo info = MapInfoFor(site, map_id);
   info.set_name(request.name());
-  ASSIGN_OR_RETURN(bool created, store_->Put(info, request.map()));
+  ASSIGN_OR_RETURN(bool created, PutWithinQuota(call, info, request.map()));
   // A rewritten (repaired) map must not be planned from artifacts of the
   // damaged copy; the content is the same, but be safe and cheap: drop them.
   if (created) cache_->EraseWithPrefix(map_id + "/");
@@ -79,7 +99,7 @@ grpc::ServerUnaryReactor* MapHandlers::PutMap(grpc::CallbackServerContext* conte
   Serve(
       io_pool_, reactor, call,
       [this, call, request, response](std::string* detail) {
-        absl::Status status = RunPutMap(*request, call.tenant_tag, response);
+        absl::Status status = RunPutMap(*request, call, response);
         *detail = response->map_id();
         return status;
       },

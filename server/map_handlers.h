@@ -2,9 +2,11 @@
 // map; its decoding runs on the I/O pool), GetMap and DeleteMap (on the read
 // pool, never behind decoding), ListMaps (paged, from the store's in-memory
 // index, on the gRPC thread). Each call passes the CallGate once; another
-// tenant's map answers as a missing one.
+// tenant's map answers as a missing one. A tenant with a max_maps quota
+// stores no more new maps than that (on this replica's view of the store).
 //
-//   MapHandlers maps(options, store, &cache, metrics, &gate, &admission, &io_pool, &read_pool);
+//   MapHandlers maps(options, store, &cache, metrics, &gate, &admission, &quotas, &io_pool,
+//                    &read_pool);
 //   return maps.GetMap(context, request, response);  // from the service's override
 //
 // Thread-safety: handlers are called concurrently by gRPC; they share only
@@ -17,6 +19,8 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "server/admission.h"
 #include "server/artifact_lru.h"
@@ -24,6 +28,7 @@
 #include "server/map_repository.h"
 #include "server/metrics.h"
 #include "server/service_options.h"
+#include "server/tenant_quotas.h"
 #include "server/worker_pool.h"
 
 namespace covplan {
@@ -33,7 +38,7 @@ class MapHandlers {
   // Every pointer outlives this.
   MapHandlers(const ServiceOptions& options, MapRepository* store, ArtifactLru* cache,
               ServerMetrics* metrics, CallGate* gate, SolveAdmission* admission,
-              WorkerPool* io_pool, WorkerPool* read_pool);
+              const TenantQuotas* quotas, WorkerPool* io_pool, WorkerPool* read_pool);
 
   grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
                                    const v1::PutMapRequest* request, v1::PutMapResponse* response);
@@ -52,8 +57,12 @@ class MapHandlers {
   // unstarted. `trim`: memory is trimmed after a long call.
   void Serve(WorkerPool* pool, CancellableReactor* reactor, const CallInfo& call,
              std::function<absl::Status(std::string* detail)> work, bool trim);
-  absl::Status RunPutMap(const v1::PutMapRequest& request, const std::string& tenant_tag,
+  absl::Status RunPutMap(const v1::PutMapRequest& request, const CallInfo& call,
                          v1::PutMapResponse* response);
+  // store_->Put, refused with RESOURCE_EXHAUSTED when `map_id` is a new map
+  // of a tenant that already stores its max_maps.
+  absl::StatusOr<bool> PutWithinQuota(const CallInfo& call, const v1::MapInfo& info,
+                                      const v1::Map& map);
   absl::Status RunGetMap(const CallInfo& call, const v1::GetMapRequest& request,
                          v1::GetMapResponse* response);
   absl::Status RunListMaps(const CallInfo& call, const v1::ListMapsRequest& request,
@@ -70,6 +79,10 @@ class MapHandlers {
   ServerMetrics* const metrics_;
   CallGate* const gate_;
   SolveAdmission* const admission_;
+  const TenantQuotas* const quotas_;
+  // Held from counting a tenant's maps to storing its new one, for tenants
+  // with a max_maps quota.
+  absl::Mutex maps_quota_mu_;
   WorkerPool* const io_pool_;
   WorkerPool* const read_pool_;
 };

@@ -116,7 +116,7 @@ grpc::ServerUnaryReactor* MissionHandlers::GetMission(grpc::CallbackServerContex
                                                       v1::GetMissionResponse* response) {
   return ServeSolve(
       gate_, admission_, context, "GetMission", *request,
-      [this](const CallInfo&) { return admission_->Admit(); },
+      [this](const CallInfo& call) { return admission_->Admit(call); },
       [this, request, response](const CallInfo& call, const StopToken& cancel,
                                 std::string* detail) {
         absl::Status status = RunGetMission(call, *request, cancel, response);

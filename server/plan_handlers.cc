@@ -229,6 +229,7 @@ grpc::ServerUnaryReactor* PlanHandlers::Plan(grpc::CallbackServerContext* contex
   };
   task.cut_short = reactor->cancel();
   task.likely_hit = likely_hit;
+  task.tenant_tag = call.tenant_tag;
   const bool queued = admission_->Submit(std::move(task));
   admission_->UpdateQueueGauge();
   if (!queued) gate_->Finish(reactor, call, admission_->Full());

@@ -15,7 +15,7 @@ grpc::ServerUnaryReactor* ReplanHandlers::ServeReplanSolve(grpc::CallbackServerC
                                                            SolveWork work) {
   return ServeSolve(
       gate_, admission_, context, method, request,
-      [this](const CallInfo&) { return admission_->Admit(); }, std::move(work));
+      [this](const CallInfo& call) { return admission_->Admit(call); }, std::move(work));
 }
 
 grpc::ServerUnaryReactor* ReplanHandlers::Replan(grpc::CallbackServerContext* context,

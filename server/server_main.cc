@@ -3,7 +3,8 @@
 //   covplan-server --address=127.0.0.1 --port=50051 --metrics_port=9464
 //                  --store_dir=./covplan-data/maps --threads=2
 //
-// SIGHUP: rereads --token_file (a bad file keeps the previous tokens).
+// SIGHUP: rereads --token_file and --tenant_quota_file (a bad file keeps the
+// previous table).
 // SIGTERM / SIGINT: health goes NOT_SERVING, new work is refused, in-flight
 // calls get --drain_grace_s to finish (then running plans answer with their
 // best so far), and the process exits 0 within the grace plus 1.5 s. A signal
@@ -84,6 +85,16 @@ ABSL_FLAG(std::string, token_file, "",
           "File of \"<sha256 hex of a bearer token> <tenant>\" lines; every call then needs "
           "\"authorization: Bearer <token>\" and sees only its tenant's maps and plans (health and "
           "reflection stay open). Reread on SIGHUP. Empty = no tokens");
+ABSL_FLAG(int, tenant_max_solves, 0,
+          "Solves one tenant may run at once (0 = no limit); its others wait while other "
+          "tenants' run");
+ABSL_FLAG(int, tenant_max_queued, 0,
+          "Solves one tenant may have waiting beyond those (0 = no limit but --max_queue); "
+          "beyond: RESOURCE_EXHAUSTED naming the quota");
+ABSL_FLAG(int64_t, tenant_max_maps, 0, "Maps one tenant may store (0 = no limit)");
+ABSL_FLAG(std::string, tenant_quota_file, "",
+          "Per-tenant overrides, lines of \"<tenant> max_solves=N max_queued=N max_maps=N\" "
+          "(any of them). Reread on SIGHUP. Empty = the --tenant_max_* flags for all");
 ABSL_FLAG(int, max_sessions, 64, "Drive sessions open at once; beyond: RESOURCE_EXHAUSTED");
 ABSL_FLAG(double, session_idle_s, 120.0,
           "A Drive session without a message for this long ends with DEADLINE_EXCEEDED");
@@ -147,6 +158,10 @@ std::vector<std::string> ValidateFlags() {
   CheckRange("drain_grace_s", absl::GetFlag(FLAGS_drain_grace_s), 0.0, 3600.0, &errors);
   CheckRange("drain_notice_s", absl::GetFlag(FLAGS_drain_notice_s), 0.0, 3600.0, &errors);
   CheckRange("max_sessions", absl::GetFlag(FLAGS_max_sessions), 1, 100000, &errors);
+  CheckRange("tenant_max_solves", absl::GetFlag(FLAGS_tenant_max_solves), 0, 100000, &errors);
+  CheckRange("tenant_max_queued", absl::GetFlag(FLAGS_tenant_max_queued), 0, 100000, &errors);
+  CheckRange<int64_t>("tenant_max_maps", absl::GetFlag(FLAGS_tenant_max_maps), 0, int64_t{1} << 40,
+                      &errors);
   CheckRange("session_idle_s", absl::GetFlag(FLAGS_session_idle_s), 0.1, 24 * 3600.0, &errors);
   CheckRange("max_live_streams", absl::GetFlag(FLAGS_max_live_streams), 1, 32, &errors);
   {
@@ -180,6 +195,7 @@ covplan::ServerConfig ConfigFromFlags() {
   config.tls_key_file = absl::GetFlag(FLAGS_tls_key);
   config.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
   config.token_file = absl::GetFlag(FLAGS_token_file);
+  config.tenant_quota_file = absl::GetFlag(FLAGS_tenant_quota_file);
   // The port opens at once; health says NOT_SERVING until the store is indexed.
   config.index_in_background = true;
   covplan::ServiceOptions& service = config.service;
@@ -198,6 +214,9 @@ covplan::ServerConfig ConfigFromFlags() {
   service.limits.max_transition_bytes = absl::GetFlag(FLAGS_max_transition_mb) << 20;
   service.limits.dense_transition_bytes = absl::GetFlag(FLAGS_dense_transition_mb) << 20;
   service.max_request_time = absl::Seconds(absl::GetFlag(FLAGS_max_request_s));
+  service.tenant_quota.max_solves = absl::GetFlag(FLAGS_tenant_max_solves);
+  service.tenant_quota.max_queued = absl::GetFlag(FLAGS_tenant_max_queued);
+  service.tenant_quota.max_maps = absl::GetFlag(FLAGS_tenant_max_maps);
   service.max_sessions = absl::GetFlag(FLAGS_max_sessions);
   service.session_idle = absl::Seconds(absl::GetFlag(FLAGS_session_idle_s));
   service.max_live_streams = absl::GetFlag(FLAGS_max_live_streams);
@@ -241,6 +260,7 @@ int main(int argc, char** argv) {
         covplan::LogLine("info", "SIGHUP ignored: server not running");
       } else {
         (void)running->ReloadTokens();  // logs its outcome
+        (void)running->ReloadQuotas();
       }
     }
     absl::MutexLock lock(&signal_mu);

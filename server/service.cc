@@ -5,20 +5,25 @@
 namespace covplan {
 
 CoveragePlannerService::CoveragePlannerService(const ServiceOptions& options, MapRepository* store,
-                                               ServerMetrics* metrics, const TenantTokens* tokens)
+                                               ServerMetrics* metrics, const TenantTokens* tokens,
+                                               const TenantQuotas* quotas)
     : options_(options),
       cache_(options.cache_budget_bytes, metrics),
       registry_(BuiltinPlanners()),
       engine_(&registry_, &cache_, options.limits),
+      own_quotas_(quotas == nullptr ? *TenantQuotas::Load(options.tenant_quota, /*path=*/"")
+                                    : nullptr),
+      quotas_(quotas == nullptr ? own_quotas_.get() : quotas),
       gate_(metrics, tokens),
-      admission_(options_, metrics, &pool_),
+      admission_(options_, metrics, &pool_, quotas_),
       archive_(options_, store, metrics, &engine_, &io_pool_),
       progress_(store, &io_pool_, 4 * options.max_retained_plans + 64),
       live_(options.max_live_streams, /*queue_limit=*/1024),
       missions_(4 * options.max_retained_plans + 16, store),
       replan_work_(options_, store, metrics, &engine_, &archive_, &progress_, &admission_,
                    &missions_),
-      maps_(options_, store, &cache_, metrics, &gate_, &admission_, &io_pool_, &read_pool_),
+      maps_(options_, store, &cache_, metrics, &gate_, &admission_, quotas_, &io_pool_,
+            &read_pool_),
       plans_(options_, store, metrics, &engine_, &gate_, &admission_, &served_, &archive_,
              &warm_pool_, background_stop_),
       fleets_(options_, store, metrics, &engine_, &gate_, &admission_, &archive_, &missions_),

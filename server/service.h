@@ -64,6 +64,7 @@
 #include "server/replan_work.h"
 #include "server/served_replies.h"
 #include "server/service_options.h"
+#include "server/tenant_quotas.h"
 #include "server/tenant_tokens.h"
 #include "server/worker_pool.h"
 
@@ -74,8 +75,11 @@ class CoveragePlannerService final
  public:
   // `tokens` (optional, outlives the service): every call must carry a
   // bearer token of a tenant, and sees only that tenant's maps and plans.
+  // `quotas` (optional, outlives the service): each tenant's quotas; without
+  // it every tenant has options.tenant_quota.
   CoveragePlannerService(const ServiceOptions& options, MapRepository* store,
-                         ServerMetrics* metrics, const TenantTokens* tokens = nullptr);
+                         ServerMetrics* metrics, const TenantTokens* tokens = nullptr,
+                         const TenantQuotas* quotas = nullptr);
   ~CoveragePlannerService() override;
 
   grpc::ServerUnaryReactor* PutMap(grpc::CallbackServerContext* context,
@@ -166,7 +170,9 @@ class CoveragePlannerService final
   ArtifactLru cache_;
   const PlannerRegistry registry_;
   const PlanningEngine engine_;
-  StopToken background_stop_;  // cancelled when draining or shutting down
+  StopToken background_stop_;                 // cancelled when draining or shutting down
+  std::unique_ptr<TenantQuotas> own_quotas_;  // without a caller's quotas
+  const TenantQuotas* const quotas_;
   CallGate gate_;
   SolveAdmission admission_;
   ServedReplies served_;

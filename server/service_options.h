@@ -19,6 +19,7 @@
 #include "absl/time/time.h"
 #include "planner/engine/limits.h"
 #include "planner/engine/planner.h"
+#include "server/tenant_quotas.h"
 
 namespace covplan {
 
@@ -54,6 +55,9 @@ struct ServiceOptions {
   // estimator) is kept under its own name, so no replica overwrites
   // another's.
   std::string replica;
+  // Every tenant's quotas unless the quota file (server/tenant_quotas.h)
+  // overrides them; without a token file all callers are one tenant.
+  TenantQuota tenant_quota;
 
   absl::Status Validate() const;
 };

@@ -35,6 +35,7 @@ grpc::ServerUnaryReactor* ServeSolve(CallGate* gate, SolveAdmission* admission,
     admission->TrimMemoryIfIdle(absl::Now() - call.start);
   };
   task.cut_short = reactor->cancel();
+  task.tenant_tag = call.tenant_tag;
   const bool queued = admission->Submit(std::move(task));
   admission->UpdateQueueGauge();
   if (!queued) gate->Finish(reactor, call, admission->Full());

@@ -5,7 +5,7 @@
 // the slot is released, logging the detail `work` set when it succeeded.
 //
 //   return ServeSolve(gate_, admission_, context, "Replan", *request,
-//                     [this](const CallInfo&) { return admission_->Admit(); },
+//                     [this](const CallInfo& call) { return admission_->Admit(call); },
 //                     [this, request, response](const CallInfo& call, const StopToken& cancel,
 //                                               std::string* detail) { ... });
 //

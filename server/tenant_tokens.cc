@@ -1,13 +1,12 @@
 #include "server/tenant_tokens.h"
 
-#include <fstream>
-#include <sstream>
-
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "api/digest.h"
+#include "planner/common/status_macros.h"
+#include "server/config_lines.h"
 
 namespace covplan {
 namespace {
@@ -23,6 +22,8 @@ bool IsLowerHex(absl::string_view s) {
   return true;
 }
 
+}  // namespace
+
 bool IsTenantName(absl::string_view s) {
   if (s.empty() || s.size() > kMaxTenantName) return false;
   for (char c : s) {
@@ -32,32 +33,19 @@ bool IsTenantName(absl::string_view s) {
   return true;
 }
 
-}  // namespace
-
 absl::StatusOr<std::map<std::string, std::string>> TenantTokens::Parse(absl::string_view text) {
   std::map<std::string, std::string> table;
-  int line_number = 0;
-  for (absl::string_view line : absl::StrSplit(text, '\n')) {
-    ++line_number;
-    line = absl::StripAsciiWhitespace(line);
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<absl::string_view> fields =
-        absl::StrSplit(line, absl::ByAnyChar(" \t"), absl::SkipEmpty());
+  RETURN_IF_ERROR(ForEachConfigLine(text, [&](const std::vector<absl::string_view>& fields) {
     if (fields.size() != 2 || fields[0].size() != 64 || !IsLowerHex(fields[0])) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "line ", line_number, ": expected \"<sha256 of the token, 64 lowercase hex> <tenant>\""));
-    }
-    if (!IsTenantName(fields[1])) {
       return absl::InvalidArgumentError(
-          absl::StrCat("line ", line_number, ": tenant must be 1-64 characters of [A-Za-z0-9._-]"));
+          "expected \"<sha256 of the token, 64 lowercase hex> <tenant>\"");
     }
-    const std::string hash(fields[0]);
-    if (table.count(hash) != 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("line ", line_number, ": the same token hash twice"));
-    }
-    table.emplace(hash, std::string(fields[1]));
-  }
+    if (!IsTenantName(fields[1]))
+      return absl::InvalidArgumentError("tenant must be 1-64 characters of [A-Za-z0-9._-]");
+    if (!table.emplace(std::string(fields[0]), std::string(fields[1])).second)
+      return absl::InvalidArgumentError("the same token hash twice");
+    return absl::OkStatus();
+  }));
   return table;
 }
 
@@ -69,12 +57,8 @@ absl::StatusOr<std::unique_ptr<TenantTokens>> TenantTokens::Load(const std::stri
 }
 
 absl::StatusOr<size_t> TenantTokens::Reload() {
-  std::ifstream in(path_, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in)
-    return absl::InvalidArgumentError(absl::StrCat("--token_file ", path_, ": cannot read it"));
-  absl::StatusOr<std::map<std::string, std::string>> table = Parse(text.str());
+  ASSIGN_OR_RETURN(const std::string text, ReadConfigFile("--token_file", path_));
+  absl::StatusOr<std::map<std::string, std::string>> table = Parse(text);
   if (!table.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("--token_file ", path_, ": ", table.status().message()));

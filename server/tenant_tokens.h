@@ -59,6 +59,8 @@ class TenantTokens {
   std::map<std::string, std::string> tenant_by_hash_ ABSL_GUARDED_BY(mu_);
 };
 
+// Whether `s` is a valid tenant name: 1-64 characters of [A-Za-z0-9._-].
+bool IsTenantName(absl::string_view s);
 // The tag of a tenant ("" for none: no token file).
 std::string TenantTag(absl::string_view tenant);
 // The id a tenant's map of content id `content_id` is stored under.

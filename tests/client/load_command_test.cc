@@ -112,6 +112,22 @@ TEST_F(LoadCommandTest, RandomStartsWarmStartFromTheRememberedTour) {
               ::testing::ContainsRegex("\"mean_estimated_duration_s\": [1-9][0-9]*\\.[0-9]+"));
 }
 
+// --rate paces the requests: 5 at 10 per second take at least 0.4 s (the
+// fifth is due then), even though each is answered in milliseconds.
+TEST_F(LoadCommandTest, RatePacesTheRequests) {
+  int code = -1;
+  const std::string json = Run({"--map", absl::StrCat(COVPLAN_SOURCE_DIR, "/maps/small_rooms.yaml"),
+                                "--rate", "10", "--requests", "5", "--concurrency", "2"},
+                               &code);
+  EXPECT_EQ(code, 0);
+  EXPECT_THAT(json, HasSubstr("\"requests\": 5, \"ok\": 5,"));
+  const size_t at = json.find("\"duration_s\": ");
+  ASSERT_NE(at, std::string::npos) << json;
+  EXPECT_GE(std::stod(json.substr(at + 14)), 0.4) << json;
+  Run({"--map", "a.yaml", "--rate", "0"}, &code);
+  EXPECT_NE(code, 0);
+}
+
 TEST_F(LoadCommandTest, MapAndMapsAreExclusive) {
   int code = -1;
   Run({"--map", "a.yaml", "--maps", "b.yaml"}, &code);

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
@@ -21,6 +22,7 @@
 #include "client/health_command.h"
 #include "client/plan_command.h"
 #include "covplan/v1/covplan.grpc.pb.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/server/grpc_probe.h"
 #include "tests/server/server_process.h"
@@ -32,11 +34,13 @@ namespace {
 using ::covplan::testing::AsciiToPgm;
 using ::covplan::testing::HealthStatus;
 using ::covplan::testing::HttpGet;
+using ::covplan::testing::PillarField;
 using ::covplan::testing::PlanRequestFor;
 using ::covplan::testing::RasterMap;
 using ::covplan::testing::ReflectionServices;
 using ::covplan::testing::ServerProcess;
 using ::covplan::testing::TwoRooms;
+using ::testing::HasSubstr;
 
 constexpr char kAlpha[] = "alpha-secret-token";
 constexpr char kBeta[] = "beta-secret-token";
@@ -356,6 +360,109 @@ TEST_F(ServerAuthTest, ABadTokenFileStopsStartup) {
   EXPECT_FALSE(
       missing.Start(dir_ + "/maps", {"--metrics_port=-1", "--token_file=" + dir_ + "/none"}).ok());
   EXPECT_NE(missing.log().find("cannot read"), std::string::npos) << missing.log();
+}
+
+// Issue 30, item 4: a tenant stores no more new maps than its max_maps (a
+// map it already has may be put again); others are not affected; SIGHUP
+// rereads the quota file.
+TEST_F(ServerAuthTest, ATenantStoresNoMoreMapsThanItsQuota) {
+  const std::string quotas = dir_ + "/quotas.txt";
+  WriteFile(quotas, "alpha max_maps=1\n");
+  StartServer({"--tenant_quota_file=" + quotas});
+  const auto put = [&](const std::string& token, double resolution, v1::PutMapResponse* out) {
+    v1::PutMapRequest request;
+    *request.mutable_map() = RasterMap(AsciiToPgm(TwoRooms(), 4), resolution);
+    return stub_->PutMap(Ctx(token).get(), request, out);
+  };
+  v1::PutMapResponse first;
+  v1::PutMapResponse again;
+  v1::PutMapResponse refused;
+  ASSERT_TRUE(put(kAlpha, 0.05, &first).ok());
+  ASSERT_TRUE(put(kAlpha, 0.05, &again).ok());
+  EXPECT_FALSE(again.created());
+  const grpc::Status over = put(kAlpha, 0.06, &refused);
+  EXPECT_EQ(over.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(over.error_message(), HasSubstr("tenant alpha stores 1 maps, its quota of 1"));
+  EXPECT_THAT(over.error_message(), HasSubstr("--tenant_max_maps"));
+  for (double resolution : {0.06, 0.07}) {
+    v1::PutMapResponse beta;
+    EXPECT_TRUE(put(kBeta, resolution, &beta).ok());
+  }
+  std::vector<std::string> ids;
+  ASSERT_TRUE(ListMaps(kAlpha, &ids).ok());
+  EXPECT_EQ(ids, std::vector<std::string>{first.map_id()});
+  // Deleting one makes room.
+  v1::DeleteMapRequest del;
+  del.set_map_id(first.map_id());
+  v1::DeleteMapResponse deleted;
+  ASSERT_TRUE(stub_->DeleteMap(Ctx(kAlpha).get(), del, &deleted).ok());
+  v1::PutMapResponse second;
+  ASSERT_TRUE(put(kAlpha, 0.06, &second).ok());
+  // A raised quota after SIGHUP.
+  WriteFile(quotas, "alpha max_maps=2\n");
+  ASSERT_EQ(::kill(server_->pid(), SIGHUP), 0);
+  const absl::Time until = absl::Now() + absl::Seconds(10);
+  while (server_->log().find("tenant quotas reloaded") == std::string::npos &&
+         absl::Now() < until) {
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  v1::PutMapResponse third;
+  EXPECT_TRUE(put(kAlpha, 0.07, &third).ok()) << server_->log();
+}
+
+// Issue 30, item 4: solves are admitted per tenant when the call arrives. A
+// tenant flooding the server past max_solves + max_queued is refused at once
+// naming its quota, and another tenant's Plan is still answered.
+TEST_F(ServerAuthTest, ATenantOverItsSolveQuotaIsRefusedAndAnotherIsServed) {
+  const std::string quotas = dir_ + "/quotas.txt";
+  WriteFile(quotas, "alpha max_solves=1 max_queued=1\n");
+  // Dense transitions keep each solve busy for its whole time limit.
+  StartServer({"--tenant_quota_file=" + quotas, "--threads=2", "--dense_transition_mb=1024"});
+  v1::PutMapRequest busy;
+  *busy.mutable_map() = RasterMap(AsciiToPgm(PillarField(120, 90, 200, 3), 4), 0.05);
+  v1::PutMapResponse alpha_map;
+  ASSERT_TRUE(stub_->PutMap(Ctx(kAlpha).get(), busy, &alpha_map).ok());
+  v1::PutMapResponse beta_map;
+  ASSERT_TRUE(PutMap(kBeta, &beta_map).ok());
+  constexpr int kAlphaCalls = 6;
+  std::vector<grpc::Status> alpha(kAlphaCalls);
+  std::vector<absl::Time> alpha_done(kAlphaCalls);
+  std::vector<std::thread> callers;
+  for (int i = 0; i < kAlphaCalls; ++i) {
+    callers.emplace_back([&, i] {
+      v1::PlanRequest request = PlanRequestFor(alpha_map.map_id(), 0.3);
+      request.set_time_limit_s(2.0);
+      request.mutable_robot()->mutable_start()->set_theta(0.1 * i);  // not a repeat
+      v1::PlanResponse response;
+      alpha[i] = stub_->Plan(Ctx(kAlpha).get(), request, &response);
+      alpha_done[i] = absl::Now();
+    });
+  }
+  absl::SleepFor(absl::Milliseconds(300));
+  v1::PlanResponse beta;
+  const grpc::Status beta_status = Plan(kBeta, beta_map.map_id(), &beta);
+  const absl::Time beta_done = absl::Now();
+  for (std::thread& t : callers) t.join();
+  EXPECT_TRUE(beta_status.ok()) << beta_status.error_message() << server_->log();
+  // Beta ran on the worker alpha's quota leaves free: answered before any of
+  // alpha's 2 s solves (in one FIFO queue it waited behind them).
+  for (int i = 0; i < kAlphaCalls; ++i) {
+    if (alpha[i].ok()) {
+      EXPECT_LT(beta_done, alpha_done[i]) << i;
+    }
+  }
+  int ok = 0;
+  int refused = 0;
+  for (const grpc::Status& s : alpha) {
+    ok += s.ok();
+    if (s.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED) {
+      ++refused;
+      EXPECT_THAT(s.error_message(),
+                  HasSubstr("tenant alpha is over its quota of 1 running and 1 queued solves"));
+    }
+  }
+  EXPECT_EQ(ok, 2) << server_->log();
+  EXPECT_EQ(refused, kAlphaCalls - 2);
 }
 
 TEST_F(ServerAuthTest, CliReachesATlsServerWithATokenAndACa) {
