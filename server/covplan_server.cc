@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -23,6 +24,17 @@
 
 namespace covplan {
 namespace {
+
+// A file's modification time and size, "" when it cannot be read.
+std::string FileStamp(const std::string& path) {
+  if (path.empty()) return "";
+  std::error_code ec;
+  const auto time = std::filesystem::last_write_time(path, ec);
+  if (ec) return "";
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) return "";
+  return absl::StrCat(time.time_since_epoch().count(), "/", size);
+}
 
 // After the grace: how long cut-short solves get to reply, then how long
 // gRPC gets to send what is written before it cancels the rest.
@@ -121,6 +133,10 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
       TenantQuotas::Load(config.service.tenant_quota, config.tenant_quota_file);
   if (!quotas.ok()) return quotas.status();
   server->quotas_ = std::move(*quotas);
+  server->token_file_ = config.token_file;
+  server->quota_file_ = config.tenant_quota_file;
+  server->token_stamp_ = FileStamp(config.token_file);
+  server->quota_stamp_ = FileStamp(config.tenant_quota_file);
   if (!config.tenant_quota_file.empty() && config.token_file.empty()) {
     LogLine("warn",
             "--tenant_quota_file without --token_file: every caller is one tenant, "
@@ -238,6 +254,23 @@ absl::Status CovplanServer::ReloadTokens() {
   return absl::OkStatus();
 }
 
+void CovplanServer::ReloadChangedFiles() {
+  if (!token_file_.empty() && tokens_ != nullptr) {
+    if (std::string stamp = FileStamp(token_file_); stamp != token_stamp_) {
+      token_stamp_ = stamp;
+      LogLine("info", "token file changed on disk; rereading it");
+      (void)ReloadTokens();  // logs its outcome
+    }
+  }
+  if (!quota_file_.empty()) {
+    if (std::string stamp = FileStamp(quota_file_); stamp != quota_stamp_) {
+      quota_stamp_ = stamp;
+      LogLine("info", "tenant quota file changed on disk; rereading it");
+      (void)ReloadQuotas();
+    }
+  }
+}
+
 absl::Status CovplanServer::ReloadQuotas() {
   if (!quotas_->has_file()) return absl::OkStatus();
   absl::StatusOr<size_t> loaded = quotas_->Reload();
@@ -267,6 +300,7 @@ void CovplanServer::ProbeStoreLoop(absl::Duration interval) {
   absl::MutexLock lock(&probe_mu_);
   while (!probe_mu_.AwaitWithTimeout(absl::Condition(&probe_stop_), interval)) {
     probe_mu_.Unlock();
+    ReloadChangedFiles();
     const absl::Status probe = store_->ProbeWritable();
     // A write that failed since the last probe counts too.
     const bool writable = probe.ok() && store_->writable();

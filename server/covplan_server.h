@@ -50,7 +50,7 @@ struct ServerConfig {
   absl::Duration drain_notice = absl::ZeroDuration();
   // How often the store is probed for writes; the result is the health of
   // kStoreHealthService and the covplan_store_writable gauge.
-  absl::Duration store_probe_interval = absl::Seconds(2);
+  absl::Duration store_probe_interval = absl::Seconds(2);  // also the files' reread bound
   // Index the store on a background thread after the port is open, with
   // health NOT_SERVING (and map calls UNAVAILABLE) until it is done, so a
   // large store does not keep the port closed. Off: Start indexes first.
@@ -105,6 +105,12 @@ class CovplanServer {
   absl::Status ReloadTokens();
   // Rereads the tenant quota file (SIGHUP) the same way.
   absl::Status ReloadQuotas();
+  // Rereads the token and quota files whose modification time or size
+  // changed since they were last read; the store probe calls it every
+  // store_probe_interval, so a file changed on every replica's disk (or
+  // its shared volume) takes effect on each within that bound, no SIGHUP
+  // needed.
+  void ReloadChangedFiles();
 
  private:
   CovplanServer() = default;
@@ -116,6 +122,10 @@ class CovplanServer {
   std::unique_ptr<MapRepository> store_;
   std::unique_ptr<TenantTokens> tokens_;  // null without --token_file
   std::unique_ptr<TenantQuotas> quotas_;
+  std::string token_file_;
+  std::string quota_file_;
+  std::string token_stamp_;  // modification time and size when last read
+  std::string quota_stamp_;
   std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;

@@ -15,6 +15,9 @@
 namespace covplan {
 namespace {
 
+// Maps whose presence Check remembers at most (then it starts afresh).
+constexpr size_t kMaxChecked = 4096;
+
 constexpr char kSchema[] =
     "BEGIN;"
     "SELECT pg_advisory_xact_lock(726501);"
@@ -289,7 +292,32 @@ absl::StatusOr<bool> PgMapStore::Delete(const std::string& map_id) {
   if (!r.ok()) return r.status();
   const bool deleted = std::string(PQcmdTuples(r->get())) == "1";
   if (deleted) --last_size_;
+  absl::MutexLock lock(&checked_mu_);
+  checked_.erase(map_id);
   return deleted;
+}
+
+absl::Status PgMapStore::Check(const std::string& map_id) const {
+  const absl::Time now = absl::Now();
+  {
+    absl::MutexLock lock(&checked_mu_);
+    const auto it = checked_.find(map_id);
+    if (it != checked_.end() && now - it->second < options_.check_ttl) return absl::OkStatus();
+  }
+  absl::StatusOr<Lease> c = Acquire();
+  if (!c.ok()) return absl::OkStatus();
+  absl::StatusOr<Result> r =
+      (*c)->Exec("SELECT 1 FROM covplan_maps WHERE map_id = $1", {{map_id}}, true, false);
+  if (!r.ok()) return absl::OkStatus();
+  const bool present = PQntuples(r->get()) == 1;
+  absl::MutexLock lock(&checked_mu_);
+  if (!present) {
+    checked_.erase(map_id);
+    return absl::NotFoundError(absl::StrCat("no map ", map_id.substr(0, 80)));
+  }
+  if (checked_.size() >= kMaxChecked) checked_.clear();
+  checked_[map_id] = now;
+  return absl::OkStatus();
 }
 
 int64_t PgMapStore::size() const {

@@ -35,8 +35,10 @@
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
+#include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
 #include "server/map_repository.h"
 
 namespace covplan {
@@ -46,6 +48,10 @@ class PgConnection;
 struct PgMapStoreOptions {
   int connections = 4;              // pool size
   int statement_timeout_ms = 5000;  // per statement, so a hung database cannot hold a worker
+  // How long a map found present stays known present to Check: the bound
+  // within which a map deleted through another replica stops being planned
+  // from this replica's cache.
+  absl::Duration check_ttl = absl::Seconds(1);
 };
 
 class PgMapStore : public MapRepository {
@@ -66,6 +72,11 @@ class PgMapStore : public MapRepository {
   int64_t TrimPlans(int64_t keep) override;
   absl::Status TouchPlan(const std::string& plan_id) override;
   absl::Status Available() const override;
+  // NotFound once the map's row is gone (looked up at most every check_ttl
+  // per map, so a delete on any replica holds here within that bound); OK
+  // when the database cannot be reached (the cached map is the best
+  // knowledge).
+  absl::Status Check(const std::string& map_id) const override;
 
  private:
   class Lease;
@@ -81,6 +92,9 @@ class PgMapStore : public MapRepository {
   mutable std::vector<std::unique_ptr<PgConnection>> idle_ ABSL_GUARDED_BY(mu_);
   mutable int leased_ ABSL_GUARDED_BY(mu_) = 0;
   mutable std::atomic<int64_t> last_size_{0};
+  // When each map was last found present (for Check).
+  mutable absl::Mutex checked_mu_;
+  mutable absl::flat_hash_map<std::string, absl::Time> checked_ ABSL_GUARDED_BY(checked_mu_);
 };
 
 }  // namespace covplan

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "api/convert.h"
 #include "covplan/v1/covplan.grpc.pb.h"
 #include "gmock/gmock.h"
@@ -142,35 +143,53 @@ TEST_F(PgMapStoreTest, MalformedConninfoIsInvalidArgument) {
 // Two servers on one database: a PutMap acknowledged by one is planned by
 // the other; with the database down a cache miss is UNAVAILABLE, and the
 // replica serves again once it returns.
-TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
-  auto start = [&](const std::string& dir) {
-    ServerConfig config;
-    config.port = 0;
-    config.metrics_port = -1;
-    config.store_dir = dir;
-    config.map_store = "postgres";
-    config.pg_conninfo = pg_->Conninfo("covplan");
-    absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
-    EXPECT_TRUE(server.ok()) << server.status();
-    return server.ok() ? std::move(*server) : nullptr;
-  };
-  const std::string tmp = std::filesystem::temp_directory_path().string();
-  std::unique_ptr<CovplanServer> one = start(tmp + "/covplan_pg_r1_" + std::to_string(getpid()));
-  std::unique_ptr<CovplanServer> two = start(tmp + "/covplan_pg_r2_" + std::to_string(getpid()));
-  ASSERT_NE(one, nullptr);
-  ASSERT_NE(two, nullptr);
-  auto stub = [](const CovplanServer& s) {
-    return v1::CoveragePlanner::NewStub(grpc::CreateChannel(absl::StrCat("127.0.0.1:", s.port()),
-                                                            grpc::InsecureChannelCredentials()));
-  };
-  auto s1 = stub(*one), s2 = stub(*two);
-  v1::PutMapRequest put;
-  *put.mutable_map() = map_;
+// A replica on the test cluster's database (its own local directory).
+std::unique_ptr<CovplanServer> StartReplica(const testing::PgTestCluster& pg,
+                                            const std::string& name) {
+  ServerConfig config;
+  config.port = 0;
+  config.metrics_port = -1;
+  config.store_dir = std::filesystem::temp_directory_path().string() + "/covplan_pg_" + name + "_" +
+                     std::to_string(getpid());
+  config.map_store = "postgres";
+  config.pg_conninfo = pg.Conninfo("covplan");
+  absl::StatusOr<std::unique_ptr<CovplanServer>> server = CovplanServer::Start(config);
+  EXPECT_TRUE(server.ok()) << server.status();
+  return server.ok() ? std::move(*server) : nullptr;
+}
+
+std::unique_ptr<v1::CoveragePlanner::Stub> StubOf(const CovplanServer& s) {
+  return v1::CoveragePlanner::NewStub(grpc::CreateChannel(absl::StrCat("127.0.0.1:", s.port()),
+                                                          grpc::InsecureChannelCredentials()));
+}
+
+// Two replicas on the test cluster's database, a map put through the first.
+struct TwoReplicas {
+  std::unique_ptr<CovplanServer> one, two;
+  std::unique_ptr<v1::CoveragePlanner::Stub> s1, s2;
   v1::PutMapResponse stored;
-  {
-    grpc::ClientContext context;
-    ASSERT_TRUE(s1->PutMap(&context, put, &stored).ok());
-  }
+};
+
+void StartTwoReplicas(const testing::PgTestCluster& pg, const v1::Map& map, const std::string& name,
+                      TwoReplicas* r) {
+  r->one = StartReplica(pg, name + "1");
+  r->two = StartReplica(pg, name + "2");
+  ASSERT_NE(r->one, nullptr);
+  ASSERT_NE(r->two, nullptr);
+  r->s1 = StubOf(*r->one);
+  r->s2 = StubOf(*r->two);
+  v1::PutMapRequest put;
+  *put.mutable_map() = map;
+  grpc::ClientContext context;
+  ASSERT_TRUE(r->s1->PutMap(&context, put, &r->stored).ok());
+}
+
+TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
+  TwoReplicas replicas;
+  ASSERT_NO_FATAL_FAILURE(StartTwoReplicas(*pg_, map_, "r", &replicas));
+  v1::CoveragePlanner::Stub* s1 = replicas.s1.get();
+  v1::CoveragePlanner::Stub* s2 = replicas.s2.get();
+  const v1::PutMapResponse& stored = replicas.stored;
   v1::PlanResponse plan;
   {
     grpc::ClientContext context;
@@ -183,9 +202,20 @@ TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
   {
     grpc::ClientContext context;
     v1::PutMapResponse again;
+    v1::PutMapRequest put;
+    *put.mutable_map() = map_;
     const grpc::Status status = s2->PutMap(&context, put, &again);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE);
     EXPECT_THAT(status.error_message(), HasSubstr("PostgreSQL"));
+  }
+  {
+    // Replica two has the map's artifacts and keeps planning it (from
+    // another start: a search, not a remembered answer).
+    grpc::ClientContext context;
+    v1::PlanRequest request = testing::PlanRequestFor(stored.map_id(), 0.4);
+    request.mutable_robot()->mutable_start()->set_theta(1.0);
+    const grpc::Status status = s2->Plan(&context, request, &plan);
+    EXPECT_TRUE(status.ok()) << status.error_message();
   }
   {
     // Replica one never built this map's artifacts: it needs the store.
@@ -201,6 +231,45 @@ TEST_F(PgMapStoreTest, ReplicasShareMapsAndSurviveTheDatabaseGoingAway) {
         s1->Plan(&context, testing::PlanRequestFor(stored.map_id(), 0.4), &plan);
     EXPECT_TRUE(status.ok()) << status.error_message();
   }
+}
+
+// Issue 30, item 1: a map deleted through one replica is refused by every
+// replica within the store's check bound (PgMapStoreOptions::check_ttl, 1 s),
+// also for a repeated request another replica answers from memory.
+TEST_F(PgMapStoreTest, AMapDeletedThroughOneReplicaIsRefusedByEveryReplica) {
+  TwoReplicas replicas;
+  ASSERT_NO_FATAL_FAILURE(StartTwoReplicas(*pg_, map_, "d", &replicas));
+  v1::CoveragePlanner::Stub* s1 = replicas.s1.get();
+  v1::CoveragePlanner::Stub* s2 = replicas.s2.get();
+  const v1::PutMapResponse& stored = replicas.stored;
+  const v1::PlanRequest request = testing::PlanRequestFor(stored.map_id(), 0.4);
+  // Both replicas plan it, twice: the second answer is remembered.
+  for (auto* stub : {s1, s2, s1, s2}) {
+    grpc::ClientContext context;
+    v1::PlanResponse plan;
+    ASSERT_TRUE(stub->Plan(&context, request, &plan).ok());
+  }
+  {
+    grpc::ClientContext context;
+    v1::DeleteMapRequest del;
+    del.set_map_id(stored.map_id());
+    v1::DeleteMapResponse deleted;
+    ASSERT_TRUE(s1->DeleteMap(&context, del, &deleted).ok());
+    ASSERT_TRUE(deleted.deleted());
+  }
+  const absl::Time deleted_at = absl::Now();
+  for (auto* stub : {s1, s2}) {
+    grpc::Status status;
+    do {
+      grpc::ClientContext context;
+      v1::PlanResponse plan;
+      status = stub->Plan(&context, request, &plan);
+      if (status.ok()) absl::SleepFor(absl::Milliseconds(50));
+    } while (status.ok() && absl::Now() - deleted_at < absl::Seconds(10));
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND) << status.error_message();
+  }
+  // The bound is 1 s; the slack is for a loaded machine.
+  EXPECT_LT(absl::Now() - deleted_at, absl::Seconds(5));
 }
 
 }  // namespace

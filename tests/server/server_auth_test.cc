@@ -351,6 +351,28 @@ TEST_F(ServerAuthTest, SighupRereadsTheTokenFile) {
   EXPECT_EQ(server_->Stop(), 0);
 }
 
+// Issue 30, item 1: a token file changed on disk is reread within the
+// store probe's interval (2 s) without a SIGHUP, so replicas that share the
+// file (or get it rolled out) agree on a revocation.
+TEST_F(ServerAuthTest, AChangedTokenFileIsRereadWithoutASignal) {
+  WriteFile(tokens_, TokenLine(kAlpha, "alpha"));
+  StartServer();
+  std::vector<std::string> ids;
+  ASSERT_TRUE(ListMaps(kAlpha, &ids).ok());
+  // Beta added, alpha revoked.
+  WriteFile(tokens_, TokenLine(kBeta, "beta"));
+  const absl::Time changed = absl::Now();
+  while (ListMaps(kAlpha, &ids).ok() && absl::Now() - changed < absl::Seconds(15)) {
+    absl::SleepFor(absl::Milliseconds(50));
+  }
+  EXPECT_EQ(ListMaps(kAlpha, &ids).error_code(), grpc::StatusCode::UNAUTHENTICATED)
+      << server_->log();
+  EXPECT_TRUE(ListMaps(kBeta, &ids).ok());
+  // The bound is 2 s; the slack is for a loaded machine.
+  EXPECT_LT(absl::Now() - changed, absl::Seconds(8));
+  EXPECT_NE(server_->log().find("token file changed on disk"), std::string::npos);
+}
+
 TEST_F(ServerAuthTest, ABadTokenFileStopsStartup) {
   WriteFile(tokens_, "abc alpha\n");
   ServerProcess server;
