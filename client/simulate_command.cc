@@ -379,8 +379,10 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
   const double total_ms = std::accumulate(r.replan_ms.begin(), r.replan_ms.end(), 0.0);
   double max_ms = 0.0;
   for (double ms : r.replan_ms) max_ms = std::max(max_ms, ms);
+  // The first kMaxListedProblems problems; num_problems counts them all.
+  constexpr size_t kMaxListedProblems = 20;
   std::string problems = "[";
-  for (size_t i = 0; i < r.problems.size(); ++i)
+  for (size_t i = 0; i < std::min(r.problems.size(), kMaxListedProblems); ++i)
     absl::StrAppend(&problems, i ? "," : "", JsonString(r.problems[i]));
   problems += "]";
   JsonObject json;
@@ -415,6 +417,7 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
   json.Field("length_in_obstacles_m", JsonNumber(r.length_in_obstacles_m));
   json.Field("completed", r.completed ? "true" : "false");
   json.Field("termination", JsonString(r.termination));
+  json.Field("num_problems", absl::StrCat(r.problems.size()));
   json.Field("problems", problems);
   json.Field("planner", JsonString(o.plan.planner));
   if (r.battery) AddBatteryFields(*r.battery, o, &json);

@@ -1,6 +1,7 @@
 #include "planner/replan/remainder.h"
 
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_format.h"
@@ -10,25 +11,61 @@
 namespace covplan::replan_internal {
 namespace {
 
+// Where a robot whose own cell was reported blocked leaves it: an adjacent
+// cell free on `all` (the old drive grid less the blocked cells) that the
+// straight move from `probe` reaches touching no other blocked cell (a
+// reported obstacle is never clipped), into the component the blocking
+// leaves with the most cells still to cover (`to_sweep`: the robot cannot
+// come back through its cell, so the others are cut off and lose the
+// least), nearest first among equals. None: the robot is walled in.
+std::optional<CellIndex> ExitCell(const Grid& all, Point2 probe,
+                                  const std::vector<uint8_t>& to_sweep) {
+  int32_t num = 0;
+  const std::vector<int32_t> comp = FreeComponents(all, &num);
+  std::vector<int64_t> size(static_cast<size_t>(num), 0);
+  for (size_t i = 0; i < comp.size(); ++i) {
+    if (comp[i] >= 0 && to_sweep[i]) ++size[comp[i]];
+  }
+  const CellIndex own = all.CellAt(probe);
+  std::optional<CellIndex> best;
+  int64_t best_size = 0;
+  double best_d2 = 0.0;
+  for (int dr = -1; dr <= 1; ++dr) {
+    for (int dc = -1; dc <= 1; ++dc) {
+      const CellIndex n{own.row + dr, own.col + dc};
+      if ((dr == 0 && dc == 0) || !all.IsFree(n) || !ClearJoin(all, {probe.x, probe.y, 0}, n))
+        continue;
+      const int64_t s = size[comp[all.Index(n.row, n.col)]];
+      const Point2 q = all.CellCenter(n);
+      const double d2 = (q.x - probe.x) * (q.x - probe.x) + (q.y - probe.y) * (q.y - probe.y);
+      if (!best || s > best_size || (s == best_size && d2 < best_d2)) {
+        best = n, best_size = s, best_d2 = d2;
+      }
+    }
+  }
+  return best;
+}
+
 // The free flags of the new drive grid: the old drive grid less the `blocked`
 // cells, cut to the component of the robot at `robot_cell` (`probe` is where
-// it stands, for finding its way out of a blocked cell).
+// it stands, for finding its way out of a blocked cell; `to_sweep` what is
+// left to cover, for choosing that way).
 std::vector<uint8_t> NewDriveFlags(const Grid& old_drive, CellIndex robot_cell, Point2 probe,
+                                   const std::vector<uint8_t>& to_sweep,
                                    std::vector<uint8_t>* blocked, ReplanStats* st) {
   std::vector<uint8_t> free = old_drive.free_flags();
   for (size_t i = 0; i < free.size(); ++i) {
     st->newly_blocked_cells += (*blocked)[i];
     if ((*blocked)[i]) free[i] = 0;
   }
-  const Grid all = old_drive.WithFreeFlags(free);
   // The robot's own cell reported blocked (it stands in the obstacle's
   // cell): blocked for the rest of the mission, like a dock's cell, which
-  // the robot leaves by its first move to the nearest free neighbour. Only
-  // a robot walled in on every side keeps its cell (and says so).
+  // the robot leaves by its first move (ExitCell). Only a robot walled in
+  // keeps its cell (and says so).
   CellIndex keep_cell = robot_cell;
   if ((*blocked)[old_drive.Index(robot_cell.row, robot_cell.col)]) {
-    absl::StatusOr<CellIndex> exit = JoinCell(all, Pose2{probe.x, probe.y, 0}, "robot");
-    if (exit.ok()) {
+    const std::optional<CellIndex> exit = ExitCell(old_drive.WithFreeFlags(free), probe, to_sweep);
+    if (exit) {
       keep_cell = *exit;
       st->robot_cell_blocked = true;
     } else {
@@ -122,8 +159,10 @@ absl::StatusOr<Remainder> ComputeRemainder(const RetainedPlan& old, const RobotP
   rest.end = Pose2{last.x, last.y, last.theta};
 
   ReplanStats& st = out->stats;
+  std::vector<uint8_t> to_sweep = old.area->cover->free_flags();
+  for (size_t i = 0; i < to_sweep.size(); ++i) to_sweep[i] = to_sweep[i] && !covered[i];
   rest.drive = std::make_shared<const Grid>(
-      old_drive.WithFreeFlags(NewDriveFlags(old_drive, *joined, probe, &blocked, &st)));
+      old_drive.WithFreeFlags(NewDriveFlags(old_drive, *joined, probe, to_sweep, &blocked, &st)));
   const Grid& drive = *rest.drive;
   MoveEndIfCutOff(old_drive, drive, &rest.end, &st);
   rest.to_cover = CellsToCover(*old.area->cover, drive, blocked, covered, out);

@@ -94,9 +94,12 @@ struct ReplanStats {
   bool rank_lp_integral = true;  // the RANK-REPLAN relaxation was integral
   bool end_moved = false;  // the old end was cut off: the plan ends at the nearest reachable cell
   // The robot's own cell was reported blocked: it is blocked from now on and
-  // the plan leaves it first (robot_cell_blocked), or, when every cell around
-  // is blocked too, it stays free so that the robot can move at all
-  // (robot_cell_kept_free).
+  // the plan leaves it first (robot_cell_blocked), by a straight move to an
+  // adjacent free cell that clips no other blocked cell, into the side with
+  // the most cells still to cover (the others are cut off). When no such
+  // move exists the robot is walled in: the cell it joins the grid at stays
+  // free so that the robot can move at all (robot_cell_kept_free), and the
+  // plan leaves through it.
   bool robot_cell_blocked = false;
   bool robot_cell_kept_free = false;
 };

@@ -254,6 +254,7 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   r_.replan_ms.push_back(1000.0 * compute_s);
   r_.replan_points.push_back(pos_);
   r_.replan_methods.push_back(st.method);
+  walled_in_ = st.robot_cell_kept_free;
 
   if (mid_segment) {
     Waypoint cut = b;
@@ -265,7 +266,11 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   }
   // Every replanned path is checked whole, not only the part the robot
   // drives before the next replan.
-  if (std::optional<std::string> crossing = CrossesReported(result->plan.path)) {
+  // (A walled-in robot's plan crosses the reported cell kept as its way out,
+  // and says so: the drive ends there, below.)
+  std::optional<std::string> crossing;
+  if (!st.robot_cell_kept_free) crossing = CrossesReported(result->plan.path);
+  if (crossing) {
     r_.problems.push_back(
         absl::StrFormat("the plan from replan %d (%s) %s", r_.num_replans, st.method, *crossing));
   }
@@ -314,6 +319,18 @@ absl::Status SimulatedDrive::HandleViolation(CellIndex cell) {
     sweeps_left |= path()[i].kind == SegmentKind::kCoverage;
   if (!sweeps_left && cell == grid_.CellAt(At(path().back()))) {
     end_blocked_ = true;
+    return absl::OkStatus();
+  }
+  // Walled in: the replanner kept the robot's only way out free although it
+  // was reported blocked (it is, on the true grid). No plan can get the
+  // robot out; replanning again would only repeat that answer.
+  if (walled_in_ && found_[Index(cell)]) {
+    r_.completed = false;
+    r_.termination = absl::StrFormat(
+        "stopped: walled in at (%.4f, %.4f): replan %d found no free cell around the robot on "
+        "its drive grid (blocked, or cut off by earlier obstacles) and kept cell (%d, %d), "
+        "reported blocked, as the way out (robot_cell_kept_free)",
+        pos_.x, pos_.y, r_.num_replans, cell.row, cell.col);
     return absl::OkStatus();
   }
   r_.problems.push_back(absl::StrFormat(

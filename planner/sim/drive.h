@@ -156,10 +156,13 @@ class SimulatedDrive {
   Point2 pos_;
   CellIndex here_;            // the cell the robot is in (borders are ambiguous)
   bool end_blocked_ = false;  // the plan's end pose lies in a blocked cell
-  bool junction_ = false;     // driven.back() is where a replan cut a segment
-  double drive_s_ = 0.0;      // rough drive time, for the time bound
-  double clock_s_ = 0.0;      // finished and cut segments (turns included) and stoppage
-  double wait_s_ = 0.0;       // stoppage of the last replan not waited out yet
+  // The last replan found every cell around the robot blocked and kept its
+  // way out free (ReplanStats::robot_cell_kept_free): walled in.
+  bool walled_in_ = false;
+  bool junction_ = false;  // driven.back() is where a replan cut a segment
+  double drive_s_ = 0.0;   // rough drive time, for the time bound
+  double clock_s_ = 0.0;   // finished and cut segments (turns included) and stoppage
+  double wait_s_ = 0.0;    // stoppage of the last replan not waited out yet
   bool started_ = false;
   bool finished_ = false;
   int planned_cycles_ = 0;

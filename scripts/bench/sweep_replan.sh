@@ -4,7 +4,8 @@
 # counts the problems the simulator finds. The simulator checks every
 # replanned path whole against the known map and every cell already
 # reported blocked, and every driven step against the true map; each
-# violation is listed in the run's "problems" field. Uses only the repo.
+# violation is counted in the run's "num_problems" field (the first 20 are
+# listed in "problems"). Uses only the repo.
 #
 #   scripts/bench/sweep_replan.sh                          # 4 methods x 2 levels x 6 seeds
 #   SEEDS="1 2" METHODS="auto" LEVELS=20 scripts/bench/sweep_replan.sh
@@ -53,8 +54,9 @@ for r in sorted(runs, key=lambda r: (r["method"], r["clutter"], r["seed"])):
         continue
     x = r["run"]
     p = x.get("problems", [])
-    bad += bool(p)
-    print(f'{r["method"]:14} {r["clutter"]:>3}% seed {r["seed"]}: problems {len(p)} '
+    n = x.get("num_problems", len(p))  # the list holds the first 20
+    bad += bool(n)
+    print(f'{r["method"]:14} {r["clutter"]:>3}% seed {r["seed"]}: problems {n} '
           f'replans {x["num_replans"]} stoppage {x["stoppage_s"]:.1f} s '
           f'coverage {x["covered_free_area_ratio"]:.4f}' + (f'  {p[:3]}' if p else ''))
 print(f'{len(runs)} runs, {bad} with problems or failures; runs in {sys.argv[1]}')
