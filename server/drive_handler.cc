@@ -47,7 +47,7 @@ grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* DriveHandler::Drive(
     return new RefusedDrive(grpc::Status(grpc::StatusCode::UNAVAILABLE, "server is shutting down"));
   }
   auto* session = new DriveSession(this, context, &sessions_, absl::StrCat("s-", call.request_id),
-                                   call.tenant_tag);
+                                   DriveHost::Tenant{call.tenant_tag, call.tenant});
   if (!sessions_.Add(session)) {
     session->Unref();
     metrics_->RecordRequest("Drive", "RESOURCE_EXHAUSTED", 0.0);
@@ -67,32 +67,34 @@ grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveEvent>* DriveHandler::Drive(
 
 absl::StatusOr<DriveHost::AdoptedPlan> DriveHandler::AdoptPlan(const v1::DriveRequest& first,
                                                                const StopToken& stop,
-                                                               const std::string& tenant_tag) {
-  return work_->AdoptPlan(first, stop, tenant_tag);
+                                                               const Tenant& tenant) {
+  return work_->AdoptPlan(first, stop, tenant.tag);
 }
 
-absl::Status DriveHandler::Replan(const std::string& request_id, const std::string& tenant_tag,
+absl::Status DriveHandler::Replan(const std::string& request_id, const Tenant& tenant,
                                   const v1::ReplanRequest& request, const StopToken& stop,
                                   v1::ReplanResponse* response) {
   CallInfo call;
   call.method = kDriveReplan.data();
   call.start = absl::Now();
   call.request_id = request_id;
-  call.tenant_tag = tenant_tag;
+  call.tenant_tag = tenant.tag;
+  call.tenant = tenant.name;
   const absl::Status status = work_->RunReplan(call, request, stop, response);
   gate_->Record(call, status,
                 status.ok() ? ReplanDetail(*response) : std::string(status.message()));
   return status;
 }
 
-absl::Status DriveHandler::SubmitSolve(const std::string& tenant_tag, std::function<void()> work) {
+absl::Status DriveHandler::SubmitSolve(const Tenant& tenant, std::function<void()> work) {
   if (gate_->draining()) return absl::UnavailableError("server draining: no new replans");
   CallInfo call;
-  call.tenant_tag = tenant_tag;
+  call.tenant_tag = tenant.tag;
+  call.tenant = tenant.name;
   RETURN_IF_ERROR(admission_->Admit(call));
   SolveAdmission::Task task;
   task.solve = std::move(work);
-  task.tenant_tag = tenant_tag;
+  task.tenant_tag = tenant.tag;
   return admission_->Submit(std::move(task)) ? absl::OkStatus() : admission_->Full();
 }
 

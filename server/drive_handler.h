@@ -50,11 +50,11 @@ class DriveHandler final : public DriveHost {
  private:
   // DriveHost, for the sessions only.
   absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first, const StopToken& stop,
-                                        const std::string& tenant_tag) override;
-  absl::Status Replan(const std::string& request_id, const std::string& tenant_tag,
+                                        const Tenant& tenant) override;
+  absl::Status Replan(const std::string& request_id, const Tenant& tenant,
                       const v1::ReplanRequest& request, const StopToken& stop,
                       v1::ReplanResponse* response) override;
-  absl::Status SubmitSolve(const std::string& tenant_tag, std::function<void()> work) override;
+  absl::Status SubmitSolve(const Tenant& tenant, std::function<void()> work) override;
   void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) override;
   std::optional<v1::RobotProgress> RecordedProgress(const std::string& plan_id) override;
   void ShareObstacles(const std::vector<std::string>& plan_ids,

@@ -5,7 +5,7 @@
 // implements it (server/drive_handler.h); tests may fake it.
 //
 //   class Host final : public DriveHost { ... };
-//   auto* session = new DriveSession(&host, context, &registry, "s-1", tenant_tag);
+//   auto* session = new DriveSession(&host, context, &registry, "s-1", {tag, name});
 //
 // Thread-safety: implementations must be thread-safe; sessions call them
 // from gRPC reactions and from workers.
@@ -37,21 +37,27 @@ class DriveHost {
     std::shared_ptr<const Grid> grid;
   };
 
+  // Who opened a session: its tenant's tag (quotas, the plans it may use)
+  // and name (logs, metrics, messages); both empty without --token_file.
+  struct Tenant {
+    std::string tag;
+    std::string name;
+  };
+
   virtual ~DriveHost() = default;
 
   virtual absl::StatusOr<AdoptedPlan> AdoptPlan(const v1::DriveRequest& first,
-                                                const StopToken& stop,
-                                                const std::string& tenant_tag) = 0;
+                                                const StopToken& stop, const Tenant& tenant) = 0;
   // Runs one replan of a session (on a worker), logged and counted as a
   // "Drive.Replan" call with this request id.
-  virtual absl::Status Replan(const std::string& request_id, const std::string& tenant_tag,
+  virtual absl::Status Replan(const std::string& request_id, const Tenant& tenant,
                               const v1::ReplanRequest& request, const StopToken& stop,
                               v1::ReplanResponse* response) = 0;
   // Runs `work` on the solve pool under the same admission bound as unary
-  // solves, as a solve of the tenant with `tenant_tag` (its quota); non-OK
+  // solves, as a solve of `tenant` (its quota); non-OK
   // (and `work` dropped): RESOURCE_EXHAUSTED when the server or the
   // tenant's quota is full (saying which), UNAVAILABLE when it drains.
-  virtual absl::Status SubmitSolve(const std::string& tenant_tag, std::function<void()> work) = 0;
+  virtual absl::Status SubmitSolve(const Tenant& tenant, std::function<void()> work) = 0;
   // The robot's latest progress on a plan, kept for Resume.
   virtual void RecordProgress(const std::string& plan_id, const v1::RobotProgress& progress) = 0;
   // The latest progress recorded for a plan (Drive, Replan), if any.

@@ -38,12 +38,12 @@ struct DriveSession::Actions {
 
 DriveSession::DriveSession(DriveHost* host, grpc::CallbackServerContext* context,
                            SessionRegistry* registry, std::string session_id,
-                           std::string tenant_tag)
+                           DriveHost::Tenant tenant)
     : host_(host),
       context_(context),
       registry_(registry),
       session_id_(std::move(session_id)),
-      tenant_tag_(std::move(tenant_tag)) {}
+      tenant_(std::move(tenant)) {}
 
 void DriveSession::Start() {
   {
@@ -422,7 +422,7 @@ void DriveSession::StartJob(Actions* a) {
   v1::Obstacles seen = seen_;
   Ref();  // held by the worker
   const absl::Status queued = host_->SubmitSolve(
-      tenant_tag_, [this, job, first = std::move(first), seen = std::move(seen), stop] {
+      tenant_, [this, job, first = std::move(first), seen = std::move(seen), stop] {
         RunJob(job, first, seen, stop);
         Unref();
       });
@@ -450,7 +450,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
   std::string adopted, map_id;
   double compute_ms = 0.0;
   if (job.start) {
-    absl::StatusOr<DriveHost::AdoptedPlan> plan = host_->AdoptPlan(first, stop, tenant_tag_);
+    absl::StatusOr<DriveHost::AdoptedPlan> plan = host_->AdoptPlan(first, stop, tenant_);
     status = plan.status();
     if (plan.ok()) {
       adopted = plan->plan_id;
@@ -477,7 +477,7 @@ void DriveSession::RunJob(const Job& job, const v1::DriveRequest& first, const v
     request.set_method(job.method != v1::REPLAN_METHOD_UNSPECIFIED ? job.method : first.method());
     request.set_seed(first.seed());
     const absl::Time t0 = absl::Now();
-    status = host_->Replan(absl::StrCat(session_id_, "/", job.sequence), tenant_tag_, request, stop,
+    status = host_->Replan(absl::StrCat(session_id_, "/", job.sequence), tenant_, request, stop,
                            event.mutable_replan());
     compute_ms = absl::ToDoubleMilliseconds(absl::Now() - t0);
   }

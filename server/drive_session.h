@@ -55,7 +55,7 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   static constexpr size_t kMaxSessionPlans = 64;
 
   DriveSession(DriveHost* host, grpc::CallbackServerContext* context, SessionRegistry* registry,
-               std::string session_id, std::string tenant_tag);
+               std::string session_id, DriveHost::Tenant tenant);
 
   // Starts reading (after the registry admitted the session).
   void Start();
@@ -136,7 +136,7 @@ class DriveSession final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   grpc::CallbackServerContext* const context_;
   SessionRegistry* const registry_;
   const std::string session_id_;
-  const std::string tenant_tag_;  // the caller's tenant (server/tenant_tokens.h)
+  const DriveHost::Tenant tenant_;  // the caller's tenant (server/tenant_tokens.h)
   std::atomic<int> refs_{1};
 
   mutable absl::Mutex mu_;

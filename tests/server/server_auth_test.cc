@@ -446,6 +446,10 @@ TEST_F(ServerAuthTest, ATenantOverItsSolveQuotaIsRefusedAndAnotherIsServed) {
   ASSERT_TRUE(stub_->PutMap(Ctx(kAlpha).get(), busy, &alpha_map).ok());
   v1::PutMapResponse beta_map;
   ASSERT_TRUE(PutMap(kBeta, &beta_map).ok());
+  v1::PutMapResponse alpha_small;
+  ASSERT_TRUE(PutMap(kAlpha, &alpha_small).ok());
+  v1::PlanResponse alpha_plan;
+  ASSERT_TRUE(Plan(kAlpha, alpha_small.map_id(), &alpha_plan).ok());
   constexpr int kAlphaCalls = 6;
   std::vector<grpc::Status> alpha(kAlphaCalls);
   std::vector<absl::Time> alpha_done(kAlphaCalls);
@@ -461,6 +465,19 @@ TEST_F(ServerAuthTest, ATenantOverItsSolveQuotaIsRefusedAndAnotherIsServed) {
     });
   }
   absl::SleepFor(absl::Milliseconds(300));
+  {  // alpha's Drive session needs a solve too: refused naming the tenant
+    auto context = Ctx(kAlpha);
+    auto stream = stub_->Drive(context.get());
+    v1::DriveRequest first;
+    first.set_plan_id(alpha_plan.plan_id());
+    stream->Write(first);
+    v1::DriveEvent event;
+    while (stream->Read(&event)) {
+    }
+    const grpc::Status drive = stream->Finish();
+    EXPECT_EQ(drive.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << drive.error_message();
+    EXPECT_THAT(drive.error_message(), HasSubstr("tenant alpha is over its quota"));
+  }
   v1::PlanResponse beta;
   const grpc::Status beta_status = Plan(kBeta, beta_map.map_id(), &beta);
   const absl::Time beta_done = absl::Now();
