@@ -36,6 +36,18 @@ std::string FileStamp(const std::string& path) {
   return absl::StrCat(time.time_since_epoch().count(), "/", size);
 }
 
+// Logs a reread of a token or quota file: how many entries it holds now, or
+// why the previous ones stay in force (and returns that error).
+absl::Status LogReload(const absl::StatusOr<size_t>& loaded, const char* failed, const char* done,
+                       const char* unit) {
+  if (!loaded.ok()) {
+    LogLine("error", failed, {{"detail", std::string(loaded.status().message())}});
+    return loaded.status();
+  }
+  LogLine("info", done, {{unit, absl::StrCat(*loaded)}});
+  return absl::OkStatus();
+}
+
 // After the grace: how long cut-short solves get to reply, then how long
 // gRPC gets to send what is written before it cancels the rest.
 constexpr absl::Duration kDrainReplyBound = absl::Milliseconds(500);
@@ -135,8 +147,11 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   server->quotas_ = std::move(*quotas);
   server->token_file_ = config.token_file;
   server->quota_file_ = config.tenant_quota_file;
-  server->token_stamp_ = FileStamp(config.token_file);
-  server->quota_stamp_ = FileStamp(config.tenant_quota_file);
+  {
+    absl::MutexLock lock(&server->reload_mu_);
+    server->token_stamp_ = FileStamp(config.token_file);
+    server->quota_stamp_ = FileStamp(config.tenant_quota_file);
+  }
   if (!config.tenant_quota_file.empty() && config.token_file.empty()) {
     LogLine("warn",
             "--tenant_quota_file without --token_file: every caller is one tenant, "
@@ -243,44 +258,40 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
 }
 
 absl::Status CovplanServer::ReloadTokens() {
-  if (tokens_ == nullptr) return absl::OkStatus();
-  absl::StatusOr<size_t> loaded = tokens_->Reload();
-  if (!loaded.ok()) {
-    LogLine("error", "token file not reloaded; the previous tokens stay in force",
-            {{"detail", std::string(loaded.status().message())}});
-    return loaded.status();
-  }
-  LogLine("info", "token file reloaded", {{"tokens", absl::StrCat(*loaded)}});
-  return absl::OkStatus();
-}
-
-void CovplanServer::ReloadChangedFiles() {
-  if (!token_file_.empty() && tokens_ != nullptr) {
-    if (std::string stamp = FileStamp(token_file_); stamp != token_stamp_) {
-      token_stamp_ = stamp;
-      LogLine("info", "token file changed on disk; rereading it");
-      (void)ReloadTokens();  // logs its outcome
-    }
-  }
-  if (!quota_file_.empty()) {
-    if (std::string stamp = FileStamp(quota_file_); stamp != quota_stamp_) {
-      quota_stamp_ = stamp;
-      LogLine("info", "tenant quota file changed on disk; rereading it");
-      (void)ReloadQuotas();
-    }
-  }
+  absl::MutexLock lock(&reload_mu_);
+  return ReloadTokensLocked();
 }
 
 absl::Status CovplanServer::ReloadQuotas() {
+  absl::MutexLock lock(&reload_mu_);
+  return ReloadQuotasLocked();
+}
+
+absl::Status CovplanServer::ReloadTokensLocked() {
+  if (tokens_ == nullptr) return absl::OkStatus();
+  token_stamp_ = FileStamp(token_file_);
+  return LogReload(tokens_->Reload(), "token file not reloaded; the previous tokens stay in force",
+                   "token file reloaded", "tokens");
+}
+
+absl::Status CovplanServer::ReloadQuotasLocked() {
   if (!quotas_->has_file()) return absl::OkStatus();
-  absl::StatusOr<size_t> loaded = quotas_->Reload();
-  if (!loaded.ok()) {
-    LogLine("error", "tenant quota file not reloaded; the previous quotas stay in force",
-            {{"detail", std::string(loaded.status().message())}});
-    return loaded.status();
+  quota_stamp_ = FileStamp(quota_file_);
+  return LogReload(quotas_->Reload(),
+                   "tenant quota file not reloaded; the previous quotas stay in force",
+                   "tenant quotas reloaded", "tenants");
+}
+
+void CovplanServer::ReloadChangedFiles() {
+  absl::MutexLock lock(&reload_mu_);
+  if (!token_file_.empty() && tokens_ != nullptr && FileStamp(token_file_) != token_stamp_) {
+    LogLine("info", "token file changed on disk; rereading it");
+    (void)ReloadTokensLocked();  // logs its outcome
   }
-  LogLine("info", "tenant quotas reloaded", {{"tenants", absl::StrCat(*loaded)}});
-  return absl::OkStatus();
+  if (!quota_file_.empty() && FileStamp(quota_file_) != quota_stamp_) {
+    LogLine("info", "tenant quota file changed on disk; rereading it");
+    (void)ReloadQuotasLocked();
+  }
 }
 
 void CovplanServer::LogIndexed(absl::Duration took) {

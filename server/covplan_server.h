@@ -102,15 +102,15 @@ class CovplanServer {
 
   // Rereads the token file (SIGHUP); on error the previous tokens stay and
   // the error is returned. OK and nothing done without a token file.
-  absl::Status ReloadTokens();
+  absl::Status ReloadTokens() ABSL_LOCKS_EXCLUDED(reload_mu_);
   // Rereads the tenant quota file (SIGHUP) the same way.
-  absl::Status ReloadQuotas();
+  absl::Status ReloadQuotas() ABSL_LOCKS_EXCLUDED(reload_mu_);
   // Rereads the token and quota files whose modification time or size
   // changed since they were last read; the store probe calls it every
   // store_probe_interval, so a file changed on every replica's disk (or
   // its shared volume) takes effect on each within that bound, no SIGHUP
   // needed.
-  void ReloadChangedFiles();
+  void ReloadChangedFiles() ABSL_LOCKS_EXCLUDED(reload_mu_);
 
  private:
   CovplanServer() = default;
@@ -124,8 +124,14 @@ class CovplanServer {
   std::unique_ptr<TenantQuotas> quotas_;
   std::string token_file_;
   std::string quota_file_;
-  std::string token_stamp_;  // modification time and size when last read
-  std::string quota_stamp_;
+  absl::Status ReloadTokensLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(reload_mu_);
+  absl::Status ReloadQuotasLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(reload_mu_);
+  // Serialises the rereads (the signal thread's and the store probe's), so a
+  // SIGHUP's reread also counts as the probe's: the file is read once.
+  absl::Mutex reload_mu_;
+  // Modification time and size when last read.
+  std::string token_stamp_ ABSL_GUARDED_BY(reload_mu_);
+  std::string quota_stamp_ ABSL_GUARDED_BY(reload_mu_);
   std::unique_ptr<ServerMetrics> metrics_;
   std::unique_ptr<CoveragePlannerService> service_;
   std::unique_ptr<grpc::Server> server_;
