@@ -14,11 +14,12 @@ namespace {
 // Where a robot whose own cell was reported blocked leaves it: an adjacent
 // cell free on `all` (the old drive grid less the blocked cells) that the
 // straight move from `probe` reaches touching no other blocked cell (a
-// reported obstacle is never clipped), into the component the blocking
+// reported obstacle is never clipped) and the robot's cell allows on the
+// old drive grid (no thin wall, no cut corner), into the component the blocking
 // leaves with the most cells still to cover (`to_sweep`: the robot cannot
 // come back through its cell, so the others are cut off and lose the
 // least), nearest first among equals. None: the robot is walled in.
-std::optional<CellIndex> ExitCell(const Grid& all, Point2 probe,
+std::optional<CellIndex> ExitCell(const Grid& old_drive, const Grid& all, Point2 probe,
                                   const std::vector<uint8_t>& to_sweep) {
   int32_t num = 0;
   const std::vector<int32_t> comp = FreeComponents(all, &num);
@@ -27,13 +28,23 @@ std::optional<CellIndex> ExitCell(const Grid& all, Point2 probe,
     if (comp[i] >= 0 && to_sweep[i]) ++size[comp[i]];
   }
   const CellIndex own = all.CellAt(probe);
+  // The robot's cell was free on the old drive grid: its moves there (thin
+  // walls, corners, obstacle pixels: DriveMoveMask) bound the ways out too.
+  const uint8_t moves = old_drive.IsFree(own) ? DriveMoveMask(old_drive, own) : 0xff;
+  auto allowed = [&](int dr, int dc) {
+    for (int k = 0; k < 8; ++k) {
+      if (kDriveDr[k] == dr && kDriveDc[k] == dc) return ((moves >> k) & 1) != 0;
+    }
+    return false;
+  };
   std::optional<CellIndex> best;
   int64_t best_size = 0;
   double best_d2 = 0.0;
   for (int dr = -1; dr <= 1; ++dr) {
     for (int dc = -1; dc <= 1; ++dc) {
       const CellIndex n{own.row + dr, own.col + dc};
-      if ((dr == 0 && dc == 0) || !all.IsFree(n) || !ClearJoin(all, {probe.x, probe.y, 0}, n))
+      if ((dr == 0 && dc == 0) || !all.IsFree(n) || !allowed(dr, dc) ||
+          !ClearJoin(all, {probe.x, probe.y, 0}, n))
         continue;
       const int64_t s = size[comp[all.Index(n.row, n.col)]];
       const Point2 q = all.CellCenter(n);
@@ -64,7 +75,8 @@ std::vector<uint8_t> NewDriveFlags(const Grid& old_drive, CellIndex robot_cell, 
   // keeps its cell (and says so).
   CellIndex keep_cell = robot_cell;
   if ((*blocked)[old_drive.Index(robot_cell.row, robot_cell.col)]) {
-    const std::optional<CellIndex> exit = ExitCell(old_drive.WithFreeFlags(free), probe, to_sweep);
+    const std::optional<CellIndex> exit =
+        ExitCell(old_drive, old_drive.WithFreeFlags(free), probe, to_sweep);
     if (exit) {
       keep_cell = *exit;
       st->robot_cell_blocked = true;

@@ -98,8 +98,8 @@ struct ReplanStats {
   // adjacent free cell that clips no other blocked cell, into the side with
   // the most cells still to cover (the others are cut off). When no such
   // move exists the robot is walled in: the cell it joins the grid at stays
-  // free so that the robot can move at all (robot_cell_kept_free), and the
-  // plan leaves through it.
+  // free so that the robot can move at all (robot_cell_kept_free); the plan
+  // leaves through it, or, when that is the robot's own cell, stays there.
   bool robot_cell_blocked = false;
   bool robot_cell_kept_free = false;
 };

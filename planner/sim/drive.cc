@@ -267,9 +267,15 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   // Every replanned path is checked whole, not only the part the robot
   // drives before the next replan.
   // (A walled-in robot's plan crosses the reported cell kept as its way out,
-  // and says so: the drive ends there, below.)
+  // free on its drive grid, and says so: the drive ends there, below. Any
+  // other reported cell it crosses is a problem; a server's answer has no
+  // drive grid, so there nothing is checked.)
+  const bool has_drive = result->area != nullptr && result->area->drive != nullptr;
   std::optional<std::string> crossing;
-  if (!st.robot_cell_kept_free) crossing = CrossesReported(result->plan.path);
+  if (!st.robot_cell_kept_free || has_drive) {
+    crossing = CrossesReported(result->plan.path,
+                               st.robot_cell_kept_free ? result->area->drive.get() : nullptr);
+  }
   if (crossing) {
     r_.problems.push_back(
         absl::StrFormat("the plan from replan %d (%s) %s", r_.num_replans, st.method, *crossing));
@@ -285,8 +291,8 @@ absl::Status SimulatedDrive::DoReplan(ReplanMethod method) {
   return absl::OkStatus();
 }
 
-std::optional<std::string> SimulatedDrive::CrossesReported(
-    const std::vector<Waypoint>& path) const {
+std::optional<std::string> SimulatedDrive::CrossesReported(const std::vector<Waypoint>& path,
+                                                           const Grid* kept) const {
   bool leaving = true;  // the path may start in the robot's cell, not come back to it
   for (size_t i = 1; i < path.size(); ++i) {
     const Point2 a = At(path[i - 1]), b = At(path[i]);
@@ -295,6 +301,7 @@ std::optional<std::string> SimulatedDrive::CrossesReported(
       if (leaving && c == here_) return false;
       leaving = false;
       if (!grid_.InBounds(c.row, c.col) || !reported_[Index(c)]) return false;
+      if (kept != nullptr && kept->IsFree(c)) return false;  // the walled-in robot's way out
       hit = c;
       return true;
     });
@@ -324,12 +331,14 @@ absl::Status SimulatedDrive::HandleViolation(CellIndex cell) {
   // Walled in: the replanner kept the robot's only way out free although it
   // was reported blocked (it is, on the true grid). No plan can get the
   // robot out; replanning again would only repeat that answer.
-  if (walled_in_ && found_[Index(cell)]) {
+  const bool kept_cell = plan_.area == nullptr || plan_.area->drive == nullptr ||
+                         plan_.area->drive->IsFree(cell);  // a server's answer: no grid
+  if (walled_in_ && found_[Index(cell)] && kept_cell) {
     r_.completed = false;
     r_.termination = absl::StrFormat(
-        "stopped: walled in at (%.4f, %.4f): replan %d found no free cell around the robot on "
-        "its drive grid (blocked, or cut off by earlier obstacles) and kept cell (%d, %d), "
-        "reported blocked, as the way out (robot_cell_kept_free)",
+        "stopped: walled in at (%.4f, %.4f): replan %d found no clean move out of the robot's "
+        "cell (its neighbours blocked, cut off by earlier obstacles, or reached only by clipping "
+        "one) and kept cell (%d, %d), reported blocked, as the way out (robot_cell_kept_free)",
         pos_.x, pos_.y, r_.num_replans, cell.row, cell.col);
     return absl::OkStatus();
   }
@@ -495,6 +504,13 @@ SimulationResult SimulatedDrive::Finish() {
         path().back().x, path().back().y, pos_.x, pos_.y);
   } else if (!finished_) {
     r_.termination = absl::StrFormat("stopped at %.3f s before the end of the plan", clock_s());
+  } else if (r_.completed && walled_in_) {
+    // Walled in with its own cell kept: the last plan stayed in it.
+    r_.completed = false;
+    r_.termination = absl::StrFormat(
+        "stopped: walled in at (%.4f, %.4f): replan %d found no clean move out of the robot's "
+        "cell and kept it free (robot_cell_kept_free)",
+        pos_.x, pos_.y, r_.num_replans);
   } else if (r_.completed) {
     r_.termination = "completed: the end of the plan was reached";
   }

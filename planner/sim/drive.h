@@ -130,7 +130,10 @@ class SimulatedDrive {
   // One step of the loop: false when the run is over (finished_) or stopped at `until_s`.
   absl::StatusOr<bool> Step(double until_s);
   // A problem line if `path` enters a cell already given to a replan.
-  std::optional<std::string> CrossesReported(const std::vector<Waypoint>& path) const;
+  // `kept`: with a walled-in robot's plan, its drive grid (the reported
+  // cell kept free there as the way out is not counted).
+  std::optional<std::string> CrossesReported(const std::vector<Waypoint>& path,
+                                             const Grid* kept = nullptr) const;
 
   PlanSource* const source_;
   const OccupancyMap& truth_;

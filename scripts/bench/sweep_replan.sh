@@ -55,10 +55,12 @@ for r in sorted(runs, key=lambda r: (r["method"], r["clutter"], r["seed"])):
     x = r["run"]
     p = x.get("problems", [])
     n = x.get("num_problems", len(p))  # the list holds the first 20
-    bad += bool(n)
+    cut = not x.get("completed", True)  # e.g. walled in: the termination says why
+    bad += bool(n) or cut
     print(f'{r["method"]:14} {r["clutter"]:>3}% seed {r["seed"]}: problems {n} '
+          + (f'STOPPED ({x.get("termination", "")[:80]}) ' if cut else '') +
           f'replans {x["num_replans"]} stoppage {x["stoppage_s"]:.1f} s '
           f'coverage {x["covered_free_area_ratio"]:.4f}' + (f'  {p[:3]}' if p else ''))
-print(f'{len(runs)} runs, {bad} with problems or failures; runs in {sys.argv[1]}')
+print(f'{len(runs)} runs, {bad} with problems, failures or early stops; runs in {sys.argv[1]}')
 sys.exit(1 if bad else 0)
 EOF

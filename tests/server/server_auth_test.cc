@@ -8,6 +8,7 @@
 #include <grpcpp/grpcpp.h>
 #include <signal.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -454,6 +455,7 @@ TEST_F(ServerAuthTest, ATenantOverItsSolveQuotaIsRefusedAndAnotherIsServed) {
   std::vector<grpc::Status> alpha(kAlphaCalls);
   std::vector<absl::Time> alpha_done(kAlphaCalls);
   std::vector<std::thread> callers;
+  std::atomic<int> refused_so_far{0};
   for (int i = 0; i < kAlphaCalls; ++i) {
     callers.emplace_back([&, i] {
       v1::PlanRequest request = PlanRequestFor(alpha_map.map_id(), 0.3);
@@ -462,9 +464,15 @@ TEST_F(ServerAuthTest, ATenantOverItsSolveQuotaIsRefusedAndAnotherIsServed) {
       v1::PlanResponse response;
       alpha[i] = stub_->Plan(Ctx(kAlpha).get(), request, &response);
       alpha_done[i] = absl::Now();
+      if (alpha[i].error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED) ++refused_so_far;
     });
   }
-  absl::SleepFor(absl::Milliseconds(300));
+  // Every call has arrived once all but the quota's two are refused (at
+  // once); those two hold alpha's quota for their 2 s.
+  const absl::Time arrived_by = absl::Now() + absl::Seconds(10);
+  while (refused_so_far.load() < kAlphaCalls - 2 && absl::Now() < arrived_by) {
+    absl::SleepFor(absl::Milliseconds(10));
+  }
   {  // alpha's Drive session needs a solve too: refused naming the tenant
     auto context = Ctx(kAlpha);
     auto stream = stub_->Drive(context.get());
