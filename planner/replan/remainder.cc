@@ -16,16 +16,17 @@ namespace {
 // straight move from `probe` reaches touching no other blocked cell (a
 // reported obstacle is never clipped) and the robot's cell allows on the
 // old drive grid (no thin wall, no cut corner), into the component the blocking
-// leaves with the most cells still to cover (`to_sweep`: the robot cannot
+// leaves with the most cells still to cover (on `cover`, not `covered`
+// before the robot: it cannot
 // come back through its cell, so the others are cut off and lose the
 // least), nearest first among equals. None: the robot is walled in.
 std::optional<CellIndex> ExitCell(const Grid& old_drive, const Grid& all, Point2 probe,
-                                  const std::vector<uint8_t>& to_sweep) {
+                                  const Grid& cover, const std::vector<uint8_t>& covered) {
   int32_t num = 0;
   const std::vector<int32_t> comp = FreeComponents(all, &num);
   std::vector<int64_t> size(static_cast<size_t>(num), 0);
   for (size_t i = 0; i < comp.size(); ++i) {
-    if (comp[i] >= 0 && to_sweep[i]) ++size[comp[i]];
+    if (comp[i] >= 0 && cover.free_flags()[i] && !covered[i]) ++size[comp[i]];
   }
   const CellIndex own = all.CellAt(probe);
   // The robot's cell was free on the old drive grid: its moves there (thin
@@ -59,10 +60,10 @@ std::optional<CellIndex> ExitCell(const Grid& old_drive, const Grid& all, Point2
 
 // The free flags of the new drive grid: the old drive grid less the `blocked`
 // cells, cut to the component of the robot at `robot_cell` (`probe` is where
-// it stands, for finding its way out of a blocked cell; `to_sweep` what is
-// left to cover, for choosing that way).
+// it stands, for finding its way out of a blocked cell; `cover` less
+// `covered` is what is left to cover, for choosing that way).
 std::vector<uint8_t> NewDriveFlags(const Grid& old_drive, CellIndex robot_cell, Point2 probe,
-                                   const std::vector<uint8_t>& to_sweep,
+                                   const Grid& cover, const std::vector<uint8_t>& covered,
                                    std::vector<uint8_t>* blocked, ReplanStats* st) {
   std::vector<uint8_t> free = old_drive.free_flags();
   for (size_t i = 0; i < free.size(); ++i) {
@@ -76,7 +77,7 @@ std::vector<uint8_t> NewDriveFlags(const Grid& old_drive, CellIndex robot_cell, 
   CellIndex keep_cell = robot_cell;
   if ((*blocked)[old_drive.Index(robot_cell.row, robot_cell.col)]) {
     const std::optional<CellIndex> exit =
-        ExitCell(old_drive, old_drive.WithFreeFlags(free), probe, to_sweep);
+        ExitCell(old_drive, old_drive.WithFreeFlags(free), probe, cover, covered);
     if (exit) {
       keep_cell = *exit;
       st->robot_cell_blocked = true;
@@ -171,10 +172,8 @@ absl::StatusOr<Remainder> ComputeRemainder(const RetainedPlan& old, const RobotP
   rest.end = Pose2{last.x, last.y, last.theta};
 
   ReplanStats& st = out->stats;
-  std::vector<uint8_t> to_sweep = old.area->cover->free_flags();
-  for (size_t i = 0; i < to_sweep.size(); ++i) to_sweep[i] = to_sweep[i] && !covered[i];
-  rest.drive = std::make_shared<const Grid>(
-      old_drive.WithFreeFlags(NewDriveFlags(old_drive, *joined, probe, to_sweep, &blocked, &st)));
+  rest.drive = std::make_shared<const Grid>(old_drive.WithFreeFlags(
+      NewDriveFlags(old_drive, *joined, probe, *old.area->cover, covered, &blocked, &st)));
   const Grid& drive = *rest.drive;
   MoveEndIfCutOff(old_drive, drive, &rest.end, &st);
   rest.to_cover = CellsToCover(*old.area->cover, drive, blocked, covered, out);
