@@ -2,6 +2,11 @@
 // (request id, deadline, the bearer token's tenant), refuses it when the
 // token is bad, the server drains or a request string is over its bound,
 // and at the end finishes it and records it (metrics and one log line).
+// With a token file, calls without a valid token are refused before they
+// get here, at the transport (server/transport_auth.h: TLS and loopback
+// ports) or at the JSON API's door; the gate looks the token up again to
+// learn the call's tenant, and its own refusal is the only one for a
+// plaintext port beyond loopback.
 // Handlers do their own work between Open and Finish and nothing else of
 // the kind.
 //

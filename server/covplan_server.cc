@@ -21,6 +21,7 @@
 #include "server/pg_map_store.h"
 #endif
 #include "server/process_metrics.h"
+#include "server/transport_auth.h"
 
 namespace covplan {
 namespace {
@@ -63,8 +64,18 @@ absl::StatusOr<std::string> ReadPem(const std::string& path, const char* flag) {
   return text.str();
 }
 
+bool IsLoopback(const std::string& address) {
+  return address == "127.0.0.1" || address == "localhost" || address == "::1" || address == "[::1]";
+}
+
+// The listening port's credentials: TLS with --tls_cert, else plaintext.
+// With `auth` (a token file), calls are checked by it at the transport on a
+// TLS port and on a plaintext loopback port (gRPC's local credentials, which
+// take a processor and accept loopback peers only); gRPC 1.51's insecure
+// credentials take none, so a plaintext port beyond loopback checks tokens
+// at the call gate alone.
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(
-    const ServerConfig& config) {
+    const ServerConfig& config, const std::shared_ptr<TransportAuth>& auth) {
   if (config.tls_cert_file.empty() != config.tls_key_file.empty()) {
     return absl::InvalidArgumentError("--tls_cert and --tls_key go together");
   }
@@ -72,7 +83,11 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(
     if (!config.tls_client_ca_file.empty()) {
       return absl::InvalidArgumentError("--tls_client_ca needs --tls_cert and --tls_key");
     }
-    return grpc::InsecureServerCredentials();
+    if (auth == nullptr || !IsLoopback(config.address)) return grpc::InsecureServerCredentials();
+    std::shared_ptr<grpc::ServerCredentials> local =
+        grpc::experimental::LocalServerCredentials(LOCAL_TCP);
+    local->SetAuthMetadataProcessor(auth);
+    return local;
   }
   grpc::SslServerCredentialsOptions options;
   grpc::SslServerCredentialsOptions::PemKeyCertPair pair;
@@ -89,7 +104,9 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> CredentialsFor(
     options.pem_root_certs = *ca;
     options.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
   }
-  return grpc::SslServerCredentials(options);
+  std::shared_ptr<grpc::ServerCredentials> tls = grpc::SslServerCredentials(options);
+  if (auth != nullptr) tls->SetAuthMetadataProcessor(auth);
+  return tls;
 }
 
 absl::StatusOr<std::unique_ptr<MapRepository>> OpenMapStore(const ServerConfig& config) {
@@ -132,13 +149,12 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
     absl::StatusOr<std::unique_ptr<TenantTokens>> tokens = TenantTokens::Load(config.token_file);
     if (!tokens.ok()) return tokens.status();
     server->tokens_ = std::move(*tokens);
-    const bool loopback = config.address == "127.0.0.1" || config.address == "localhost" ||
-                          config.address == "::1" || config.address == "[::1]";
-    if (config.tls_cert_file.empty() && !loopback) {
-      LogLine(
-          "warn",
-          "bearer tokens on a plaintext port beyond loopback travel in the clear; use --tls_cert",
-          {{"address", config.address}});
+    if (config.tls_cert_file.empty() && !IsLoopback(config.address)) {
+      LogLine("warn",
+              "bearer tokens on a plaintext port beyond loopback travel in the clear and are "
+              "checked at the call gate, not the transport (gRPC's plaintext credentials take no "
+              "auth processor); use --tls_cert",
+              {{"address", config.address}});
     }
   }
   absl::StatusOr<std::unique_ptr<TenantQuotas>> quotas =
@@ -190,7 +206,12 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
   builder.SetMaxSendMessageSize(config.max_message_bytes);
   const std::string address = absl::StrCat(config.address, ":", config.port);
-  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials = CredentialsFor(config);
+  std::shared_ptr<TransportAuth> auth =
+      server->tokens_ == nullptr
+          ? nullptr
+          : std::make_shared<TransportAuth>(server->tokens_.get(), server->metrics_.get());
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
+      CredentialsFor(config, auth);
   if (!credentials.ok()) return credentials.status();
   builder.AddListeningPort(address, *credentials, &server->port_);
   builder.RegisterService(server->service_.get());
@@ -209,6 +230,8 @@ absl::StatusOr<std::unique_ptr<CovplanServer>> CovplanServer::Start(const Server
     // bytes fields travel as base64 in JSON: 4/3 of gRPC's limit, and some.
     http.max_body_bytes = int64_t{config.max_message_bytes} * 4 / 3 + (1 << 20);
     http.request_timeout_ms = config.http_request_timeout_ms;
+    http.tokens = server->tokens_.get();
+    http.metrics = server->metrics_.get();
     grpc::ChannelArguments args;
     args.SetMaxReceiveMessageSize(config.max_message_bytes);
     args.SetMaxSendMessageSize(config.max_message_bytes);

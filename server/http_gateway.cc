@@ -27,6 +27,8 @@
 #include "server/console_assets.h"
 #include "server/grpc_status.h"
 #include "server/log.h"
+#include "server/rpc_methods.h"
+#include "server/transport_auth.h"
 
 namespace covplan {
 namespace {
@@ -241,8 +243,9 @@ int HttpGateway::Serve(mg_connection* conn) {
   const mg_request_info* request = mg_get_request_info(conn);
   const absl::string_view uri = request->local_uri != nullptr ? request->local_uri : "";
   if (!absl::StartsWith(uri, kApiPrefix)) return ServeConsole(conn, uri);
-  if (uri == kEventsPath) return ServeEvents(conn);
   const std::string method_name(uri.substr(kApiPrefix.size()));
+  if (!Authenticated(conn, uri == kEventsPath ? "events" : method_name)) return 401;
+  if (uri == kEventsPath) return ServeEvents(conn);
   const pb::ServiceDescriptor* service = pb::DescriptorPool::generated_pool()->FindServiceByName(
       v1::CoveragePlanner::service_full_name());
   const pb::MethodDescriptor* method =
@@ -298,6 +301,21 @@ int HttpGateway::Serve(mg_connection* conn) {
       break;
   }
   return Call(conn, *method, body);
+}
+
+bool HttpGateway::Authenticated(mg_connection* conn, absl::string_view method) {
+  if (options_.tokens == nullptr) return true;
+  const char* authorization = mg_get_header(conn, "Authorization");
+  const absl::StatusOr<std::string> tenant =
+      options_.tokens->Authenticate(authorization != nullptr ? authorization : "");
+  if (tenant.ok()) return true;
+  const std::string label =
+      MethodLabel(absl::StrCat("/", v1::CoveragePlanner::service_full_name(), "/", method));
+  RecordUnauthenticated(options_.metrics, method == "events" ? "events" : label,
+                        tenant.status().message(), "http");
+  SendError(conn, grpc::StatusCode::UNAUTHENTICATED, std::string(tenant.status().message()),
+            /*close=*/true);
+  return false;
 }
 
 int HttpGateway::ServeConsole(mg_connection* conn, absl::string_view uri) {

@@ -40,6 +40,8 @@
 #include "absl/strings/string_view.h"
 #include "absl/synchronization/mutex.h"
 #include "server/live_events.h"
+#include "server/metrics.h"
+#include "server/tenant_tokens.h"
 
 struct mg_context;
 struct mg_connection;
@@ -63,6 +65,14 @@ struct HttpGatewayOptions {
   // Threads serving requests; each open event stream holds one (the
   // service's max_live_streams bounds them).
   int worker_threads = 48;
+  // With --token_file (optional, outlives the gateway): every /v1/ request
+  // must carry "Authorization: Bearer <token>" of a tenant, checked at the
+  // door before its body is read (401 otherwise); the console's files stay
+  // open, so the page can ask for the token. The call gate checks the token
+  // again to learn the tenant.
+  const TenantTokens* tokens = nullptr;
+  // Where refusals at the door are counted (optional, outlives the gateway).
+  ServerMetrics* metrics = nullptr;
 };
 
 class HttpGateway {
@@ -89,6 +99,9 @@ class HttpGateway {
               LiveEvents* live);
   static int HandleApi(mg_connection* conn, void* self);
   int Serve(mg_connection* conn);
+  // With a token file: false once it answered 401 (the request's bearer
+  // token is missing or unknown).
+  bool Authenticated(mg_connection* conn, absl::string_view method);
   // GET / and the console's files (server/console_assets.h); 404 else.
   int ServeConsole(mg_connection* conn, absl::string_view uri);
   // GET /v1/events: the map's live events once GetMap says the caller may

@@ -2,14 +2,12 @@
 
 #include <string>
 
-#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
-#include "covplan/v1/covplan.grpc.pb.h"
-#include "covplan/v1/covplan.pb.h"
 #include "google/protobuf/descriptor.h"
 #include "server/log.h"
+#include "server/rpc_methods.h"
 
 namespace covplan {
 namespace {
@@ -59,17 +57,11 @@ class Factory final : public grpc::experimental::ServerInterceptorFactoryInterfa
   grpc::experimental::Interceptor* CreateServerInterceptor(
       grpc::experimental::ServerRpcInfo* info) override {
     // "/covplan.v1.CoveragePlanner/PutMap": only our unary methods.
-    const std::string prefix = absl::StrCat("/", v1::CoveragePlanner::service_full_name(), "/");
     const char* name = info->method();
-    if (name == nullptr || info->type() != grpc::experimental::ServerRpcInfo::Type::UNARY ||
-        !absl::StartsWith(name, prefix)) {
+    if (name == nullptr || info->type() != grpc::experimental::ServerRpcInfo::Type::UNARY) {
       return nullptr;
     }
-    const google::protobuf::ServiceDescriptor* service =
-        v1::PutMapRequest::descriptor()->file()->FindServiceByName("CoveragePlanner");
-    const google::protobuf::MethodDescriptor* method =
-        service == nullptr ? nullptr
-                           : service->FindMethodByName(std::string(name).substr(prefix.size()));
+    const google::protobuf::MethodDescriptor* method = CoveragePlannerMethod(name);
     if (method == nullptr) return nullptr;
     return new MalformedRequestInterceptor(method, metrics_);
   }

@@ -55,11 +55,13 @@ std::string FromBuffer(const grpc::ByteBuffer& buffer) {
 }
 
 absl::StatusOr<std::string> RawUnaryCall(const std::shared_ptr<grpc::Channel>& channel,
-                                         const std::string& method, const std::string& request) {
+                                         const std::string& method, const std::string& request,
+                                         const std::string& authorization) {
   grpc::GenericStub stub(channel);
   grpc::CompletionQueue cq;
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+  if (!authorization.empty()) context.AddMetadata("authorization", authorization);
   auto call = stub.PrepareUnaryCall(&context, method, ToBuffer(request), &cq);
   call->StartCall();
   grpc::ByteBuffer reply;

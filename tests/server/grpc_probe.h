@@ -28,9 +28,11 @@ namespace covplan::testing {
 std::string FromBuffer(const grpc::ByteBuffer& buffer);
 
 // One unary call of `method` ("/package.Service/Method") with `request` as
-// its raw bytes; the reply's bytes, or the call's status (code and message).
+// its raw bytes (and `authorization` metadata unless empty); the reply's
+// bytes, or the call's status (code and message).
 absl::StatusOr<std::string> RawUnaryCall(const std::shared_ptr<grpc::Channel>& channel,
-                                         const std::string& method, const std::string& request);
+                                         const std::string& method, const std::string& request,
+                                         const std::string& authorization = "");
 
 // grpc.health.v1 ServingStatus: 0 UNKNOWN, 1 SERVING, 2 NOT_SERVING.
 absl::StatusOr<int> HealthStatus(const std::shared_ptr<grpc::Channel>& channel,

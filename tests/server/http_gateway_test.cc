@@ -22,6 +22,7 @@
 #include "absl/strings/str_cat.h"
 #include "api/digest.h"
 #include "covplan/v1/covplan.grpc.pb.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/covplan_server.h"
 #include "tests/server/grpc_probe.h"
@@ -311,6 +312,30 @@ TEST_F(HttpGatewayTest, TokensAndTenantsAreGrpcs) {
   // gRPC with alpha's token sees the map JSON stored.
   v1::GetMapResponse map;
   EXPECT_TRUE(stub_->GetMap(Ctx(kAlpha).get(), get, &map).ok());
+}
+
+// With tokens the door refuses a request without a valid one before its
+// body is read: a body that is not JSON at all is 401, not 400 (which it is
+// with alpha's token), and so is the event stream; the console's page,
+// which asks for the token, stays open.
+TEST_F(HttpGatewayTest, TheTokenIsCheckedAtTheDoorBeforeTheBody) {
+  Start(/*tokens=*/true);
+  const HttpReply anonymous = Post("PutMap", "this is not JSON");
+  EXPECT_EQ(anonymous.status, 401) << anonymous.body;
+  EXPECT_EQ(ErrorOf(anonymous).code, grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_THAT(ErrorOf(anonymous).message, ::testing::HasSubstr("Bearer"));
+  EXPECT_EQ(Post("PutMap", "this is not JSON", "wrong-token").status, 401);
+  EXPECT_EQ(Post("NoSuchMethod", "{}").status, 401) << "no method list for strangers";
+  const HttpReply parsed = Post("PutMap", "this is not JSON", kAlpha);
+  EXPECT_EQ(parsed.status, 400) << parsed.body;
+  EXPECT_EQ(ErrorOf(parsed).code, grpc::StatusCode::INVALID_ARGUMENT);
+  absl::StatusOr<HttpReply> events =
+      HttpRequest(server_->http_port(), "GET", "/v1/events?map_id=m");
+  ASSERT_TRUE(events.ok()) << events.status();
+  EXPECT_EQ(events->status, 401);
+  absl::StatusOr<HttpReply> page = HttpRequest(server_->http_port(), "GET", "/");
+  ASSERT_TRUE(page.ok()) << page.status();
+  EXPECT_EQ(page->status, 200);
 }
 
 // Connects and sends part of a request, then holds the connection.

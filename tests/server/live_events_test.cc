@@ -244,8 +244,14 @@ TEST_F(LiveStreamTest, OnlyCallersWhoMayReadTheMapWatchIt) {
   ASSERT_TRUE(no_map.ok());
   EXPECT_EQ(no_map->status, 400);
   EXPECT_NE(no_map->body.find("map_id"), std::string::npos) << no_map->body;
+  // The token is checked at the door, before the method: 401 without one.
   absl::StatusOr<HttpReply> post = HttpRequest(server_->http_port(), "POST", "/v1/events",
                                                {"Content-Type: application/json"}, "{}");
+  ASSERT_TRUE(post.ok());
+  EXPECT_EQ(post->status, 401);
+  post = HttpRequest(
+      server_->http_port(), "POST", "/v1/events",
+      {"Content-Type: application/json", absl::StrCat("Authorization: Bearer ", kAlpha)}, "{}");
   ASSERT_TRUE(post.ok());
   EXPECT_EQ(post->status, 405);
   // The streams are bounded (max_live_streams, 4 by default): the fifth

@@ -112,6 +112,15 @@ class ServerAuthTest : public ::testing::Test {
     for (const v1::MapInfo& info : response.maps()) ids->push_back(info.map_id());
     return status;
   }
+  // Scrapes /metrics and expects each of `series` ("name{labels} value").
+  void ExpectSeries(std::initializer_list<const char*> series) {
+    absl::StatusOr<std::string> metrics = HttpGet(server_->metrics_port(), "/metrics");
+    ASSERT_TRUE(metrics.ok()) << metrics.status();
+    for (const char* one : series) {
+      EXPECT_NE(metrics->find(one), std::string::npos) << one << " missing from\n" << *metrics;
+    }
+    EXPECT_EQ(metrics->find(R"(tenant="")"), std::string::npos);
+  }
   grpc::Status Plan(const std::string& token, const std::string& map_id,
                     v1::PlanResponse* response) {
     return stub_->Plan(Ctx(token).get(), PlanRequestFor(map_id, 0.3), response);
@@ -161,6 +170,46 @@ TEST_F(ServerAuthTest, CallsWithoutAValidTokenAreUnauthenticatedHealthStaysOpen)
             services->end());
   // A valid token is served.
   EXPECT_TRUE(ListMaps(kAlpha, &ids).ok());
+}
+
+// The token is checked by the transport before gRPC reads the request:
+// a request that is not even a valid protobuf, sent without a valid token,
+// is UNAUTHENTICATED (a handler, or gRPC's own parsing, would have answered
+// INVALID_ARGUMENT), and the refusal is counted and logged as refused at the
+// transport. With alpha's token the same bytes reach the parsing and are
+// INVALID_ARGUMENT.
+TEST_F(ServerAuthTest, TokensAreCheckedAtTheTransportBeforeTheRequestIsRead) {
+  StartServer({"--metrics_port=0"});
+  const std::string junk = "\xff\xff\xff\xff not a protobuf";
+  const std::string put_map = "/covplan.v1.CoveragePlanner/PutMap";
+  for (const std::string& authorization :
+       {std::string(), std::string("Bearer not-a-known-token"), std::string(kAlpha)}) {
+    absl::StatusOr<std::string> reply =
+        testing::RawUnaryCall(channel_, put_map, junk, authorization);
+    ASSERT_FALSE(reply.ok());
+    EXPECT_EQ(reply.status().code(), absl::StatusCode::kUnauthenticated)
+        << "authorization '" << authorization << "': " << reply.status();
+  }
+  absl::StatusOr<std::string> served =
+      testing::RawUnaryCall(channel_, put_map, junk, absl::StrCat("Bearer ", kAlpha));
+  ASSERT_FALSE(served.ok());
+  EXPECT_EQ(served.status().code(), absl::StatusCode::kInvalidArgument) << served.status();
+  // Unknown methods need a token too (a refusal, not UNIMPLEMENTED), labelled "unknown".
+  absl::StatusOr<std::string> unknown = testing::RawUnaryCall(channel_, "/x.Y/Z", "");
+  EXPECT_EQ(unknown.status().code(), absl::StatusCode::kUnauthenticated) << unknown.status();
+
+  ExpectSeries({
+      R"(covplan_requests_total{code="UNAUTHENTICATED",method="PutMap",tenant="unauthenticated"} 3)",
+      R"(covplan_requests_total{code="UNAUTHENTICATED",method="unknown",tenant="unauthenticated"} 1)",
+  });
+  int at_transport = 0;
+  std::istringstream log(server_->log());
+  for (std::string line; std::getline(log, line);) {
+    if (line.find("refused_at=transport") != std::string::npos &&
+        line.find("code=UNAUTHENTICATED") != std::string::npos)
+      ++at_transport;
+  }
+  EXPECT_EQ(at_transport, 4) << server_->log();
 }
 
 TEST_F(ServerAuthTest, TenantsSeeOnlyTheirOwnMapsAndPlans) {
@@ -299,18 +348,12 @@ TEST_F(ServerAuthTest, TheTenantLabelsTheRequestMetricsAndTheLogLine) {
   std::vector<std::string> ids;
   ASSERT_TRUE(ListMaps(kBeta, &ids).ok());
   ASSERT_EQ(ListMaps("", &ids).error_code(), grpc::StatusCode::UNAUTHENTICATED);
-  absl::StatusOr<std::string> metrics = HttpGet(server_->metrics_port(), "/metrics");
-  ASSERT_TRUE(metrics.ok()) << metrics.status();
-  for (
-      const char* series : {
-          R"(covplan_requests_total{code="OK",method="PutMap",tenant="alpha"} 1)",
-          R"(covplan_requests_total{code="OK",method="ListMaps",tenant="beta"} 1)",
-          R"(covplan_requests_total{code="UNAUTHENTICATED",method="ListMaps",tenant="unauthenticated"} 1)",
-          R"(covplan_request_duration_seconds_count{method="PutMap",tenant="alpha"} 1)",
-      }) {
-    EXPECT_NE(metrics->find(series), std::string::npos) << series << " missing from\n" << *metrics;
-  }
-  EXPECT_EQ(metrics->find(R"(tenant="")"), std::string::npos);
+  ExpectSeries({
+      R"(covplan_requests_total{code="OK",method="PutMap",tenant="alpha"} 1)",
+      R"(covplan_requests_total{code="OK",method="ListMaps",tenant="beta"} 1)",
+      R"(covplan_requests_total{code="UNAUTHENTICATED",method="ListMaps",tenant="unauthenticated"} 1)",
+      R"(covplan_request_duration_seconds_count{method="PutMap",tenant="alpha"} 1)",
+  });
   // The log lines of the three calls, each with its tenant.
   std::set<std::string> seen;
   std::istringstream log(server_->log());
