@@ -4,8 +4,8 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/match.h"
-#include "server/log.h"
 #include "server/grpc_status.h"
+#include "server/log.h"
 #include "server/rpc_methods.h"
 
 namespace covplan {

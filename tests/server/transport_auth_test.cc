@@ -25,8 +25,7 @@ class TransportAuthTest : public ::testing::Test {
     ASSERT_NE(mkdtemp(pattern.data()), nullptr);
     dir_ = pattern;
     std::ofstream(dir_ + "/tokens.txt") << Sha256Hex("alpha-token") << " alpha\n";
-    absl::StatusOr<std::unique_ptr<TenantTokens>> tokens =
-        TenantTokens::Load(dir_ + "/tokens.txt");
+    absl::StatusOr<std::unique_ptr<TenantTokens>> tokens = TenantTokens::Load(dir_ + "/tokens.txt");
     ASSERT_TRUE(tokens.ok()) << tokens.status();
     tokens_ = std::move(*tokens);
     auth_ = std::make_unique<TransportAuth>(tokens_.get(), &metrics_);
