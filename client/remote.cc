@@ -6,10 +6,15 @@
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/support/proto_buffer_reader.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <limits>
+#include <random>
 
+#include "absl/strings/str_cat.h"
 #include "api/convert.h"
 #include "covplan/v1/covplan.grpc.pb.h"
+#include "planner/common/status_macros.h"
 
 namespace covplan {
 namespace {
@@ -39,6 +44,12 @@ std::shared_ptr<grpc::Channel> ChannelFor(const Connection& connection) {
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(256 << 20);
   arguments.SetMaxSendMessageSize(256 << 20);
+  // A server that went away is looked for again soon (gRPC's defaults wait
+  // 1 s, then up to 2 minutes): a Drive session reconnecting after its
+  // replica died finds the next one within its 2 s backoff.
+  arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
+  arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
+  arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 2000);
   std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
   if (connection.tls) {
     grpc::SslCredentialsOptions options;
@@ -59,6 +70,7 @@ void AddCallCredentials(const Connection& connection, grpc::ClientContext* conte
 
 struct RemotePlanner::Impl {
   Connection connection;
+  std::shared_ptr<grpc::Channel> channel;
   std::unique_ptr<v1::CoveragePlanner::Stub> stub;
   std::unique_ptr<grpc::GenericStub> generic;
 };
@@ -130,9 +142,9 @@ std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const std::string& target)
 std::unique_ptr<RemotePlanner> RemotePlanner::Connect(const Connection& connection) {
   auto impl = std::make_unique<Impl>();
   impl->connection = connection;
-  std::shared_ptr<grpc::Channel> channel = ChannelFor(connection);
-  impl->stub = v1::CoveragePlanner::NewStub(channel);
-  impl->generic = std::make_unique<grpc::GenericStub>(channel);
+  impl->channel = ChannelFor(connection);
+  impl->stub = v1::CoveragePlanner::NewStub(impl->channel);
+  impl->generic = std::make_unique<grpc::GenericStub>(impl->channel);
   return std::unique_ptr<RemotePlanner>(new RemotePlanner(std::move(impl)));
 }
 
@@ -209,11 +221,11 @@ struct RemotePlanner::DriveSession::Stream {
   std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> rw;
 };
 
-RemotePlanner::DriveSession::DriveSession(std::unique_ptr<Stream> stream)
-    : stream_(std::move(stream)) {}
+RemotePlanner::DriveSession::DriveSession(Impl* owner, const v1::DriveRequest& first)
+    : owner_(owner), first_(first) {}
 
 RemotePlanner::DriveSession::~DriveSession() {
-  if (!closed_) {
+  if (!closed_ && stream_ != nullptr) {
     stream_->context.TryCancel();
     stream_->rw->Finish().ok();
   }
@@ -221,10 +233,14 @@ RemotePlanner::DriveSession::~DriveSession() {
 
 absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(
     const v1::DriveRequest& first) {
+  std::unique_ptr<DriveSession> session(new DriveSession(impl_.get(), first));
+  // The first message's obstacles are replanned once; a reopened session
+  // sends only where the robot is.
+  session->first_.clear_obstacles();
   auto stream = std::make_unique<DriveSession::Stream>();
   AddCallCredentials(impl_->connection, &stream->context);
   stream->rw = impl_->stub->Drive(&stream->context);
-  std::unique_ptr<DriveSession> session(new DriveSession(std::move(stream)));
+  session->stream_ = std::move(stream);
   v1::DriveEvent event;
   if (!session->stream_->rw->Write(first) || !session->stream_->rw->Read(&event)) {
     session->closed_ = true;
@@ -237,26 +253,110 @@ absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Driv
   return session;
 }
 
-absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(
-    const v1::DriveRequest& request) {
-  if (closed_) return absl::FailedPreconditionError("the drive session is closed");
-  if (!stream_->rw->Write(request)) {
-    const absl::Status s = Close();
-    return s.ok() ? absl::UnavailableError("the drive session ended") : s;
+absl::Status RemotePlanner::DriveSession::Open() {
+  auto stream = std::make_unique<Stream>();
+  AddCallCredentials(owner_->connection, &stream->context);
+  stream->rw = owner_->stub->Drive(&stream->context);
+  stream_ = std::move(stream);
+  closed_ = false;
+  v1::DriveEvent event;
+  if (!stream_->rw->Write(first_) || !stream_->rw->Read(&event)) return Broken();
+  if (!event.has_ready()) {
+    closed_ = true;
+    return absl::InternalError("the reopened drive session's first event is not `ready`");
   }
+  ready_ = event.ready();
+  return absl::OkStatus();
+}
+
+absl::Status RemotePlanner::DriveSession::Broken() {
+  closed_ = true;
+  v1::DriveEvent rest;  // a failed Write: the call is over, the reads end at once
+  while (stream_->rw->Read(&rest)) {
+  }
+  const absl::Status s = FromGrpc(stream_->rw->Finish());
+  // The server ended the call itself (not a broken link): nothing to retry.
+  return s.ok() ? absl::AbortedError("the server ended the drive session") : s;
+}
+
+absl::Status RemotePlanner::DriveSession::Reconnect(absl::Status broken) {
+  const absl::Time start = absl::Now();
+  // Each wait jittered by +-20 %, so a fleet whose replica died does not
+  // come back in lockstep.
+  std::minstd_rand jitter(static_cast<uint32_t>(reinterpret_cast<uintptr_t>(this) >> 4) ^
+                          static_cast<uint32_t>(absl::ToUnixMicros(start)));
+  absl::Duration backoff = absl::Milliseconds(100);
+  while (absl::IsUnavailable(broken)) {
+    const absl::Duration wait = backoff * std::uniform_real_distribution<double>(0.8, 1.2)(jitter);
+    if (absl::Now() - start + wait > kReconnectBudget) {
+      return absl::UnavailableError(
+          absl::StrCat("the drive session broke and no server took it back within ",
+                       absl::FormatDuration(kReconnectBudget), ": ", broken.message()));
+    }
+    // Until the channel is connected again (asking it to try), or after the
+    // wait. Connected already (a server that answered UNAVAILABLE, e.g. one
+    // draining): the whole wait.
+    const absl::Time wake = absl::Now() + wait;
+    if (owner_->channel->GetState(/*try_to_connect=*/false) == GRPC_CHANNEL_READY ||
+        !owner_->channel->WaitForConnected(absl::ToChronoTime(wake))) {
+      absl::SleepFor(wake - absl::Now());
+    }
+    backoff = std::min(2 * backoff, absl::Seconds(1));
+    broken = Open();
+    if (broken.ok()) {
+      reconnect_s_.push_back(absl::ToDoubleSeconds(absl::Now() - start));
+      return absl::OkStatus();
+    }
+  }
+  return broken;
+}
+
+void RemotePlanner::DriveSession::Remember(const v1::DriveRequest& request) {
+  if (request.has_progress()) {
+    *first_.mutable_progress() = request.progress();
+    // The progress refers to the plan the request names.
+    if (request.plan_ref_case() == v1::DriveRequest::kPlanId) first_.set_plan_id(request.plan_id());
+  }
+}
+
+absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Exchange(
+    const v1::DriveRequest& request) {
+  if (!stream_->rw->Write(request)) return Broken();
   v1::DriveEvent event;
   while (stream_->rw->Read(&event)) {
     if (event.sequence() == request.sequence()) return event;
   }
-  closed_ = true;
-  const absl::Status s = FromGrpc(stream_->rw->Finish());
-  return s.ok() ? absl::UnavailableError("the drive session ended before answering") : s;
+  return Broken();
+}
+
+absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(
+    const v1::DriveRequest& request) {
+  if (closed_) return absl::FailedPreconditionError("the drive session is closed");
+  Remember(request);
+  absl::StatusOr<v1::DriveEvent> event = Exchange(request);
+  // Unanswered: once more on a new stream, as often as the server goes away.
+  while (!event.ok() && absl::IsUnavailable(event.status())) {
+    RETURN_IF_ERROR(Reconnect(event.status()));
+    event = Exchange(request);
+  }
+  if (!event.ok()) return event.status();
+  // The robot drives the new plan from here: a reopened session starts on it
+  // (the server stored it before it sent it).
+  if (event->has_replan() && !event->replan().plan().plan_id().empty()) {
+    first_.set_plan_id(event->replan().plan().plan_id());
+    first_.clear_progress();
+  }
+  return event;
 }
 
 absl::Status RemotePlanner::DriveSession::Report(const v1::DriveRequest& request) {
   if (closed_) return absl::FailedPreconditionError("the drive session is closed");
-  if (!stream_->rw->Write(request)) return absl::UnavailableError("the drive session ended");
-  return absl::OkStatus();
+  Remember(request);
+  if (stream_->rw->Write(request)) return absl::OkStatus();
+  const absl::Status broken = Broken();
+  if (!absl::IsUnavailable(broken)) return broken;
+  // The reopened session starts from this report's progress: nothing to resend.
+  return Reconnect(broken);
 }
 
 absl::Status RemotePlanner::DriveSession::Close() {

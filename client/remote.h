@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
@@ -38,6 +39,8 @@ std::string ServerError(const std::string& target, const absl::Status& status);
 void AddCallCredentials(const Connection& connection, grpc::ClientContext* context);
 
 class RemotePlanner {
+  struct Impl;
+
  public:
   static std::unique_ptr<RemotePlanner> Connect(const std::string& target);  // plaintext, no token
   static std::unique_ptr<RemotePlanner> Connect(const Connection& connection);
@@ -65,27 +68,52 @@ class RemotePlanner {
   // A Drive session, driven synchronously: Open sends the first message and
   // waits for the ready event; Observe sends an observation and waits for the
   // event that answers it; Report sends progress only.
+  //
+  // The session outlives its server: when the stream breaks with
+  // UNAVAILABLE (the replica died or drains, the link dropped), the session
+  // opens a new one on the same channel (a router sends it to a live
+  // replica) with backoff, 100 ms doubling to 1 s (+-20 %), for up to
+  // kReconnectBudget, as the protocol asks of a robot (docs/robustness.md):
+  // the first message names the newest plan the session received (the
+  // server stores a replan before it sends it), carries the latest progress
+  // sent and the session's method and seed; then the observation that was
+  // not answered is sent again. Other errors end the session as before.
   class DriveSession {
    public:
+    static constexpr absl::Duration kReconnectBudget = absl::Seconds(30);
     ~DriveSession();  // cancels the call if Close was not called
     const v1::DriveReady& ready() const { return ready_; }
     absl::StatusOr<v1::DriveEvent> Observe(const v1::DriveRequest& request);
     absl::Status Report(const v1::DriveRequest& request);
     // Half-closes and returns the call's final status.
     absl::Status Close();
+    // How long each reconnect took, from the break to the new ready event.
+    const std::vector<double>& reconnect_seconds() const { return reconnect_s_; }
 
    private:
     friend class RemotePlanner;
     struct Stream;
-    explicit DriveSession(std::unique_ptr<Stream> stream);
+    DriveSession(Impl* owner, const v1::DriveRequest& first);
+    // Opens a stream with `first_` and reads its ready event.
+    absl::Status Open();
+    // After a break: reopens with backoff while the answer is UNAVAILABLE.
+    absl::Status Reconnect(absl::Status broken);
+    // The stream's final status once Write or Read failed.
+    absl::Status Broken();
+    // One exchange on the current stream: the answer to `request`.
+    absl::StatusOr<v1::DriveEvent> Exchange(const v1::DriveRequest& request);
+    void Remember(const v1::DriveRequest& request);
+
+    Impl* const owner_;       // opens the streams; outlives the session
+    v1::DriveRequest first_;  // plan_id: the newest plan received
     std::unique_ptr<Stream> stream_;
     v1::DriveReady ready_;
     bool closed_ = false;
+    std::vector<double> reconnect_s_;
   };
   absl::StatusOr<std::unique_ptr<DriveSession>> Drive(const v1::DriveRequest& first);
 
  private:
-  struct Impl;
   explicit RemotePlanner(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

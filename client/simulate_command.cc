@@ -375,7 +375,7 @@ void AddBatteryFields(const BatteryRun& b, const SimulationOptions& o, JsonObjec
 
 std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::string& truth_name,
                     const SimulationResult& r, const OfflineBound& bound,
-                    const OfflineBound& cell_bound) {
+                    const OfflineBound& cell_bound, const std::vector<double>& reconnects) {
   const double total_ms = std::accumulate(r.replan_ms.begin(), r.replan_ms.end(), 0.0);
   double max_ms = 0.0;
   for (double ms : r.replan_ms) max_ms = std::max(max_ms, ms);
@@ -389,6 +389,13 @@ std::string RunJson(const ParsedArgs& a, const SimulationOptions& o, const std::
   json.Field("method", JsonString(ReplanMethodName(o.method)));
   json.Field("planner_at",
              JsonString(a.Get("server") ? absl::StrCat("server ", *a.Get("server")) : "local"));
+  if (a.Get("server")) {
+    // The Drive session's reconnects after its server went away.
+    double longest = 0.0;
+    for (double t : reconnects) longest = std::max(longest, t);
+    json.Field("server_reconnects", absl::StrCat(reconnects.size()));
+    json.Field("max_reconnect_s", JsonNumber(longest));
+  }
   json.Field("true_map", JsonString(truth_name));
   json.Field("total_time_s", JsonNumber(r.total_time_s));
   json.Field("drive_time_s", JsonNumber(r.drive_time_s));
@@ -502,7 +509,8 @@ absl::StatusOr<std::string> SimulateCommandJson(const std::vector<std::string>& 
 
   if (auto svg_path = a.Get("svg")) RETURN_IF_ERROR(WriteRunSvg(*svg_path, truth, r, o));
 
-  return RunJson(a, o, true_map.name, r, bound, cell_bound);
+  return RunJson(a, o, true_map.name, r, bound, cell_bound,
+                 remote != nullptr ? remote->ReconnectSeconds() : std::vector<double>());
 }
 
 namespace {

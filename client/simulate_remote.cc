@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -91,6 +92,10 @@ class ServerPlanSource final : public PlanSource {
   }
 
   bool WatchesMoves() const override { return watch_speed_ > 0.0; }
+
+  std::vector<double> ReconnectSeconds() const override {
+    return session_ != nullptr ? session_->reconnect_seconds() : std::vector<double>();
+  }
 
   // Paced: the run's clock at watch_speed_ times real time. Like a real
   // robot it reports at a steady 20 Hz, turning in place or driving (a

@@ -95,25 +95,40 @@ void PlanArchive::PublishRetainedCount() {
   metrics_->plans_retained().Set(static_cast<double>(plans_.size()));
 }
 
-void PlanArchive::Persist(const v1::PlanRequest& origin, const v1::PlanResponse& plan) {
+std::shared_ptr<std::string> PlanArchive::Record(const v1::PlanRequest& origin,
+                                                 const v1::PlanResponse& plan) {
   v1::InlinePlan record;
   *record.mutable_request() = origin;
   *record.mutable_plan() = plan;
   auto bytes = std::make_shared<std::string>();
-  if (!record.SerializeToString(bytes.get())) return;
+  if (!record.SerializeToString(bytes.get())) return nullptr;
+  RememberOrigin(plan.plan_id(), std::make_shared<const v1::PlanRequest>(origin));
+  return bytes;
+}
+
+void PlanArchive::Write(const std::string& plan_id, const std::string& bytes) {
+  if (absl::Status s = store_->PutPlan(plan_id, bytes); !s.ok()) {
+    LogLine("warn", "plan not persisted",
+            {{"plan", plan_id}, {"detail", std::string(s.message())}});
+    return;
+  }
+  if (persisted_.fetch_add(1) % 256 == 255) {
+    io_pool_->TrySubmit([this] { store_->TrimPlans(options_.max_stored_plans); });
+  }
+}
+
+void PlanArchive::Persist(const v1::PlanRequest& origin, const v1::PlanResponse& plan) {
+  std::shared_ptr<std::string> bytes = Record(origin, plan);
+  if (bytes == nullptr) return;
   const std::string plan_id = plan.plan_id();
-  RememberOrigin(plan_id, std::make_shared<const v1::PlanRequest>(origin));
   // Off the reply's path: the disk write (with its fsyncs) runs on the I/O
   // pool after the answer is on its way.
-  const bool queued = io_pool_->TrySubmit([this, bytes, plan_id] {
-    if (absl::Status s = store_->PutPlan(plan_id, *bytes); !s.ok()) {
-      LogLine("warn", "plan not persisted",
-              {{"plan", plan_id}, {"detail", std::string(s.message())}});
-      return;
-    }
-    if (persisted_.fetch_add(1) % 256 == 255) store_->TrimPlans(options_.max_stored_plans);
-  });
+  const bool queued = io_pool_->TrySubmit([this, bytes, plan_id] { Write(plan_id, *bytes); });
   if (!queued) LogLine("warn", "plan not persisted: I/O queue full", {{"plan", plan_id}});
+}
+
+void PlanArchive::PersistNow(const v1::PlanRequest& origin, const v1::PlanResponse& plan) {
+  if (std::shared_ptr<std::string> bytes = Record(origin, plan)) Write(plan.plan_id(), *bytes);
 }
 
 void PlanArchive::RememberOrigin(const std::string& plan_id,

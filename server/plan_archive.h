@@ -58,8 +58,15 @@ class PlanArchive {
   // The plans-retained gauge.
   void PublishRetainedCount();
 
-  // Writes the plan (with the original request it continues) to the store.
+  // Writes the plan (with the original request it continues) to the store,
+  // on the I/O pool.
   void Persist(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
+  // The same write on the caller's thread, done when it returns: a replan
+  // is stored before its robot receives it, so a robot whose replica dies
+  // continues on another from the newest plan it holds (docs/robustness.md,
+  // "Drive sessions that outlive their replica"). A failed write is logged,
+  // as Persist's; the call still succeeds.
+  void PersistNow(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
   // Names `original_id`'s plan `alias_id` too, a mission of its own (a
   // repeated Plan answered from memory), retained as an alias that starts
   // from the original's origin. When the alias is first used (Get, Find),
@@ -94,6 +101,11 @@ class PlanArchive {
     std::string original_id;
     std::string record;  // a serialised v1::InlinePlan
   };
+  // The stored record of `plan` (null if it does not serialise); remembers
+  // its origin.
+  std::shared_ptr<std::string> Record(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
+  // Stores a record (a failure is logged) and trims the store now and then.
+  void Write(const std::string& plan_id, const std::string& bytes);
   void RememberOrigin(const std::string& plan_id, std::shared_ptr<const v1::PlanRequest> origin);
   // The origin of `plan_id`, or of the original it is an alias of; false
   // when none is known.

@@ -173,7 +173,9 @@ void ReplanWork::KeepReplan(ReplanResult result, const ResolvedPlan& old,
   retained->request = old.plan->request;
   result.plan = retained->plan;
   ReplanToProto(result, *retained, response);
-  if (old.has_origin) archive_->Persist(old.origin, response->plan());
+  // Stored before the robot receives it (the caller answers after this
+  // returns): the plan a robot holds survives its replica.
+  if (old.has_origin) archive_->PersistNow(old.origin, response->plan());
   // A robot of a fleet mission drives the new plan now: the mission follows
   // (a Drive session's replan only once the session adopts it).
   if (missions_ != nullptr && mission_follows) {

@@ -166,6 +166,9 @@ class PlanSource {
   // The robot moved: it stands at `at` on the plan it drives, `clock_s`
   // seconds into the run (a watched run paces itself and reports it).
   virtual void Moved(const RobotProgress& at, double clock_s) {}
+  // A remote source: how long each reconnect to its planner took, in
+  // seconds (the server went away mid-run). Empty in process.
+  virtual std::vector<double> ReconnectSeconds() const { return {}; }
 };
 
 // InvalidArgument when the options are bad, the maps differ in size,
