@@ -221,8 +221,9 @@ struct RemotePlanner::DriveSession::Stream {
   std::unique_ptr<grpc::ClientReaderWriter<v1::DriveRequest, v1::DriveEvent>> rw;
 };
 
-RemotePlanner::DriveSession::DriveSession(Impl* owner, const v1::DriveRequest& first)
-    : owner_(owner), first_(first) {}
+RemotePlanner::DriveSession::DriveSession(Impl* owner, const v1::DriveRequest& first,
+                                          const std::string& map_id)
+    : owner_(owner), first_(first), map_id_(map_id) {}
 
 RemotePlanner::DriveSession::~DriveSession() {
   if (!closed_ && stream_ != nullptr) {
@@ -232,13 +233,14 @@ RemotePlanner::DriveSession::~DriveSession() {
 }
 
 absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(
-    const v1::DriveRequest& first) {
-  std::unique_ptr<DriveSession> session(new DriveSession(impl_.get(), first));
+    const v1::DriveRequest& first, const std::string& map_id) {
+  std::unique_ptr<DriveSession> session(new DriveSession(impl_.get(), first, map_id));
   // The first message's obstacles are replanned once; a reopened session
   // sends only where the robot is.
   session->first_.clear_obstacles();
   auto stream = std::make_unique<DriveSession::Stream>();
   AddCallCredentials(impl_->connection, &stream->context);
+  SetMapId(&stream->context, map_id);
   stream->rw = impl_->stub->Drive(&stream->context);
   session->stream_ = std::move(stream);
   v1::DriveEvent event;
@@ -256,6 +258,7 @@ absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Driv
 absl::Status RemotePlanner::DriveSession::Open() {
   auto stream = std::make_unique<Stream>();
   AddCallCredentials(owner_->connection, &stream->context);
+  SetMapId(&stream->context, map_id_);
   stream->rw = owner_->stub->Drive(&stream->context);
   stream_ = std::move(stream);
   closed_ = false;
@@ -279,6 +282,18 @@ absl::Status RemotePlanner::DriveSession::Broken() {
   return s.ok() ? absl::AbortedError("the server ended the drive session") : s;
 }
 
+namespace {
+
+// A stream that broke on the way rather than one a server ended: UNAVAILABLE
+// (the replica died or drains, the link dropped) or UNKNOWN (no status
+// reached the client: a proxy such as HAProxy ended the stream when its
+// replica died, "No status received"; covplan servers send no UNKNOWN).
+bool LinkBroke(const absl::Status& status) {
+  return absl::IsUnavailable(status) || absl::IsUnknown(status);
+}
+
+}  // namespace
+
 absl::Status RemotePlanner::DriveSession::Reconnect(absl::Status broken) {
   const absl::Time start = absl::Now();
   // Each wait jittered by +-20 %, so a fleet whose replica died does not
@@ -286,7 +301,7 @@ absl::Status RemotePlanner::DriveSession::Reconnect(absl::Status broken) {
   std::minstd_rand jitter(static_cast<uint32_t>(reinterpret_cast<uintptr_t>(this) >> 4) ^
                           static_cast<uint32_t>(absl::ToUnixMicros(start)));
   absl::Duration backoff = absl::Milliseconds(100);
-  while (absl::IsUnavailable(broken)) {
+  while (LinkBroke(broken)) {
     const absl::Duration wait = backoff * std::uniform_real_distribution<double>(0.8, 1.2)(jitter);
     if (absl::Now() - start + wait > kReconnectBudget) {
       return absl::UnavailableError(
@@ -335,7 +350,7 @@ absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(
   Remember(request);
   absl::StatusOr<v1::DriveEvent> event = Exchange(request);
   // Unanswered: once more on a new stream, as often as the server goes away.
-  while (!event.ok() && absl::IsUnavailable(event.status())) {
+  while (!event.ok() && LinkBroke(event.status())) {
     RETURN_IF_ERROR(Reconnect(event.status()));
     event = Exchange(request);
   }
@@ -354,7 +369,7 @@ absl::Status RemotePlanner::DriveSession::Report(const v1::DriveRequest& request
   Remember(request);
   if (stream_->rw->Write(request)) return absl::OkStatus();
   const absl::Status broken = Broken();
-  if (!absl::IsUnavailable(broken)) return broken;
+  if (!LinkBroke(broken)) return broken;
   // The reopened session starts from this report's progress: nothing to resend.
   return Reconnect(broken);
 }

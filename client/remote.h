@@ -70,7 +70,8 @@ class RemotePlanner {
   // event that answers it; Report sends progress only.
   //
   // The session outlives its server: when the stream breaks with
-  // UNAVAILABLE (the replica died or drains, the link dropped), the session
+  // UNAVAILABLE (the replica died or drains, the link dropped) or UNKNOWN
+  // (no status reached the client: a proxy ended it), the session
   // opens a new one on the same channel (a router sends it to a live
   // replica) with backoff, 100 ms doubling to 1 s (+-20 %), for up to
   // kReconnectBudget, as the protocol asks of a robot (docs/robustness.md):
@@ -93,7 +94,7 @@ class RemotePlanner {
    private:
     friend class RemotePlanner;
     struct Stream;
-    DriveSession(Impl* owner, const v1::DriveRequest& first);
+    DriveSession(Impl* owner, const v1::DriveRequest& first, const std::string& map_id);
     // Opens a stream with `first_` and reads its ready event.
     absl::Status Open();
     // After a break: reopens with backoff while the answer is UNAVAILABLE.
@@ -104,14 +105,19 @@ class RemotePlanner {
     absl::StatusOr<v1::DriveEvent> Exchange(const v1::DriveRequest& request);
     void Remember(const v1::DriveRequest& request);
 
-    Impl* const owner_;       // opens the streams; outlives the session
-    v1::DriveRequest first_;  // plan_id: the newest plan received
+    Impl* const owner_;         // opens the streams; outlives the session
+    v1::DriveRequest first_;    // plan_id: the newest plan received
+    const std::string map_id_;  // routing metadata of every stream
     std::unique_ptr<Stream> stream_;
     v1::DriveReady ready_;
     bool closed_ = false;
     std::vector<double> reconnect_s_;
   };
-  absl::StatusOr<std::unique_ptr<DriveSession>> Drive(const v1::DriveRequest& first);
+  // `map_id` (optional: the plan's map) is sent as routing metadata on the
+  // session's streams, so a map-affine router sends the session to the
+  // replica that planned on that map (the plan is in its memory).
+  absl::StatusOr<std::unique_ptr<DriveSession>> Drive(const v1::DriveRequest& first,
+                                                      const std::string& map_id = "");
 
  private:
   explicit RemotePlanner(std::unique_ptr<Impl> impl);

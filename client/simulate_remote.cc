@@ -50,7 +50,7 @@ class ServerPlanSource final : public PlanSource {
     first.set_method(method_);
     first.set_seed(seed_);
     first.set_sequence(next_sequence_++);
-    ASSIGN_OR_RETURN(session_, remote_->Drive(first));
+    ASSIGN_OR_RETURN(session_, remote_->Drive(first, planned.map_id()));
     current_plan_id_ = planned.plan_id();
     started_ = absl::Now();
     RetainedPlan retained;

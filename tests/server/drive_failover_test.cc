@@ -70,7 +70,8 @@ bool WaitForLog(const ServerProcess& server, const std::string& text, absl::Dura
 }
 
 TEST(DriveFailover, ARobotContinuesOnTheNextServerWhenItsServerIsKilled) {
-  std::string pattern = (std::filesystem::temp_directory_path() / "covplan_failover_XXXXXX").string();
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / "covplan_failover_XXXXXX").string();
   ASSERT_NE(mkdtemp(pattern.data()), nullptr);
   const std::string store = pattern + "/maps";
   ServerProcess first;
@@ -116,7 +117,8 @@ TEST(DriveFailover, ARobotContinuesOnTheNextServerWhenItsServerIsKilled) {
   // an obstacle in a doorway cuts off, with or without a failure).
   EXPECT_GE(JsonNumberField(*json, "swept_reachable_ratio"),
             JsonNumberField(*uninterrupted, "swept_reachable_ratio") - 0.03)
-      << *json << "\n" << *uninterrupted;
+      << *json << "\n"
+      << *uninterrupted;
   EXPECT_GE(JsonNumberField(*json, "swept_reachable_ratio"), 0.9) << *json;
   std::cerr << "failover: server_reconnects " << JsonNumberField(*json, "server_reconnects")
             << ", max_reconnect_s " << JsonNumberField(*json, "max_reconnect_s")
