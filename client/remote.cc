@@ -265,7 +265,8 @@ absl::Status RemotePlanner::DriveSession::Open() {
   v1::DriveEvent event;
   if (!stream_->rw->Write(first_) || !stream_->rw->Read(&event)) return Broken();
   if (!event.has_ready()) {
-    closed_ = true;
+    stream_->context.TryCancel();
+    Broken().IgnoreError();
     return absl::InternalError("the reopened drive session's first event is not `ready`");
   }
   ready_ = event.ready();
@@ -301,7 +302,10 @@ absl::Status RemotePlanner::DriveSession::Reconnect(absl::Status broken) {
   std::minstd_rand jitter(static_cast<uint32_t>(reinterpret_cast<uintptr_t>(this) >> 4) ^
                           static_cast<uint32_t>(absl::ToUnixMicros(start)));
   absl::Duration backoff = absl::Milliseconds(100);
-  while (LinkBroke(broken)) {
+  // A reopened stream may also be refused as busy (the survivors of a dead
+  // replica take its whole fleet at once: RESOURCE_EXHAUSTED from admission
+  // or a tenant quota): waited out like a broken link.
+  while (LinkBroke(broken) || absl::IsResourceExhausted(broken)) {
     const absl::Duration wait = backoff * std::uniform_real_distribution<double>(0.8, 1.2)(jitter);
     if (absl::Now() - start + wait > kReconnectBudget) {
       return absl::UnavailableError(
@@ -349,8 +353,14 @@ absl::StatusOr<v1::DriveEvent> RemotePlanner::DriveSession::Observe(
   if (closed_) return absl::FailedPreconditionError("the drive session is closed");
   Remember(request);
   absl::StatusOr<v1::DriveEvent> event = Exchange(request);
-  // Unanswered: once more on a new stream, as often as the server goes away.
-  while (!event.ok() && LinkBroke(event.status())) {
+  // Unanswered: once more on a new stream, a few times at most (a request
+  // that took its server down each time would otherwise loop forever).
+  for (int resent = 0; !event.ok() && LinkBroke(event.status()); ++resent) {
+    if (resent == kMaxResends) {
+      return absl::UnavailableError(absl::StrCat(
+          "the drive session broke ", kMaxResends + 1,
+          " times while this observation waited for its answer: ", event.status().message()));
+    }
     RETURN_IF_ERROR(Reconnect(event.status()));
     event = Exchange(request);
   }

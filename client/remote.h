@@ -78,10 +78,15 @@ class RemotePlanner {
   // the first message names the newest plan the session received (the
   // server stores a replan before it sends it), carries the latest progress
   // sent and the session's method and seed; then the observation that was
-  // not answered is sent again. Other errors end the session as before.
+  // not answered is sent again (at most kMaxResends times). A reopened
+  // stream refused as busy (RESOURCE_EXHAUSTED) is retried the same way.
+  // Other errors end the session as before. A session must not outlive its
+  // RemotePlanner.
   class DriveSession {
    public:
     static constexpr absl::Duration kReconnectBudget = absl::Seconds(30);
+    // How often one observation is sent again on a new stream.
+    static constexpr int kMaxResends = 4;
     ~DriveSession();  // cancels the call if Close was not called
     const v1::DriveReady& ready() const { return ready_; }
     absl::StatusOr<v1::DriveEvent> Observe(const v1::DriveRequest& request);

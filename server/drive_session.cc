@@ -14,6 +14,7 @@
 #include "server/grpc_status.h"
 #include "server/log.h"
 #include "server/request_limits.h"
+#include "server/tenant_tokens.h"
 
 namespace covplan {
 namespace {
@@ -227,7 +228,15 @@ void DriveSession::HandleMessage(Actions* a) {
     job.sequence = seq;
     pending_ = std::move(job);
     StartJob(a);
-    if (ObstacleItems(in_.obstacles()) == 0) return;
+    if (ObstacleItems(in_.obstacles()) == 0) {
+      // Where the robot is (a robot that reconnected says so first): kept for
+      // Resume like any report, on a plan of the caller's tenant.
+      if (in_.has_progress() && in_.plan_ref_case() == v1::DriveRequest::kPlanId &&
+          OwnsPlan(tenant_.tag, in_.plan_id())) {
+        host_->RecordProgress(in_.plan_id(), in_.progress());
+      }
+      return;
+    }
     // Obstacles in the first message: replanned once the plan is adopted.
   } else if (in_.plan_ref_case() == v1::DriveRequest::kPlan) {
     PushError(

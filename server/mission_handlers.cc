@@ -374,7 +374,8 @@ absl::Status MissionHandlers::KeepPlans(const CallInfo& call, const FleetMission
     v1::PlanResponse* out = response->mutable_robots(static_cast<int>(i))->mutable_plan();
     RetainedPlanFieldsToProto(*retained, out);
     if (stored_map && retained->area != nullptr) {
-      archive_->Persist(OriginFor(roster.origins[k], robot), *out);
+      // Stored before the mission pushes it onto the robot's session.
+      archive_->PersistNow(OriginFor(roster.origins[k], robot), *out);
     }
     updated.plan_ids[slot[k]] = retained->plan_id;
     archive_->Put(std::move(retained));

@@ -13,6 +13,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/synchronization/notification.h"
 #include "api/convert.h"
 #include "server/log.h"
 #include "server/map_sources.h"
@@ -128,7 +129,25 @@ void PlanArchive::Persist(const v1::PlanRequest& origin, const v1::PlanResponse&
 }
 
 void PlanArchive::PersistNow(const v1::PlanRequest& origin, const v1::PlanResponse& plan) {
-  if (std::shared_ptr<std::string> bytes = Record(origin, plan)) Write(plan.plan_id(), *bytes);
+  std::shared_ptr<std::string> bytes = Record(origin, plan);
+  if (bytes == nullptr) return;
+  const std::string plan_id = plan.plan_id();
+  auto written = std::make_shared<absl::Notification>();
+  const bool queued = io_pool_->TrySubmit([this, bytes, plan_id, written] {
+    Write(plan_id, *bytes);
+    written->Notify();
+  });
+  if (!queued) {
+    LogLine("warn", "plan not persisted: I/O queue full", {{"plan", plan_id}});
+    return;
+  }
+  // A store that hangs (a database gone) delays the answer by this much at
+  // most; the write goes on behind it.
+  if (!written->WaitForNotificationWithTimeout(kPersistNowWait)) {
+    LogLine("warn", "plan write still pending when its answer left",
+            {{"plan", plan_id},
+             {"waited_ms", absl::StrCat(absl::ToInt64Milliseconds(kPersistNowWait))}});
+  }
 }
 
 void PlanArchive::RememberOrigin(const std::string& plan_id,

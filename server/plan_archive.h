@@ -61,12 +61,13 @@ class PlanArchive {
   // Writes the plan (with the original request it continues) to the store,
   // on the I/O pool.
   void Persist(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
-  // The same write on the caller's thread, done when it returns: a replan
-  // is stored before its robot receives it, so a robot whose replica dies
-  // continues on another from the newest plan it holds (docs/robustness.md,
-  // "Drive sessions that outlive their replica"). A failed write is logged,
-  // as Persist's; the call still succeeds.
+  // The same write, waited for (up to kPersistNowWait): a replan is stored
+  // before its robot receives it, so a robot whose replica dies continues on
+  // another from the newest plan it holds (docs/robustness.md, "Drive
+  // sessions that outlive their replica"). A failed write is logged, as
+  // Persist's; a slower one goes on after the wait; the call still succeeds.
   void PersistNow(const v1::PlanRequest& origin, const v1::PlanResponse& plan);
+  static constexpr absl::Duration kPersistNowWait = absl::Milliseconds(250);
   // Names `original_id`'s plan `alias_id` too, a mission of its own (a
   // repeated Plan answered from memory), retained as an alias that starts
   // from the original's origin. When the alias is first used (Get, Find),
