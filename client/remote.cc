@@ -235,27 +235,14 @@ RemotePlanner::DriveSession::~DriveSession() {
 absl::StatusOr<std::unique_ptr<RemotePlanner::DriveSession>> RemotePlanner::Drive(
     const v1::DriveRequest& first, const std::string& map_id) {
   std::unique_ptr<DriveSession> session(new DriveSession(impl_.get(), first, map_id));
+  RETURN_IF_ERROR(session->Open(first));
   // The first message's obstacles are replanned once; a reopened session
   // sends only where the robot is.
   session->first_.clear_obstacles();
-  auto stream = std::make_unique<DriveSession::Stream>();
-  AddCallCredentials(impl_->connection, &stream->context);
-  SetMapId(&stream->context, map_id);
-  stream->rw = impl_->stub->Drive(&stream->context);
-  session->stream_ = std::move(stream);
-  v1::DriveEvent event;
-  if (!session->stream_->rw->Write(first) || !session->stream_->rw->Read(&event)) {
-    session->closed_ = true;
-    const absl::Status s = FromGrpc(session->stream_->rw->Finish());
-    return s.ok() ? absl::UnavailableError("the drive session ended before it was ready") : s;
-  }
-  if (!event.has_ready())
-    return absl::InternalError("the drive session's first event is not `ready`");
-  session->ready_ = event.ready();
   return session;
 }
 
-absl::Status RemotePlanner::DriveSession::Open() {
+absl::Status RemotePlanner::DriveSession::Open(const v1::DriveRequest& first) {
   auto stream = std::make_unique<Stream>();
   AddCallCredentials(owner_->connection, &stream->context);
   SetMapId(&stream->context, map_id_);
@@ -263,11 +250,11 @@ absl::Status RemotePlanner::DriveSession::Open() {
   stream_ = std::move(stream);
   closed_ = false;
   v1::DriveEvent event;
-  if (!stream_->rw->Write(first_) || !stream_->rw->Read(&event)) return Broken();
+  if (!stream_->rw->Write(first) || !stream_->rw->Read(&event)) return Broken();
   if (!event.has_ready()) {
     stream_->context.TryCancel();
     Broken().IgnoreError();
-    return absl::InternalError("the reopened drive session's first event is not `ready`");
+    return absl::InternalError("the drive session's first event is not `ready`");
   }
   ready_ = event.ready();
   return absl::OkStatus();
@@ -321,7 +308,7 @@ absl::Status RemotePlanner::DriveSession::Reconnect(absl::Status broken) {
       absl::SleepFor(wake - absl::Now());
     }
     backoff = std::min(2 * backoff, absl::Seconds(1));
-    broken = Open();
+    broken = Open(first_);
     if (broken.ok()) {
       reconnect_s_.push_back(absl::ToDoubleSeconds(absl::Now() - start));
       return absl::OkStatus();

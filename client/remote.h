@@ -100,8 +100,8 @@ class RemotePlanner {
     friend class RemotePlanner;
     struct Stream;
     DriveSession(Impl* owner, const v1::DriveRequest& first, const std::string& map_id);
-    // Opens a stream with `first_` and reads its ready event.
-    absl::Status Open();
+    // Opens a stream, sends `first` and reads its ready event.
+    absl::Status Open(const v1::DriveRequest& first);
     // After a break: reopens with backoff while the answer is UNAVAILABLE.
     absl::Status Reconnect(absl::Status broken);
     // The stream's final status once Write or Read failed.

@@ -310,9 +310,10 @@ bool HttpGateway::Authenticated(mg_connection* conn, absl::string_view method) {
       options_.tokens->Authenticate(authorization != nullptr ? authorization : "");
   if (tenant.ok()) return true;
   const std::string label =
-      MethodLabel(absl::StrCat("/", v1::CoveragePlanner::service_full_name(), "/", method));
-  RecordUnauthenticated(options_.metrics, method == "events" ? "events" : label,
-                        tenant.status().message(), "http");
+      method == "events"
+          ? "events"
+          : MethodLabel(absl::StrCat("/", v1::CoveragePlanner::service_full_name(), "/", method));
+  RecordUnauthenticated(options_.metrics, label, tenant.status().message(), "http");
   SendError(conn, grpc::StatusCode::UNAUTHENTICATED, std::string(tenant.status().message()),
             /*close=*/true);
   return false;
